@@ -1,0 +1,67 @@
+//! `blendbsdf` — Mitsuba's blend of two BSDFs: f = (1 − weight)·f₁ + weight·f₂, where f₁ is the first
+//! nested BSDF and f₂ the second (weight 0 shows the first alone, 1 the second). A convex combination, so it
+//! conserves energy when both components do. Implemented as a two-term [`Sum`](super::Sum).
+//!
+//! | parameter | type          | default | meaning                                   |
+//! |-----------|---------------|---------|-------------------------------------------|
+//! | `weight`  | float [0,1]   | 0.5     | the share of the second nested BSDF       |
+//! | (nested)  | two bsdfs     | —       | first and second component, in order      |
+//!
+//! ```
+//! use gonio::bsdf::{Bsdf, BsdfModel};
+//! use gonio::math::Vec3;
+//! let b = Bsdf::from_json(r#"{"type": "blendbsdf", "weight": 0.25,
+//!     "a": {"type": "diffuse", "reflectance": 0.0}, "b": {"type": "diffuse", "reflectance": 1.0}}"#).unwrap();
+//! assert!((b.f(Vec3::Z, Vec3::Z).r() - 0.25 / std::f32::consts::PI).abs() < 1e-6);
+//! ```
+
+use super::{Bsdf, BsdfFlags, BsdfModel, BsdfSample, Sum};
+use crate::error::{Error, Result};
+use crate::math::{Vec2, Vec3};
+use crate::props::Props;
+use crate::spectrum::Rgb;
+
+/// A convex blend of two BSDFs.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BlendBsdf {
+    pub weight: f32,
+    mix: Sum,
+}
+
+impl BlendBsdf {
+    pub const EXAMPLES: &'static [&'static str] = &[
+        r#"{"type": "blendbsdf", "a": {"type": "diffuse"}, "b": {"type": "conductor", "material": "Au"}}"#,
+        r#"{"type": "blendbsdf", "weight": 0.9, "a": {"type": "diffuse", "reflectance": 1}, "b": {"type": "dielectric"}}"#,
+        r#"{"type": "blendbsdf", "weight": 0.0, "a": {"type": "diffuse"}, "b": {"type": "thindielectric"}}"#,
+    ];
+
+    /// (1 − weight)·first + weight·second.
+    #[must_use]
+    pub fn new(first: Bsdf, second: Bsdf, weight: f32) -> Self {
+        BlendBsdf { weight, mix: Sum::new(vec![first, second], vec![1.0 - weight, weight]) }
+    }
+
+    pub fn from_props(p: &Props) -> Result<Self> {
+        let weight = p.float_in("weight", 0.5, 0.0, 1.0)?;
+        let nested = p.nested();
+        let [first, second] = nested.as_slice() else {
+            return Err(Error::spec(p.at(), format!("`blendbsdf` needs exactly two nested BSDFs, got {}", nested.len())));
+        };
+        Ok(BlendBsdf::new(Bsdf::from_props(first)?, Bsdf::from_props(second)?, weight))
+    }
+}
+
+impl BsdfModel for BlendBsdf {
+    fn flags(&self) -> BsdfFlags {
+        self.mix.flags()
+    }
+    fn f(&self, wo: Vec3, wi: Vec3) -> Rgb {
+        self.mix.f(wo, wi)
+    }
+    fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
+        self.mix.sample(wo, uc, u)
+    }
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        self.mix.pdf(wo, wi)
+    }
+}

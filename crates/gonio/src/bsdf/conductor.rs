@@ -1,0 +1,111 @@
+//! `conductor` — a perfectly smooth metal: mirror reflection weighted by the exact Fresnel equations of a
+//! conductor with complex index η + i k (Born & Wolf §14.2; pbrt-v4 §9.3.6 and eq. 9.5).
+//!
+//! | parameter              | type          | default  | meaning                                              |
+//! |------------------------|---------------|----------|------------------------------------------------------|
+//! | `material`             | string        | `"none"` | named metal (`Au`, `Ag`, `Al`, `Cu`, `Cr`, `W`, …); `none` reflects 100 % |
+//! | `eta`                  | rgb ≥ 0       | preset   | real part η of the relative complex index (instead of `material`) |
+//! | `k`                    | rgb ≥ 0       | preset   | imaginary part k (absorption) of the index           |
+//! | `specular_reflectance` | rgb [0,1]     | 1        | multiplier on the reflected light (not physical, for artists) |
+//!
+//! One-sided (light from below is absorbed). A single delta lobe: `sample` returns the mirror direction
+//! with probability 1 and weight F(cos θo)·`specular_reflectance`.
+//!
+//! ```
+//! use gonio::bsdf::{Bsdf, BsdfModel};
+//! use gonio::math::{Vec2, Vec3};
+//! let mirror = Bsdf::from_json(r#"{"type": "conductor"}"#).unwrap();
+//! let s = mirror.sample(Vec3::new(0.6, 0.0, 0.8), 0.5, Vec2::splat(0.5)).unwrap();
+//! assert!((s.wi - Vec3::new(-0.6, 0.0, 0.8)).length() < 1e-6);
+//! assert_eq!(s.weight, gonio::Rgb::ONE);
+//! ```
+
+use super::{BsdfFlags, BsdfModel, BsdfSample};
+use crate::error::{Error, Result};
+use crate::fresnel::{fresnel_conductor_rgb, reflect};
+use crate::math::{Vec2, Vec3};
+use crate::props::Props;
+use crate::spectrum::{named, Rgb};
+
+/// A smooth conductor.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Conductor {
+    /// Real part of the complex index; `None` (with `k`) for the 100 % reflecting `material = "none"`.
+    pub eta_k: Option<(Rgb, Rgb)>,
+    pub specular_reflectance: Rgb,
+}
+
+impl Conductor {
+    pub const EXAMPLES: &'static [&'static str] = &[
+        r#"{"type": "conductor"}"#,
+        r#"{"type": "conductor", "material": "Au"}"#,
+        r#"{"type": "conductor", "material": "Cu", "specular_reflectance": [0.2, 0.5, 1.0]}"#,
+        r#"{"type": "conductor", "eta": [0.001, 1, 40], "k": [0, 0.001, 100]}"#,
+    ];
+
+    /// A conductor with complex index `eta + i k`.
+    #[must_use]
+    pub fn new(eta: Rgb, k: Rgb) -> Self {
+        Conductor { eta_k: Some((eta, k)), specular_reflectance: Rgb::ONE }
+    }
+
+    /// The perfect mirror (`material = "none"`).
+    #[must_use]
+    pub fn mirror() -> Self {
+        Conductor { eta_k: None, specular_reflectance: Rgb::ONE }
+    }
+
+    pub fn from_props(p: &Props) -> Result<Self> {
+        let material = p.string("material")?;
+        let has_index = p.has("eta") || p.has("k");
+        let eta = p.rgb_in("eta", Rgb::ZERO, 0.0, f32::MAX)?;
+        let k = p.rgb_in("k", Rgb::ZERO, 0.0, f32::MAX)?;
+        let specular_reflectance = p.reflectance("specular_reflectance", Rgb::ONE)?;
+        let eta_k = match (material, has_index) {
+            (Some(_), true) => return Err(Error::spec(p.at(), "give either `material` or `eta`/`k` to `conductor`, not both")),
+            (None, true) => {
+                if (0..3).any(|c| eta.0[c] + k.0[c] <= 0.0) {
+                    return Err(Error::spec(p.at(), "`conductor` needs eta + k > 0 in every channel"));
+                }
+                Some((eta, k))
+            }
+            (None, false) => None,
+            (Some(m), false) if m == "none" => None,
+            (Some(m), false) => Some(named::conductor(&m).ok_or_else(|| {
+                Error::spec(p.at(), format!("unknown conductor material `{m}`; expected one of: {}", named::CONDUCTORS.join(", ")))
+            })?),
+        };
+        Ok(Conductor { eta_k, specular_reflectance })
+    }
+
+    /// Fresnel reflectance times `specular_reflectance` at incidence cosine `cos_theta_i` ≥ 0.
+    #[must_use]
+    pub fn reflectance(&self, cos_theta_i: f32) -> Rgb {
+        let fresnel = match self.eta_k {
+            Some((eta, k)) => fresnel_conductor_rgb(cos_theta_i, eta, k),
+            None => Rgb::ONE,
+        };
+        fresnel * self.specular_reflectance
+    }
+}
+
+impl BsdfModel for Conductor {
+    fn flags(&self) -> BsdfFlags {
+        BsdfFlags::DELTA_REFLECTION
+    }
+
+    fn f(&self, _wo: Vec3, _wi: Vec3) -> Rgb {
+        Rgb::ZERO
+    }
+
+    fn sample(&self, wo: Vec3, _uc: f32, _u: Vec2) -> Option<BsdfSample> {
+        if wo.z <= 0.0 {
+            return None;
+        }
+        BsdfSample::delta(reflect(wo, Vec3::Z), self.reflectance(wo.z), 1.0, BsdfFlags::DELTA_REFLECTION, 1.0)
+    }
+
+    fn pdf(&self, _wo: Vec3, _wi: Vec3) -> f32 {
+        0.0
+    }
+}

@@ -1,0 +1,136 @@
+//! `dielectric` — a smooth interface between two dielectrics (glass, water): mirror reflection and
+//! refraction by Snell's law, weighted by the exact unpolarised Fresnel equations, with total internal
+//! reflection beyond the critical angle (Born & Wolf §1.5; pbrt-v4 §9.5).
+//!
+//! | parameter                | type            | default | meaning                                         |
+//! |--------------------------|-----------------|---------|-------------------------------------------------|
+//! | `int_ior`                | float or name   | `bk7` (1.5046) | index of the inside (below the surface, z < 0) |
+//! | `ext_ior`                | float or name   | `air` (1.000277) | index of the outside (z > 0)               |
+//! | `specular_reflectance`   | rgb [0,1]       | 1       | multiplier on reflection (not physical)         |
+//! | `specular_transmittance` | rgb [0,1]       | 1       | multiplier on transmission (not physical)       |
+//! | `fresnel`                | bool            | true    | gonio's teaching switch: `false` replaces F(θ) by the constant F(0) = ((η−1)/(η+1))² (total internal reflection stays) |
+//!
+//! Both sides scatter: `wo` below the surface sees the interface from the inside. Names are those of
+//! Mitsuba's IOR table (`vacuum`, `air`, `water`, `bk7`, `diamond`, …).
+//!
+//! Sampling picks reflection with probability F and refraction with 1 − F, so both weights are 1 times
+//! the multipliers, and refraction carries the radiance factor (ηᵢ/ηₜ)² (see [`crate::bsdf`]).
+//!
+//! ```
+//! use gonio::bsdf::{Bsdf, BsdfModel};
+//! use gonio::math::{Vec2, Vec3};
+//! let glass = Bsdf::from_json(r#"{"type": "dielectric", "int_ior": 1.5, "ext_ior": 1.0}"#).unwrap();
+//! // At normal incidence 4 % is reflected: uc = 0.5 chooses refraction, straight through.
+//! let s = glass.sample(Vec3::Z, 0.5, Vec2::ZERO).unwrap();
+//! assert!((s.wi + Vec3::Z).length() < 1e-6);
+//! assert!((s.pdf - 0.96).abs() < 1e-6);
+//! assert!((s.weight.r() - 1.0 / 2.25).abs() < 1e-6); // (1/1.5)² entering glass
+//! ```
+
+use super::{BsdfFlags, BsdfModel, BsdfSample};
+use crate::error::{Error, Result};
+use crate::fresnel::{fresnel_dielectric, reflect, refract};
+use crate::math::{Vec2, Vec3};
+use crate::props::{NumberOrName, Props};
+use crate::spectrum::{named, Rgb};
+
+/// A smooth dielectric interface.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Dielectric {
+    /// Relative index η = int_ior / ext_ior.
+    pub eta: f32,
+    pub specular_reflectance: Rgb,
+    pub specular_transmittance: Rgb,
+    pub fresnel: bool,
+}
+
+impl Dielectric {
+    pub const EXAMPLES: &'static [&'static str] = &[
+        r#"{"type": "dielectric"}"#,
+        r#"{"type": "dielectric", "int_ior": "diamond"}"#,
+        r#"{"type": "dielectric", "int_ior": 1.0, "ext_ior": 1.5}"#,
+        r#"{"type": "dielectric", "int_ior": 1.01}"#,
+        r#"{"type": "dielectric", "int_ior": 1.5, "fresnel": false}"#,
+        r#"{"type": "dielectric", "specular_transmittance": [0.2, 0.7, 0.9]}"#,
+    ];
+
+    #[must_use]
+    pub fn new(eta: f32) -> Self {
+        Dielectric { eta, specular_reflectance: Rgb::ONE, specular_transmittance: Rgb::ONE, fresnel: true }
+    }
+
+    pub fn from_props(p: &Props) -> Result<Self> {
+        Ok(Dielectric {
+            eta: relative_ior(p)?,
+            specular_reflectance: p.reflectance("specular_reflectance", Rgb::ONE)?,
+            specular_transmittance: p.reflectance("specular_transmittance", Rgb::ONE)?,
+            fresnel: p.bool("fresnel", true)?,
+        })
+    }
+
+    /// The reflected fraction for `cos_theta_o` (signed), honouring the `fresnel` switch.
+    #[must_use]
+    pub fn reflected_fraction(&self, cos_theta_o: f32) -> f32 {
+        let f = fresnel_dielectric(cos_theta_o, self.eta);
+        if self.fresnel || f >= 1.0 {
+            f
+        } else {
+            fresnel_dielectric(1.0, self.eta)
+        }
+    }
+}
+
+/// Read `int_ior` / `ext_ior` (numbers > 0 or names from Mitsuba's table) and return their ratio.
+/// Shared by every model with a dielectric interface.
+pub(crate) fn relative_ior(p: &Props) -> Result<f32> {
+    let int_ior = ior(p, "int_ior", 1.5046)?;
+    let ext_ior = ior(p, "ext_ior", 1.000_277)?;
+    Ok(int_ior / ext_ior)
+}
+
+fn ior(p: &Props, name: &'static str, default: f32) -> Result<f32> {
+    match p.number_or_name(name)? {
+        None => Ok(default),
+        Some(NumberOrName::Number(v, at)) => {
+            if v > 0.0 && v.is_finite() && v < 1e4 {
+                Ok(v as f32)
+            } else {
+                Err(Error::spec(at, format!("parameter `{name}` of `{}` must be an index of refraction in (0, 10000), got {v}", p.plugin_type())))
+            }
+        }
+        Some(NumberOrName::Name(n, at)) => named::dielectric_ior(&n).ok_or_else(|| {
+            Error::spec(at, format!("parameter `{name}`: unknown material `{n}`; expected a number or one of: {}", named::DIELECTRICS.join(", ")))
+        }),
+    }
+}
+
+impl BsdfModel for Dielectric {
+    fn flags(&self) -> BsdfFlags {
+        BsdfFlags::DELTA_REFLECTION | BsdfFlags::DELTA_TRANSMISSION
+    }
+
+    fn f(&self, _wo: Vec3, _wi: Vec3) -> Rgb {
+        Rgb::ZERO
+    }
+
+    fn sample(&self, wo: Vec3, uc: f32, _u: Vec2) -> Option<BsdfSample> {
+        if wo.z == 0.0 {
+            return None;
+        }
+        let r = self.reflected_fraction(wo.z);
+        // Choose a lobe in proportion to its energy: the Fresnel factor cancels from both weights.
+        if uc < r {
+            let wi = reflect(wo, Vec3::Z);
+            return BsdfSample::delta(wi, self.specular_reflectance * r, r, BsdfFlags::DELTA_REFLECTION, 1.0);
+        }
+        let t = 1.0 - r;
+        let refr = refract(wo, self.eta)?;
+        // Radiance is compressed into a smaller solid angle on the denser side: (ηᵢ/ηₜ)².
+        let value = self.specular_transmittance * (t / (refr.eta * refr.eta));
+        BsdfSample::delta(refr.wt, value, t, BsdfFlags::DELTA_TRANSMISSION, refr.eta)
+    }
+
+    fn pdf(&self, _wo: Vec3, _wi: Vec3) -> f32 {
+        0.0
+    }
+}

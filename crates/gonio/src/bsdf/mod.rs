@@ -1,0 +1,264 @@
+//! Reflection models. Every model is a small value type implementing [`BsdfModel`]
+//! (`flags`, `f`, `sample`, `pdf`), collected in the closed enum [`Bsdf`].
+//!
+//! # Conventions
+//! - `wo` (towards the viewer) and `wi` (towards the light) point *away* from the surface, are unit
+//!   length and are expressed in the local shading frame, normal = +z.
+//! - `f(wo, wi)` is the BSDF value in sr⁻¹ **without** the cosine. Mitsuba's `eval` includes it:
+//!   `mitsuba.eval(si.wi = a, wo = b) == gonio f(a, b) · |cos θ(b)|`.
+//! - `sample` returns `wi`, the solid-angle `pdf` (for a delta lobe: the discrete probability of choosing
+//!   it, with [`BsdfFlags::DELTA`] set), and `weight = f · |cos θi| / pdf`.
+//! - Transport is radiance transport: refraction scales `f` by (ηᵢ/ηₜ)², where ηᵢ is the index on the
+//!   side of `wo` and ηₜ the index on the side of `wi` (the path's incident and transmitted media;
+//!   [`BsdfSample::eta`] is ηₜ/ηᵢ). Radiance is η²-denser in the denser medium; importance (adjoint)
+//!   transport omits the factor. gonio traces radiance only for now.
+//!
+//! ```
+//! use gonio::bsdf::{Bsdf, BsdfModel};
+//! use gonio::math::{Vec2, Vec3};
+//! let bsdf = Bsdf::from_json(r#"{"type": "diffuse", "reflectance": 0.5}"#).unwrap();
+//! let wo = Vec3::new(0.0, 0.6, 0.8);
+//! let s = bsdf.sample(wo, 0.3, Vec2::new(0.2, 0.7)).unwrap();
+//! // Lambertian: f = ρ/π and the cosine-weighted sample has weight ρ.
+//! assert!((s.weight.r() - 0.5).abs() < 1e-5);
+//! assert!((bsdf.f(wo, s.wi).g() - 0.5 / std::f32::consts::PI).abs() < 1e-6);
+//! ```
+
+pub mod blend;
+pub mod conductor;
+pub mod dielectric;
+pub mod diffuse;
+pub mod sum;
+pub mod thin_dielectric;
+pub mod twosided;
+
+use crate::error::{Error, Result};
+use crate::math::{Vec2, Vec3};
+use crate::props::Props;
+use crate::spectrum::Rgb;
+
+pub use blend::BlendBsdf;
+pub use conductor::Conductor;
+pub use dielectric::Dielectric;
+pub use diffuse::Diffuse;
+pub use sum::Sum;
+pub use thin_dielectric::ThinDielectric;
+pub use twosided::TwoSided;
+
+/// What kind of scattering a model (or one sampled lobe) does. A small bit set.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct BsdfFlags(pub u32);
+
+impl BsdfFlags {
+    pub const NONE: BsdfFlags = BsdfFlags(0);
+    /// Scatters into the hemisphere of `wo`.
+    pub const REFLECTION: BsdfFlags = BsdfFlags(1);
+    /// Scatters into the opposite hemisphere.
+    pub const TRANSMISSION: BsdfFlags = BsdfFlags(2);
+    /// A smooth lobe spread over the hemisphere.
+    pub const DIFFUSE: BsdfFlags = BsdfFlags(4);
+    /// A peaked but finite lobe.
+    pub const GLOSSY: BsdfFlags = BsdfFlags(8);
+    /// A Dirac delta: `f` and `pdf` are zero for every pair of directions; only `sample` finds it.
+    pub const DELTA: BsdfFlags = BsdfFlags(16);
+
+    pub const DIFFUSE_REFLECTION: BsdfFlags = BsdfFlags(1 | 4);
+    pub const GLOSSY_REFLECTION: BsdfFlags = BsdfFlags(1 | 8);
+    pub const DELTA_REFLECTION: BsdfFlags = BsdfFlags(1 | 16);
+    pub const DELTA_TRANSMISSION: BsdfFlags = BsdfFlags(2 | 16);
+
+    #[inline]
+    #[must_use]
+    pub const fn contains(self, other: BsdfFlags) -> bool {
+        self.0 & other.0 == other.0
+    }
+
+    #[inline]
+    #[must_use]
+    pub const fn intersects(self, other: BsdfFlags) -> bool {
+        self.0 & other.0 != 0
+    }
+
+    #[inline]
+    #[must_use]
+    pub const fn union(self, other: BsdfFlags) -> BsdfFlags {
+        BsdfFlags(self.0 | other.0)
+    }
+
+    /// Whether the model has any delta lobe.
+    #[inline]
+    #[must_use]
+    pub const fn has_delta(self) -> bool {
+        self.intersects(BsdfFlags::DELTA)
+    }
+
+    /// Whether the model has any lobe that `f` and `pdf` can see.
+    #[inline]
+    #[must_use]
+    pub const fn has_smooth(self) -> bool {
+        self.intersects(BsdfFlags(4 | 8))
+    }
+
+    /// Names of the set bits, e.g. `"reflection|delta"`.
+    #[must_use]
+    pub fn describe(self) -> String {
+        let names = ["reflection", "transmission", "diffuse", "glossy", "delta"];
+        let parts: Vec<&str> = names.iter().enumerate().filter(|(i, _)| self.0 & (1 << i) != 0).map(|(_, n)| *n).collect();
+        if parts.is_empty() {
+            "none".into()
+        } else {
+            parts.join("|")
+        }
+    }
+}
+
+impl std::ops::BitOr for BsdfFlags {
+    type Output = BsdfFlags;
+    fn bitor(self, o: BsdfFlags) -> BsdfFlags {
+        self.union(o)
+    }
+}
+
+/// One sampled scattering direction.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BsdfSample {
+    /// The sampled direction towards the light, local frame, unit length.
+    pub wi: Vec3,
+    /// `f(wo, wi)`; for a delta lobe the coefficient of the Dirac delta (weight · pdf / |cos θi|).
+    pub f: Rgb,
+    /// Solid-angle density of `wi`; for a delta lobe the discrete probability of having chosen it.
+    pub pdf: f32,
+    /// `f · |cos θi| / pdf`: the Monte Carlo weight of this sample.
+    pub weight: Rgb,
+    /// The lobe that was sampled (reflection or transmission; diffuse, glossy or delta).
+    pub flags: BsdfFlags,
+    /// Relative index of refraction ηₜ/ηᵢ along the sampled path (1 for reflection).
+    pub eta: f32,
+}
+
+impl BsdfSample {
+    /// A sample of a smooth lobe: `weight` is derived from `f` and `pdf`.
+    #[inline]
+    #[must_use]
+    pub fn smooth(wi: Vec3, f: Rgb, pdf: f32, flags: BsdfFlags, eta: f32) -> Option<Self> {
+        if !(pdf > 0.0) || !pdf.is_finite() {
+            return None;
+        }
+        Some(BsdfSample { wi, f, pdf, weight: f * (wi.z.abs() / pdf), flags, eta })
+    }
+
+    /// A sample of a delta lobe chosen with probability `prob`, carrying total energy `value`
+    /// (the weight is `value / prob`, and `f` is the delta's coefficient `value / |cos θi|`).
+    #[inline]
+    #[must_use]
+    pub fn delta(wi: Vec3, value: Rgb, prob: f32, flags: BsdfFlags, eta: f32) -> Option<Self> {
+        if !(prob > 0.0) {
+            return None;
+        }
+        let cos = wi.z.abs();
+        // On the horizon the delta's coefficient is unbounded; report 0 rather than Inf (2026-11: f is
+        // informational for delta lobes, the weight is what integrators use).
+        let f = if cos > 0.0 { value / cos } else { Rgb::ZERO };
+        Some(BsdfSample { wi, f, pdf: prob, weight: value / prob, flags: flags.union(BsdfFlags::DELTA), eta })
+    }
+}
+
+/// The interface every reflection model implements.
+pub trait BsdfModel {
+    /// The lobes this model has.
+    fn flags(&self) -> BsdfFlags;
+
+    /// The BSDF value f(wo, wi) in sr⁻¹, without the cosine. Zero for delta lobes.
+    fn f(&self, wo: Vec3, wi: Vec3) -> Rgb;
+
+    /// Sample `wi` given `wo`, a 1-D sample `uc` (lobe selection) and a 2-D sample `u` (direction).
+    /// `None` when the model does not scatter from `wo`.
+    fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample>;
+
+    /// Solid-angle density with which `sample` produces `wi`, counting smooth lobes only.
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32;
+}
+
+/// Declares the closed set of models: the enum, its `BsdfModel` forwarding, `From` conversions and the
+/// plugin-name table. Adding a model is one line here.
+macro_rules! bsdf_models {
+    ($( $variant:ident($ty:ty) = $plugin:literal ),* $(,)?) => {
+        /// Any gonio reflection model. Nested models (blend, sum, twosided) hold boxed `Bsdf`s.
+        #[derive(Clone, Debug, PartialEq)]
+        pub enum Bsdf { $( $variant($ty) ),* }
+
+        $( impl From<$ty> for Bsdf {
+            #[inline]
+            fn from(m: $ty) -> Bsdf { Bsdf::$variant(m) }
+        } )*
+
+        macro_rules! dispatch {
+            ($self:ident, $m:ident => $call:expr) => { match $self { $( Bsdf::$variant($m) => $call ),* } };
+        }
+
+        impl BsdfModel for Bsdf {
+            #[inline]
+            fn flags(&self) -> BsdfFlags { dispatch!(self, m => m.flags()) }
+            #[inline]
+            fn f(&self, wo: Vec3, wi: Vec3) -> Rgb { dispatch!(self, m => m.f(wo, wi)) }
+            #[inline]
+            fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> { dispatch!(self, m => m.sample(wo, uc, u)) }
+            #[inline]
+            fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 { dispatch!(self, m => m.pdf(wo, wi)) }
+        }
+
+        /// The plugin names gonio understands, as in Mitsuba's `type = "…"`.
+        pub const PLUGINS: &[&str] = &[ $( $plugin ),* ];
+
+        impl Bsdf {
+            /// Build a model from a plugin description (JSON or XML, see [`Props`]).
+            pub fn from_props(props: &Props) -> Result<Bsdf> {
+                let bsdf = match props.plugin_type() {
+                    $( $plugin => <$ty>::from_props(props)?.into(), )*
+                    other => return Err(Error::spec(props.at(), format!(
+                        "unknown BSDF type `{other}`; expected one of: {}", PLUGINS.join(", ")))),
+                };
+                props.finish()?;
+                Ok(bsdf)
+            }
+
+            /// The plugin name of this model.
+            #[must_use]
+            pub fn plugin_name(&self) -> &'static str {
+                match self { $( Bsdf::$variant(_) => $plugin ),* }
+            }
+
+            /// Example specs per plugin (defaults and extreme parameters), used by `gonio check --all`.
+            #[must_use]
+            pub fn examples() -> Vec<&'static str> {
+                let mut all = Vec::new();
+                $( all.extend_from_slice(<$ty>::EXAMPLES); )*
+                all
+            }
+        }
+    };
+}
+
+bsdf_models! {
+    Diffuse(Diffuse) = "diffuse",
+    Conductor(Conductor) = "conductor",
+    Dielectric(Dielectric) = "dielectric",
+    ThinDielectric(ThinDielectric) = "thindielectric",
+    Blend(BlendBsdf) = "blendbsdf",
+    Sum(Sum) = "sum",
+    TwoSided(TwoSided) = "twosided",
+}
+
+impl Bsdf {
+    /// Build a model from a JSON object in Mitsuba's dictionary form, e.g.
+    /// `{"type": "conductor", "material": "Au"}`.
+    pub fn from_json(text: &str) -> Result<Bsdf> {
+        Bsdf::from_props(&Props::from_json(text)?)
+    }
+
+    /// Build a model from an XML document whose root (or only `<bsdf>` child) is a `<bsdf>` element.
+    /// `source` names the file in error messages.
+    pub fn from_xml(text: &str, source: &str) -> Result<Bsdf> {
+        Bsdf::from_props(&Props::from_xml_bsdf(text, source)?)
+    }
+}

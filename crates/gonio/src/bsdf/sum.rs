@@ -1,0 +1,125 @@
+//! `sum` — a linear combination Σₖ wₖ fₖ of nested BSDFs: "a BRDF is usually a sum of components"
+//! (a diffuse base plus a glossy or mirror lobe). gonio's own plugin; `blendbsdf` is built on it.
+//!
+//! | parameter | type            | default   | meaning                                              |
+//! |-----------|-----------------|-----------|------------------------------------------------------|
+//! | (nested)  | bsdf, ≥ 1       | —         | the components, under any names, in the order given  |
+//! | `weights` | list of floats ≥ 0 | all 1  | wₖ, one per component                                |
+//!
+//! Not energy conserving by construction: with Σ wₖ > 1 the albedo may exceed 1, which `gonio check`
+//! reports. Sampling picks component k with probability wₖ/Σw (one-sample MIS, Veach 1997 §9.2.4),
+//! then evaluates the whole mixture at the sampled direction so that `pdf` and `weight` are those of the
+//! mixture; a sampled delta lobe keeps its own discrete probability times wₖ/Σw.
+//!
+//! ```
+//! use gonio::bsdf::{Bsdf, BsdfModel};
+//! use gonio::math::Vec3;
+//! let s = Bsdf::from_json(r#"{"type": "sum", "weights": [0.5, 0.25],
+//!     "a": {"type": "diffuse", "reflectance": 1.0}, "b": {"type": "diffuse", "reflectance": 1.0}}"#).unwrap();
+//! assert!((s.f(Vec3::Z, Vec3::Z).r() - 0.75 / std::f32::consts::PI).abs() < 1e-6);
+//! ```
+
+use super::{Bsdf, BsdfFlags, BsdfModel, BsdfSample};
+use crate::error::{Error, Result};
+use crate::math::{Vec2, Vec3};
+use crate::props::Props;
+use crate::spectrum::Rgb;
+
+/// A weighted sum of BSDFs.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Sum {
+    components: Vec<Bsdf>,
+    weights: Vec<f32>,
+    /// Selection probabilities wₖ / Σw.
+    probs: Vec<f32>,
+}
+
+impl Sum {
+    pub const EXAMPLES: &'static [&'static str] = &[
+        r#"{"type": "sum", "weights": [0.7, 0.3], "base": {"type": "diffuse", "reflectance": 1.0}, "coat": {"type": "conductor"}}"#,
+        r#"{"type": "sum", "weights": [0.5, 0.5], "a": {"type": "diffuse"}, "b": {"type": "dielectric"}}"#,
+        r#"{"type": "sum", "weights": [1, 0], "a": {"type": "diffuse"}, "b": {"type": "conductor", "material": "Au"}}"#,
+    ];
+
+    /// A sum of `components` with `weights` (non-negative, not all zero, as many as components).
+    ///
+    /// # Panics
+    /// In debug builds, when the lengths differ or a weight is negative.
+    #[must_use]
+    pub fn new(components: Vec<Bsdf>, weights: Vec<f32>) -> Self {
+        debug_assert_eq!(components.len(), weights.len());
+        debug_assert!(weights.iter().all(|w| *w >= 0.0));
+        let total: f32 = weights.iter().sum();
+        let probs = weights.iter().map(|w| if total > 0.0 { w / total } else { 0.0 }).collect();
+        Sum { components, weights, probs }
+    }
+
+    #[must_use]
+    pub fn components(&self) -> &[Bsdf] {
+        &self.components
+    }
+
+    #[must_use]
+    pub fn weights(&self) -> &[f32] {
+        &self.weights
+    }
+
+    pub fn from_props(p: &Props) -> Result<Self> {
+        let nested = p.nested();
+        if nested.is_empty() {
+            return Err(Error::spec(p.at(), "`sum` needs at least one nested BSDF"));
+        }
+        let components = nested.into_iter().map(Bsdf::from_props).collect::<Result<Vec<_>>>()?;
+        let weights = match p.floats("weights")? {
+            None => vec![1.0; components.len()],
+            Some(w) => {
+                if w.len() != components.len() {
+                    return Err(Error::spec(p.at(), format!("`sum` has {} nested BSDFs but {} weights", components.len(), w.len())));
+                }
+                if w.iter().any(|v| *v < 0.0) || w.iter().all(|v| *v == 0.0) {
+                    return Err(Error::spec(p.at(), "`sum` weights must be ≥ 0 and not all zero"));
+                }
+                w.into_iter().map(|v| v as f32).collect()
+            }
+        };
+        Ok(Sum::new(components, weights))
+    }
+
+    /// Pick a component from `uc` and rescale `uc` for reuse.
+    fn select(&self, uc: f32) -> Option<(usize, f32)> {
+        let mut start = 0.0;
+        let last = self.probs.iter().rposition(|p| *p > 0.0)?;
+        for (k, p) in self.probs.iter().enumerate() {
+            if *p > 0.0 && (uc < start + p || k == last) {
+                return Some((k, ((uc - start) / p).clamp(0.0, 1.0 - f32::EPSILON)));
+            }
+            start += p;
+        }
+        None
+    }
+}
+
+impl BsdfModel for Sum {
+    fn flags(&self) -> BsdfFlags {
+        self.components.iter().zip(&self.weights).filter(|(_, w)| **w > 0.0).fold(BsdfFlags::NONE, |acc, (c, _)| acc | c.flags())
+    }
+
+    fn f(&self, wo: Vec3, wi: Vec3) -> Rgb {
+        self.components.iter().zip(&self.weights).fold(Rgb::ZERO, |acc, (c, w)| acc + c.f(wo, wi) * *w)
+    }
+
+    fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
+        let (k, uc) = self.select(uc)?;
+        let s = self.components[k].sample(wo, uc, u)?;
+        let (w, p) = (self.weights[k], self.probs[k]);
+        if s.flags.has_delta() {
+            return Some(BsdfSample { f: s.f * w, pdf: s.pdf * p, weight: s.weight * (w / p), ..s });
+        }
+        // A smooth direction: every component's smooth lobes may have produced it.
+        BsdfSample::smooth(s.wi, self.f(wo, s.wi), self.pdf(wo, s.wi), s.flags, s.eta)
+    }
+
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        self.components.iter().zip(&self.probs).filter(|(_, p)| **p > 0.0).map(|(c, p)| c.pdf(wo, wi) * p).sum()
+    }
+}

@@ -1,0 +1,94 @@
+//! `thindielectric` — a thin slab of dielectric (a window pane, a soap film) with parallel smooth faces.
+//! Light reflects at the front, or enters, bounces between the faces any number of times and leaves
+//! through the front (reflection) or the back (transmission, undeviated: the two refractions cancel).
+//!
+//! Summing the geometric series of inter-reflections with single-interface reflectance R and T = 1 − R:
+//! R' = R + T² R / (1 − R²) = 2R / (1 + R), T' = 1 − R' (absorption-free slab; pbrt-v4 §9.5.2's
+//! ThinDielectricBxDF, Mitsuba's `thindielectric`).
+//!
+//! | parameter                | type          | default | meaning                                    |
+//! |--------------------------|---------------|---------|--------------------------------------------|
+//! | `int_ior`                | float or name | `bk7`   | index of the slab                           |
+//! | `ext_ior`                | float or name | `air`   | index around it                             |
+//! | `specular_reflectance`   | rgb [0,1]     | 1       | multiplier on reflection                    |
+//! | `specular_transmittance` | rgb [0,1]     | 1       | multiplier on transmission                  |
+//!
+//! Symmetric: both sides behave alike. Transmission leaves through the same medium it entered, so there
+//! is no radiance scaling and `eta` is 1.
+//!
+//! ```
+//! use gonio::bsdf::{Bsdf, BsdfModel};
+//! use gonio::math::{Vec2, Vec3};
+//! let pane = Bsdf::from_json(r#"{"type": "thindielectric", "int_ior": 1.5, "ext_ior": 1.0}"#).unwrap();
+//! let s = pane.sample(Vec3::Z, 0.5, Vec2::ZERO).unwrap();
+//! assert!((s.wi + Vec3::Z).length() < 1e-6); // straight through
+//! assert!((s.pdf - (1.0 - 2.0 * 0.04 / 1.04)).abs() < 1e-6);
+//! ```
+
+use super::dielectric::relative_ior;
+use super::{BsdfFlags, BsdfModel, BsdfSample};
+use crate::error::Result;
+use crate::fresnel::{fresnel_dielectric, reflect};
+use crate::math::{Vec2, Vec3};
+use crate::props::Props;
+use crate::spectrum::Rgb;
+
+/// A thin dielectric slab.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ThinDielectric {
+    /// Relative index η = int_ior / ext_ior.
+    pub eta: f32,
+    pub specular_reflectance: Rgb,
+    pub specular_transmittance: Rgb,
+}
+
+impl ThinDielectric {
+    pub const EXAMPLES: &'static [&'static str] = &[
+        r#"{"type": "thindielectric"}"#,
+        r#"{"type": "thindielectric", "int_ior": 2.4, "specular_reflectance": [1, 0.5, 0.2]}"#,
+        r#"{"type": "thindielectric", "int_ior": 1.0, "ext_ior": 1.0}"#,
+    ];
+
+    pub fn from_props(p: &Props) -> Result<Self> {
+        Ok(ThinDielectric {
+            eta: relative_ior(p)?,
+            specular_reflectance: p.reflectance("specular_reflectance", Rgb::ONE)?,
+            specular_transmittance: p.reflectance("specular_transmittance", Rgb::ONE)?,
+        })
+    }
+
+    /// Total reflectance R' = 2R/(1 + R) of the slab at incidence cosine `cos_theta` (either side).
+    #[must_use]
+    pub fn reflected_fraction(&self, cos_theta: f32) -> f32 {
+        let r = fresnel_dielectric(cos_theta.abs(), self.eta);
+        // Grazing light (R = 1) is reflected entirely: 2·1/(1+1) = 1, no special case needed.
+        2.0 * r / (1.0 + r)
+    }
+}
+
+impl BsdfModel for ThinDielectric {
+    fn flags(&self) -> BsdfFlags {
+        BsdfFlags::DELTA_REFLECTION | BsdfFlags::DELTA_TRANSMISSION
+    }
+
+    fn f(&self, _wo: Vec3, _wi: Vec3) -> Rgb {
+        Rgb::ZERO
+    }
+
+    fn sample(&self, wo: Vec3, uc: f32, _u: Vec2) -> Option<BsdfSample> {
+        if wo.z == 0.0 {
+            return None;
+        }
+        let r = self.reflected_fraction(wo.z);
+        if uc < r {
+            BsdfSample::delta(reflect(wo, Vec3::Z), self.specular_reflectance * r, r, BsdfFlags::DELTA_REFLECTION, 1.0)
+        } else {
+            let t = 1.0 - r;
+            BsdfSample::delta(-wo, self.specular_transmittance * t, t, BsdfFlags::DELTA_TRANSMISSION, 1.0)
+        }
+    }
+
+    fn pdf(&self, _wo: Vec3, _wi: Vec3) -> f32 {
+        0.0
+    }
+}

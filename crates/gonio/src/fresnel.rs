@@ -1,0 +1,228 @@
+//! Reflection, refraction (Snell's law in vector form) and the exact Fresnel equations for dielectric and
+//! conducting interfaces.
+//!
+//! Convention: `eta` is the *relative* index η_inside / η_outside of the interface, the normal is +z
+//! (outside is z > 0), and `cos_theta_i` is signed: negative means the direction lies inside. References:
+//! Born & Wolf, *Principles of Optics*, §1.5.2 (eqs. 20–21: the amplitude coefficients rₛ, rₚ) and
+//! pbrt-v4 §9.3 (the complex-index form for conductors).
+
+use crate::math::Vec3;
+use crate::spectrum::Rgb;
+
+/// Mirror `w` about the normal `n`: 2 (w·n) n − w. Both point away from the surface.
+#[inline]
+#[must_use]
+pub fn reflect(w: Vec3, n: Vec3) -> Vec3 {
+    2.0 * w.dot(n) * n - w
+}
+
+/// The outcome of refracting a direction through an interface.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Refraction {
+    /// The transmitted direction, pointing away from the surface on the other side.
+    pub wt: Vec3,
+    /// Relative index ηₜ/ηᵢ along this path (η when entering, 1/η when leaving).
+    pub eta: f32,
+}
+
+/// Snell's law in vector form for the local frame (normal +z): the direction transmitted from `wi`
+/// through an interface of relative index `eta` (η_inside/η_outside). `None` on total internal reflection.
+///
+/// With η' = ηₜ/ηᵢ and n on the side of `wi`: wₜ = −wᵢ/η' + (cos θᵢ/η' − cos θₜ) n, where
+/// cos²θₜ = 1 − sin²θᵢ/η'² (pbrt-v4 eq. 9.4).
+#[inline]
+#[must_use]
+pub fn refract(wi: Vec3, eta: f32) -> Option<Refraction> {
+    let (eta, n, cos_i) = if wi.z < 0.0 { (1.0 / eta, -Vec3::Z, -wi.z) } else { (eta, Vec3::Z, wi.z) };
+    let sin2_i = (1.0 - cos_i * cos_i).max(0.0);
+    let sin2_t = sin2_i / (eta * eta);
+    if sin2_t >= 1.0 {
+        return None;
+    }
+    let cos_t = (1.0 - sin2_t).sqrt();
+    let wt = -wi / eta + (cos_i / eta - cos_t) * n;
+    Some(Refraction { wt, eta })
+}
+
+/// Fresnel reflectances (Rₛ, Rₚ) of s- and p-polarised light at a dielectric interface.
+/// `cos_theta_i` is signed (negative: arriving from inside). Both are 1 under total internal reflection.
+#[inline]
+#[must_use]
+pub fn fresnel_dielectric_sp(cos_theta_i: f32, eta: f32) -> (f32, f32) {
+    let (eta, cos_i) = if cos_theta_i < 0.0 { (1.0 / eta, -cos_theta_i) } else { (eta, cos_theta_i) };
+    let cos_i = cos_i.min(1.0);
+    let sin2_t = (1.0 - cos_i * cos_i) / (eta * eta);
+    if sin2_t >= 1.0 {
+        return (1.0, 1.0);
+    }
+    let cos_t = (1.0 - sin2_t).max(0.0).sqrt();
+    // Born & Wolf eq. 1.5.21 with n₁ = 1, n₂ = η.
+    let rs = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    let rp = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    (rs * rs, rp * rp)
+}
+
+/// Unpolarised Fresnel reflectance (Rₛ + Rₚ)/2 of a dielectric interface.
+#[inline]
+#[must_use]
+pub fn fresnel_dielectric(cos_theta_i: f32, eta: f32) -> f32 {
+    let (rs, rp) = fresnel_dielectric_sp(cos_theta_i, eta);
+    0.5 * (rs + rp)
+}
+
+/// A complex number, just enough for the conductor Fresnel equations.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Complex {
+    re: f32,
+    im: f32,
+}
+
+impl Complex {
+    fn new(re: f32, im: f32) -> Self {
+        Complex { re, im }
+    }
+    fn add(self, o: Complex) -> Complex {
+        Complex::new(self.re + o.re, self.im + o.im)
+    }
+    fn sub(self, o: Complex) -> Complex {
+        Complex::new(self.re - o.re, self.im - o.im)
+    }
+    fn mul(self, o: Complex) -> Complex {
+        Complex::new(self.re * o.re - self.im * o.im, self.re * o.im + self.im * o.re)
+    }
+    fn norm(self) -> f32 {
+        self.re * self.re + self.im * self.im
+    }
+    fn div(self, o: Complex) -> Complex {
+        let d = o.norm();
+        Complex::new((self.re * o.re + self.im * o.im) / d, (self.im * o.re - self.re * o.im) / d)
+    }
+    /// Principal square root.
+    fn sqrt(self) -> Complex {
+        let r = self.norm().sqrt();
+        if r == 0.0 {
+            return Complex::new(0.0, 0.0);
+        }
+        let re = (0.5 * (r + self.re)).max(0.0).sqrt();
+        let im = (0.5 * (r - self.re)).max(0.0).sqrt();
+        Complex::new(re, if self.im < 0.0 { -im } else { im })
+    }
+}
+
+/// Unpolarised Fresnel reflectance of a conductor with complex relative index η + i k, for light arriving
+/// at `cos_theta_i` ∈ [0, 1] from the outside. Snell's law with a complex index gives a complex cos θₜ;
+/// the amplitude coefficients are then those of the dielectric case (pbrt-v4 §9.3.6).
+#[must_use]
+pub fn fresnel_conductor(cos_theta_i: f32, eta: f32, k: f32) -> f32 {
+    let cos_i = cos_theta_i.clamp(0.0, 1.0);
+    let n = Complex::new(eta, k);
+    let sin2_i = Complex::new(1.0 - cos_i * cos_i, 0.0);
+    let sin2_t = sin2_i.div(n.mul(n));
+    let cos_t = Complex::new(1.0, 0.0).sub(sin2_t).sqrt();
+    let ci = Complex::new(cos_i, 0.0);
+    let rs = ci.sub(n.mul(cos_t)).div(ci.add(n.mul(cos_t)));
+    let rp = n.mul(ci).sub(cos_t).div(n.mul(ci).add(cos_t));
+    0.5 * (rs.norm() + rp.norm())
+}
+
+/// [`fresnel_conductor`] per RGB channel.
+#[inline]
+#[must_use]
+pub fn fresnel_conductor_rgb(cos_theta_i: f32, eta: Rgb, k: Rgb) -> Rgb {
+    Rgb::new(
+        fresnel_conductor(cos_theta_i, eta.r(), k.r()),
+        fresnel_conductor(cos_theta_i, eta.g(), k.g()),
+        fresnel_conductor(cos_theta_i, eta.b(), k.b()),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn normal_incidence_is_squared_ratio() {
+        for eta in [1.33f32, 1.5, 2.4, 0.7] {
+            let r0 = ((eta - 1.0) / (eta + 1.0)).powi(2);
+            assert!((fresnel_dielectric(1.0, eta) - r0).abs() < 1e-6, "eta {eta}");
+            // Same from the other side (1/η gives the same R₀).
+            assert!((fresnel_dielectric(-1.0, 1.0 / eta) - r0).abs() < 1e-6);
+        }
+        // Glass, η = 1.5: R₀ = 0.04 exactly.
+        assert!((fresnel_dielectric(1.0, 1.5) - 0.04).abs() < 1e-7);
+    }
+
+    #[test]
+    fn brewster_angle_has_no_p_reflection() {
+        let eta = 1.5f32;
+        let theta_b = eta.atan();
+        let (rs, rp) = fresnel_dielectric_sp(theta_b.cos(), eta);
+        assert!(rp < 1e-10, "Rp at Brewster = {rp}");
+        // The averaged value is then Rs/2 exactly; Rs at Brewster for η = 1.5 is
+        // ((cos θB − η cos θt)/(cos θB + η cos θt))² with θt = π/2 − θB: 0.1479.
+        assert!((fresnel_dielectric(theta_b.cos(), eta) - 0.5 * rs).abs() < 1e-7);
+        assert!((rs - 0.147_928).abs() < 1e-5, "Rs = {rs}");
+    }
+
+    #[test]
+    fn critical_angle_starts_total_internal_reflection() {
+        let (n1, n2) = (1.5f32, 1.0f32);
+        let eta = n1 / n2; // inside is the glass, light arrives from inside
+        let theta_c = (n2 / n1).asin();
+        let just_below = -(theta_c - 1e-3).cos();
+        let just_above = -(theta_c + 1e-3).cos();
+        assert!(fresnel_dielectric(just_below, eta) < 1.0);
+        assert_eq!(fresnel_dielectric(just_above, eta), 1.0);
+        let w_below = Vec3::new((theta_c - 1e-3).sin(), 0.0, -(theta_c - 1e-3).cos());
+        let w_above = Vec3::new((theta_c + 1e-3).sin(), 0.0, -(theta_c + 1e-3).cos());
+        assert!(refract(w_below, eta).is_some());
+        assert!(refract(w_above, eta).is_none());
+    }
+
+    #[test]
+    fn refraction_obeys_snell() {
+        let eta = 1.5f32;
+        for theta in [0.0f32, 0.3, 0.9, 1.4] {
+            let wi = Vec3::new(theta.sin(), 0.0, theta.cos());
+            let r = refract(wi, eta).unwrap();
+            assert!((r.wt.length() - 1.0).abs() < 1e-6);
+            assert!(r.wt.z < 0.0);
+            let sin_t = (r.wt.x * r.wt.x + r.wt.y * r.wt.y).sqrt();
+            assert!((theta.sin() - eta * sin_t).abs() < 1e-6, "n1 sinθ1 = n2 sinθ2");
+            assert!(r.wt.x <= 0.0, "the transmitted ray continues across the normal");
+            // Refracting back out retraces the path.
+            let back = refract(r.wt, eta).unwrap();
+            assert!((back.wt - wi).length() < 1e-5);
+            assert!((back.eta - 1.0 / eta).abs() < 1e-7);
+        }
+    }
+
+    #[test]
+    fn conductor_matches_hand_computed_values() {
+        // 1. Normal incidence: R = ((η−1)² + k²)/((η+1)² + k²).
+        //    η = 0.2, k = 3.0: (0.64 + 9)/(1.44 + 9) = 9.64/10.44 = 0.923372.
+        assert!((fresnel_conductor(1.0, 0.2, 3.0) - 0.923_372).abs() < 1e-5);
+        // 2. k = 0 reduces to the dielectric: η = 1.5 at 60°: cos θt = sqrt(1 − 0.75/2.25) = 0.816497;
+        //    rs = (0.5 − 1.224745)/(0.5 + 1.224745) = −0.420204, rp = (0.75 − 0.816497)/(0.75 + 0.816497)
+        //    = −0.042449; F = (0.176571 + 0.001802)/2 = 0.089187.
+        let c60 = 0.5f32;
+        assert!((fresnel_conductor(c60, 1.5, 0.0) - 0.089_187).abs() < 1e-5);
+        assert!((fresnel_conductor(c60, 1.5, 0.0) - fresnel_dielectric(c60, 1.5)).abs() < 1e-6);
+        // 3. Gold-like η = 0.2, k = 3.0 at 60°: η̃² = −8.96 + 1.2i, sin²θt = 0.75/η̃² = −0.082230 − 0.011013i,
+        //    cos θt = sqrt(1 − sin²θt) = 1.040316 + 0.005293i, η̃ cos θt = 0.192184 + 3.122008i;
+        //    |rs|² = |0.5 − η̃ cos θt|²/|0.5 + η̃ cos θt|² = 9.841685 / 10.226053 = 0.962413;
+        //    |rp|² = |η̃/2 − cos θt|²/|η̃/2 + cos θt|² with η̃/2 = 0.1 + 1.5i: 0.874409; F = 0.918411.
+        let f = fresnel_conductor(c60, 0.2, 3.0);
+        assert!((f - 0.918_411).abs() < 1e-5, "F = {f}");
+        // Grazing incidence reflects everything.
+        assert!((fresnel_conductor(0.0, 0.2, 3.0) - 1.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn reflect_is_an_involution() {
+        let w = Vec3::new(0.3, -0.4, 0.866).normalize();
+        let r = reflect(w, Vec3::Z);
+        assert!((r - Vec3::new(-w.x, -w.y, w.z)).length() < 1e-6);
+        assert!((reflect(r, Vec3::Z) - w).length() < 1e-6);
+    }
+}

@@ -1,0 +1,29 @@
+//! # gonio — a physically based reflectance toolkit
+//!
+//! Reflection models with `f`, `sample` and `pdf` ([`bsdf`]), the Fresnel equations ([`fresnel`]),
+//! sampling warps ([`sampling`]), and a verification harness that proves a model's physics
+//! ([`verify`]: chi-square, reciprocity, energy, NaN sweeps).
+//!
+//! ```
+//! use gonio::bsdf::{Bsdf, BsdfModel};
+//! use gonio::math::Vec3;
+//! // A gold mirror: no smooth lobe, so f is zero for any pair of directions...
+//! let gold = Bsdf::from_json(r#"{"type": "conductor", "material": "Au"}"#).unwrap();
+//! assert!(gold.f(Vec3::Z, Vec3::Z).is_black());
+//! // ...and its albedo at normal incidence is the Fresnel reflectance of gold, reddish-yellow.
+//! let a = gonio::verify::energy::albedo(&gold, Vec3::Z, 16, 1);
+//! assert!(a.r() > a.b());
+//! ```
+
+pub mod bsdf;
+pub mod error;
+pub mod fresnel;
+pub mod math;
+pub mod props;
+pub mod sampling;
+pub mod spectrum;
+pub mod verify;
+
+pub use bsdf::{Bsdf, BsdfFlags, BsdfModel, BsdfSample};
+pub use error::{Error, Result};
+pub use spectrum::Rgb;

@@ -1,0 +1,7 @@
+//! Vectors (re-exported from `glam`), the shading frame and spherical coordinates.
+
+pub mod frame;
+pub mod spherical;
+
+pub use frame::Frame;
+pub use glam::{DVec3, Vec2, Vec3};

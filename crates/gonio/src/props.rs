@@ -1,0 +1,452 @@
+//! Plugin descriptions: the parameters of one Mitsuba-style plugin (`type` plus named values), read from
+//! a JSON object in Mitsuba's dictionary form or from an XML element in Mitsuba's scene format.
+//!
+//! Models read their parameters with typed getters that check ranges; [`Props::finish`] then rejects
+//! anything nobody asked for, so a misspelt parameter is an error rather than silently ignored.
+//!
+//! | JSON value                                  | XML element                          | read as          |
+//! |---------------------------------------------|--------------------------------------|------------------|
+//! | `0.5`                                       | `<float name=… value="0.5"/>`, `<integer>` | number     |
+//! | `true`                                      | `<boolean name=… value="true"/>`     | bool             |
+//! | `"Au"`                                      | `<string name=… value="Au"/>`        | string           |
+//! | `[0.1, 0.2, 0.3]`, `{"type": "rgb", "value": …}` | `<rgb name=… value="0.1, 0.2, 0.3"/>` | colour (a number is grey) |
+//! | `{"type": "spectrum", "value": 0.5}`        | `<spectrum name=… value="0.5"/>`     | number (uniform spectrum) |
+//! | `{"type": "diffuse", …}` under any key      | nested `<bsdf type="diffuse">`       | nested plugin    |
+
+use crate::error::{Error, Result};
+use crate::spectrum::Rgb;
+use std::cell::{Cell, RefCell};
+
+/// One parameter value.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Value {
+    Number(f64),
+    Bool(bool),
+    String(String),
+    /// A list of numbers (a colour when it has three).
+    List(Vec<f64>),
+    Nested(Props),
+}
+
+impl Value {
+    fn kind(&self) -> &'static str {
+        match self {
+            Value::Number(_) => "a number",
+            Value::Bool(_) => "a boolean",
+            Value::String(_) => "a string",
+            Value::List(_) => "a list of numbers",
+            Value::Nested(_) => "a nested plugin",
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+struct Entry {
+    name: String,
+    value: Value,
+    at: String,
+    used: Cell<bool>,
+}
+
+/// The parameters of one plugin.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Props {
+    plugin: String,
+    id: Option<String>,
+    at: String,
+    entries: Vec<Entry>,
+    /// Every name a model asked for, to list the accepted parameters in errors.
+    asked: RefCell<Vec<&'static str>>,
+}
+
+impl Props {
+    /// An empty description of plugin `plugin`, located at `at` (for messages).
+    #[must_use]
+    pub fn new(plugin: &str, at: &str) -> Self {
+        Props { plugin: plugin.into(), id: None, at: at.into(), entries: Vec::new(), asked: RefCell::new(Vec::new()) }
+    }
+
+    /// Add a parameter (the last of equal names wins, as in Mitsuba's dictionaries).
+    pub fn set(&mut self, name: &str, value: Value, at: &str) {
+        self.entries.retain(|e| e.name != name);
+        self.entries.push(Entry { name: name.into(), value, at: at.into(), used: Cell::new(false) });
+    }
+
+    #[must_use]
+    pub fn plugin_type(&self) -> &str {
+        &self.plugin
+    }
+
+    #[must_use]
+    pub fn id(&self) -> Option<&str> {
+        self.id.as_deref()
+    }
+
+    /// Where this plugin was described: "file:line:col" or a JSON path.
+    #[must_use]
+    pub fn at(&self) -> &str {
+        &self.at
+    }
+
+    fn entry(&self, name: &'static str) -> Option<&Entry> {
+        self.asked.borrow_mut().push(name);
+        let e = self.entries.iter().find(|e| e.name == name)?;
+        e.used.set(true);
+        Some(e)
+    }
+
+    fn wrong(&self, e: &Entry, expected: &str) -> Error {
+        Error::spec(&e.at, format!("parameter `{}` of `{}` must be {expected}, got {}", e.name, self.plugin, e.value.kind()))
+    }
+
+    /// Whether the parameter was given (does not count as reading it).
+    #[must_use]
+    pub fn has(&self, name: &str) -> bool {
+        self.entries.iter().any(|e| e.name == name)
+    }
+
+    /// A finite number in `[lo, hi]`, or `default` when absent.
+    pub fn float_in(&self, name: &'static str, default: f32, lo: f32, hi: f32) -> Result<f32> {
+        let Some(e) = self.entry(name) else { return Ok(default) };
+        let v = match &e.value {
+            Value::Number(v) => *v,
+            _ => return Err(self.wrong(e, "a number")),
+        };
+        if !(v >= lo as f64 && v <= hi as f64) {
+            return Err(Error::spec(&e.at, format!("parameter `{name}` of `{}` must be a number in {}, got {v}", self.plugin, range(lo, hi))));
+        }
+        Ok(v as f32)
+    }
+
+    /// A finite number > 0, or `default` when absent.
+    pub fn float_positive(&self, name: &'static str, default: f32) -> Result<f32> {
+        let v = self.float_in(name, default, 0.0, f32::MAX)?;
+        if v <= 0.0 {
+            let at = self.entry(name).map_or(self.at.clone(), |e| e.at.clone());
+            return Err(Error::spec(at, format!("parameter `{name}` of `{}` must be a number > 0, got {v}", self.plugin)));
+        }
+        Ok(v)
+    }
+
+    /// A colour with every channel in `[lo, hi]` (a number is a grey), or `default` when absent.
+    pub fn rgb_in(&self, name: &'static str, default: Rgb, lo: f32, hi: f32) -> Result<Rgb> {
+        let Some(e) = self.entry(name) else { return Ok(default) };
+        let c = match &e.value {
+            Value::Number(v) => [*v; 3],
+            Value::List(l) if l.len() == 3 => [l[0], l[1], l[2]],
+            _ => return Err(self.wrong(e, "a colour (a number or three numbers)")),
+        };
+        if c.iter().any(|v| !(*v >= lo as f64 && *v <= hi as f64)) {
+            return Err(Error::spec(
+                &e.at,
+                format!("parameter `{name}` of `{}` must have every channel in {}, got [{}, {}, {}]", self.plugin, range(lo, hi), c[0], c[1], c[2]),
+            ));
+        }
+        Ok(Rgb::new(c[0] as f32, c[1] as f32, c[2] as f32))
+    }
+
+    /// A reflectance-like colour in [0, 1]³.
+    pub fn reflectance(&self, name: &'static str, default: Rgb) -> Result<Rgb> {
+        self.rgb_in(name, default, 0.0, 1.0)
+    }
+
+    /// A list of numbers: a JSON array, or an XML string of comma- or space-separated numbers.
+    pub fn floats(&self, name: &'static str) -> Result<Option<Vec<f64>>> {
+        let Some(e) = self.entry(name) else { return Ok(None) };
+        let list = match &e.value {
+            Value::List(l) => l.clone(),
+            Value::Number(v) => vec![*v],
+            Value::String(s) => parse_numbers(s).ok_or_else(|| self.wrong(e, "a list of numbers"))?,
+            _ => return Err(self.wrong(e, "a list of numbers")),
+        };
+        if list.iter().any(|v| !v.is_finite()) {
+            return Err(Error::spec(&e.at, format!("parameter `{name}` of `{}` must hold finite numbers", self.plugin)));
+        }
+        Ok(Some(list))
+    }
+
+    /// A string, or `None` when absent.
+    pub fn string(&self, name: &'static str) -> Result<Option<String>> {
+        let Some(e) = self.entry(name) else { return Ok(None) };
+        match &e.value {
+            Value::String(s) => Ok(Some(s.clone())),
+            _ => Err(self.wrong(e, "a string")),
+        }
+    }
+
+    /// A parameter that may be a number or a name (e.g. `int_ior = 1.5` or `"bk7"`).
+    pub fn number_or_name(&self, name: &'static str) -> Result<Option<NumberOrName>> {
+        let Some(e) = self.entry(name) else { return Ok(None) };
+        match &e.value {
+            Value::Number(v) => Ok(Some(NumberOrName::Number(*v, e.at.clone()))),
+            Value::String(s) => Ok(Some(NumberOrName::Name(s.clone(), e.at.clone()))),
+            _ => Err(self.wrong(e, "a number or a name")),
+        }
+    }
+
+    /// A boolean, or `default` when absent.
+    pub fn bool(&self, name: &'static str, default: bool) -> Result<bool> {
+        let Some(e) = self.entry(name) else { return Ok(default) };
+        match &e.value {
+            Value::Bool(b) => Ok(*b),
+            _ => Err(self.wrong(e, "true or false")),
+        }
+    }
+
+    /// Nested plugins, in the order they were given, whatever their parameter names.
+    #[must_use]
+    pub fn nested(&self) -> Vec<&Props> {
+        self.entries
+            .iter()
+            .filter_map(|e| match &e.value {
+                Value::Nested(p) => {
+                    e.used.set(true);
+                    Some(p)
+                }
+                _ => None,
+            })
+            .collect()
+    }
+
+    /// Reject parameters that no model asked for.
+    pub fn finish(&self) -> Result<()> {
+        if let Some(e) = self.entries.iter().find(|e| !e.used.get()) {
+            let mut asked = self.asked.borrow().clone();
+            asked.sort_unstable();
+            asked.dedup();
+            let accepted = if asked.is_empty() { "none".to_string() } else { asked.join(", ") };
+            return Err(Error::spec(&e.at, format!("unknown parameter `{}` for `{}` (accepted: {accepted})", e.name, self.plugin)));
+        }
+        Ok(())
+    }
+
+    // ---------------------------------------------------------------- JSON
+
+    /// Parse a JSON object in Mitsuba's dictionary form.
+    pub fn from_json(text: &str) -> Result<Props> {
+        let value: serde_json::Value = serde_json::from_str(text).map_err(|e| Error::Syntax {
+            at: format!("JSON spec:{}:{}", e.line(), e.column()),
+            message: format!("not valid JSON: {e}"),
+        })?;
+        Props::from_json_value(&value, "$")
+    }
+
+    /// Build from an already parsed JSON object; `path` names it in messages (`$` for the root).
+    pub fn from_json_value(value: &serde_json::Value, path: &str) -> Result<Props> {
+        let serde_json::Value::Object(map) = value else {
+            return Err(Error::spec(path, "expected a JSON object with a \"type\" key"));
+        };
+        let Some(serde_json::Value::String(plugin)) = map.get("type") else {
+            return Err(Error::spec(path, "expected a \"type\" key naming the plugin, e.g. {\"type\": \"diffuse\"}"));
+        };
+        let mut props = Props::new(plugin, path);
+        for (key, v) in map {
+            let at = format!("{path}.{key}");
+            match key.as_str() {
+                "type" => {}
+                "id" => match v {
+                    serde_json::Value::String(s) => props.id = Some(s.clone()),
+                    _ => return Err(Error::spec(at, "\"id\" must be a string")),
+                },
+                _ => {
+                    let value = json_value(v, &at)?;
+                    props.set(key, value, &at);
+                }
+            }
+        }
+        Ok(props)
+    }
+
+    // ---------------------------------------------------------------- XML
+
+    /// Parse an XML document whose root is a `<bsdf>` element, or whose root holds exactly one.
+    pub fn from_xml_bsdf(text: &str, source: &str) -> Result<Props> {
+        let doc = roxmltree::Document::parse(text).map_err(|e| {
+            let p = e.pos();
+            Error::Syntax { at: format!("{source}:{}:{}", p.row, p.col), message: format!("not valid XML: {e}") }
+        })?;
+        let root = doc.root_element();
+        let bsdf = if root.has_tag_name("bsdf") {
+            root
+        } else {
+            let found: Vec<_> = root.children().filter(|n| n.has_tag_name("bsdf")).collect();
+            match found.as_slice() {
+                [one] => *one,
+                [] => return Err(Error::spec(xml_at(source, root), format!("expected a <bsdf> element, found <{}>", root.tag_name().name()))),
+                _ => return Err(Error::spec(xml_at(source, root), format!("expected one <bsdf> element, found {}", found.len()))),
+            }
+        };
+        Props::from_xml_element(bsdf, source)
+    }
+
+    /// Build from one plugin element (`<bsdf type="…">`) of a Mitsuba XML document.
+    pub fn from_xml_element(node: roxmltree::Node, source: &str) -> Result<Props> {
+        let at = xml_at(source, node);
+        let plugin = node
+            .attribute("type")
+            .ok_or_else(|| Error::spec(&at, format!("<{}> needs a type attribute", node.tag_name().name())))?;
+        let mut props = Props::new(plugin, &at);
+        props.id = node.attribute("id").map(str::to_string);
+        let mut unnamed = 0;
+        for child in node.children().filter(|n| n.is_element()) {
+            let cat = xml_at(source, child);
+            let tag = child.tag_name().name();
+            if matches!(tag, "bsdf") {
+                let name = match child.attribute("name") {
+                    Some(n) => n.to_string(),
+                    None => {
+                        unnamed += 1;
+                        format!("_arg_{unnamed}")
+                    }
+                };
+                let nested = Props::from_xml_element(child, source)?;
+                props.set(&name, Value::Nested(nested), &cat);
+                continue;
+            }
+            let name = child.attribute("name").ok_or_else(|| Error::spec(&cat, format!("<{tag}> needs a name attribute")))?;
+            let raw = child.attribute("value").ok_or_else(|| Error::spec(&cat, format!("<{tag} name=\"{name}\"> needs a value attribute")))?;
+            let bad = |what: &str| Error::spec(&cat, format!("<{tag} name=\"{name}\">: expected {what}, got \"{raw}\""));
+            let value = match tag {
+                "float" | "integer" => Value::Number(parse_number(raw).ok_or_else(|| bad("a number"))?),
+                "boolean" => Value::Bool(match raw.trim() {
+                    "true" => true,
+                    "false" => false,
+                    _ => return Err(bad("true or false")),
+                }),
+                "string" => Value::String(raw.to_string()),
+                "rgb" => match parse_numbers(raw).as_deref() {
+                    Some([v]) => Value::Number(*v),
+                    Some([r, g, b]) => Value::List(vec![*r, *g, *b]),
+                    _ => return Err(bad("one or three numbers")),
+                },
+                "spectrum" => match parse_numbers(raw).as_deref() {
+                    Some([v]) => Value::Number(*v),
+                    _ => return Err(bad("a single number (wavelength:value lists need the scene loader)")),
+                },
+                _ => return Err(Error::spec(&cat, format!("unsupported element <{tag}> inside <{}>", node.tag_name().name()))),
+            };
+            props.set(name, value, &cat);
+        }
+        Ok(props)
+    }
+}
+
+/// A parameter given as a number or a name (e.g. an index of refraction).
+#[derive(Clone, Debug, PartialEq)]
+pub enum NumberOrName {
+    /// The number and where it was given.
+    Number(f64, String),
+    /// The name and where it was given.
+    Name(String, String),
+}
+
+fn range(lo: f32, hi: f32) -> String {
+    if hi == f32::MAX {
+        format!("[{lo}, ∞)")
+    } else {
+        format!("[{lo}, {hi}]")
+    }
+}
+
+fn xml_at(source: &str, node: roxmltree::Node) -> String {
+    let p = node.document().text_pos_at(node.range().start);
+    format!("{source}:{}:{}", p.row, p.col)
+}
+
+fn parse_number(s: &str) -> Option<f64> {
+    s.trim().parse::<f64>().ok()
+}
+
+fn parse_numbers(s: &str) -> Option<Vec<f64>> {
+    let parts: Vec<&str> = s.split(|c: char| c == ',' || c.is_whitespace()).filter(|p| !p.is_empty()).collect();
+    if parts.is_empty() {
+        return None;
+    }
+    parts.into_iter().map(parse_number).collect()
+}
+
+fn json_value(v: &serde_json::Value, at: &str) -> Result<Value> {
+    use serde_json::Value as J;
+    Ok(match v {
+        J::Number(n) => Value::Number(n.as_f64().ok_or_else(|| Error::spec(at, "number out of range"))?),
+        J::Bool(b) => Value::Bool(*b),
+        J::String(s) => Value::String(s.clone()),
+        J::Array(items) => Value::List(
+            items
+                .iter()
+                .map(|i| i.as_f64().ok_or_else(|| Error::spec(at, "expected a list of numbers")))
+                .collect::<Result<_>>()?,
+        ),
+        J::Object(map) => match map.get("type").and_then(J::as_str) {
+            Some("rgb") | Some("spectrum") => {
+                let inner = map.get("value").ok_or_else(|| Error::spec(at, "expected a \"value\" key"))?;
+                if let Some(extra) = map.keys().find(|k| *k != "type" && *k != "value") {
+                    return Err(Error::spec(at, format!("unknown key `{extra}` in a colour")));
+                }
+                match json_value(inner, &format!("{at}.value"))? {
+                    v @ Value::Number(_) => v,
+                    Value::List(l) if l.len() == 3 && map["type"] == "rgb" => Value::List(l),
+                    _ => return Err(Error::spec(at, "a colour's \"value\" must be a number or three numbers")),
+                }
+            }
+            Some(_) => Value::Nested(Props::from_json_value(v, at)?),
+            None => return Err(Error::spec(at, "a nested object needs a \"type\" key")),
+        },
+        J::Null => return Err(Error::spec(at, "null is not a parameter value")),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn json_values_of_every_kind() {
+        let p = Props::from_json(r#"{"type": "x", "a": 0.5, "b": [0.1, 0.2, 0.3], "c": {"type": "rgb", "value": 0.25},
+            "d": "Au", "e": true, "n": {"type": "diffuse"}}"#)
+        .unwrap();
+        assert_eq!(p.plugin_type(), "x");
+        assert_eq!(p.float_in("a", 0.0, 0.0, 1.0).unwrap(), 0.5);
+        assert_eq!(p.reflectance("b", Rgb::ZERO).unwrap(), Rgb::new(0.1, 0.2, 0.3));
+        assert_eq!(p.reflectance("c", Rgb::ZERO).unwrap(), Rgb::splat(0.25));
+        assert_eq!(p.string("d").unwrap().as_deref(), Some("Au"));
+        assert!(p.bool("e", false).unwrap());
+        assert_eq!(p.nested().len(), 1);
+        p.finish().unwrap();
+    }
+
+    #[test]
+    fn unknown_parameter_is_named_with_accepted_list() {
+        let p = Props::from_json(r#"{"type": "diffuse", "reflectanse": 0.5}"#).unwrap();
+        let _ = p.reflectance("reflectance", Rgb::splat(0.5)).unwrap();
+        let err = p.finish().unwrap_err().to_string();
+        assert!(err.contains("unknown parameter `reflectanse`") && err.contains("accepted: reflectance"), "{err}");
+        assert!(err.starts_with("$.reflectanse"), "{err}");
+    }
+
+    #[test]
+    fn range_errors_name_parameter_and_range() {
+        let p = Props::from_json(r#"{"type": "diffuse", "reflectance": [0.5, 1.5, 0.2]}"#).unwrap();
+        let err = p.reflectance("reflectance", Rgb::ZERO).unwrap_err().to_string();
+        assert!(err.contains("`reflectance`") && err.contains("[0, 1]") && err.contains("1.5"), "{err}");
+    }
+
+    #[test]
+    fn xml_element_with_line_numbers() {
+        let xml = "<bsdf type=\"twosided\">\n  <bsdf type=\"diffuse\">\n    <rgb name=\"reflectance\" value=\"0.1, 0.2, 0.3\"/>\n  </bsdf>\n</bsdf>";
+        let p = Props::from_xml_bsdf(xml, "m.xml").unwrap();
+        let inner = p.nested()[0];
+        assert_eq!(inner.reflectance("reflectance", Rgb::ZERO).unwrap(), Rgb::new(0.1, 0.2, 0.3));
+        assert_eq!(inner.at(), "m.xml:2:3");
+        let bad = Props::from_xml_bsdf("<bsdf type=\"diffuse\">\n<float name=\"x\" value=\"abc\"/></bsdf>", "m.xml").unwrap_err();
+        assert!(bad.to_string().starts_with("m.xml:2:1"), "{bad}");
+    }
+
+    #[test]
+    fn malformed_input_is_a_syntax_error() {
+        assert!(matches!(Props::from_json("{\"type\": "), Err(Error::Syntax { .. })));
+        assert!(matches!(Props::from_xml_bsdf("<bsdf", "f.xml"), Err(Error::Syntax { .. })));
+        assert!(Props::from_json("[1, 2]").is_err());
+        assert!(Props::from_json("{\"reflectance\": 1}").unwrap_err().to_string().contains("\"type\""));
+    }
+}

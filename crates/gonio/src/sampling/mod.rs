@@ -1,0 +1,9 @@
+//! Sampling: warps of the unit square ([`warp`]), piecewise-constant distributions ([`distribution`]),
+//! the random number generator ([`rng`]) and multiple importance sampling weights ([`mis`]).
+
+pub mod distribution;
+pub mod mis;
+pub mod rng;
+pub mod warp;
+
+pub use rng::Pcg32;

@@ -1,0 +1,2 @@
+//! The verification harness (to be written).
+pub mod energy;
