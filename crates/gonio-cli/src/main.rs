@@ -1,1 +1,39 @@
-fn main() {}
+//! `gonio` — the command line of the gonio reflectance toolkit.
+//!
+//! Exit codes: 0 success, 1 a check failed, 2 bad input (the message names the file or parameter).
+
+mod cmd;
+mod spec;
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(name = "gonio", version, about = "A physically based reflectance toolkit: verify, measure and render BSDFs")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Verify a BSDF: chi-square of sample vs pdf, sample weights, reciprocity, energy, NaN/Inf sweep.
+    Check(cmd::check::Args),
+    /// Print the directional albedo ∫ f cos dωi of a BSDF against θo.
+    Albedo(cmd::albedo::Args),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Check(args) => cmd::check::run(args),
+        Command::Albedo(args) => cmd::albedo::run(args),
+    };
+    match result {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("gonio: error: {e}");
+            ExitCode::from(2)
+        }
+    }
+}

@@ -113,7 +113,10 @@ impl Props {
             _ => return Err(self.wrong(e, "a number")),
         };
         if !(v >= lo as f64 && v <= hi as f64) {
-            return Err(Error::spec(&e.at, format!("parameter `{name}` of `{}` must be a number in {}, got {v}", self.plugin, range(lo, hi))));
+            return Err(Error::spec(
+                &e.at,
+                format!("parameter `{name}` of `{}` must be a number in {}, got {v}", self.plugin, range(lo, hi)),
+            ));
         }
         Ok(v as f32)
     }
@@ -139,7 +142,14 @@ impl Props {
         if c.iter().any(|v| !(*v >= lo as f64 && *v <= hi as f64)) {
             return Err(Error::spec(
                 &e.at,
-                format!("parameter `{name}` of `{}` must have every channel in {}, got [{}, {}, {}]", self.plugin, range(lo, hi), c[0], c[1], c[2]),
+                format!(
+                    "parameter `{name}` of `{}` must have every channel in {}, got [{}, {}, {}]",
+                    self.plugin,
+                    range(lo, hi),
+                    c[0],
+                    c[1],
+                    c[2]
+                ),
             ));
         }
         Ok(Rgb::new(c[0] as f32, c[1] as f32, c[2] as f32))
@@ -224,10 +234,8 @@ impl Props {
 
     /// Parse a JSON object in Mitsuba's dictionary form.
     pub fn from_json(text: &str) -> Result<Props> {
-        let value: serde_json::Value = serde_json::from_str(text).map_err(|e| Error::Syntax {
-            at: format!("JSON spec:{}:{}", e.line(), e.column()),
-            message: format!("not valid JSON: {e}"),
-        })?;
+        let value: serde_json::Value = serde_json::from_str(text)
+            .map_err(|e| Error::Syntax { at: format!("JSON spec:{}:{}", e.line(), e.column()), message: format!("not valid JSON: {e}") })?;
         Props::from_json_value(&value, "$")
     }
 
@@ -272,7 +280,9 @@ impl Props {
             let found: Vec<_> = root.children().filter(|n| n.has_tag_name("bsdf")).collect();
             match found.as_slice() {
                 [one] => *one,
-                [] => return Err(Error::spec(xml_at(source, root), format!("expected a <bsdf> element, found <{}>", root.tag_name().name()))),
+                [] => {
+                    return Err(Error::spec(xml_at(source, root), format!("expected a <bsdf> element, found <{}>", root.tag_name().name())))
+                }
                 _ => return Err(Error::spec(xml_at(source, root), format!("expected one <bsdf> element, found {}", found.len()))),
             }
         };
@@ -282,9 +292,8 @@ impl Props {
     /// Build from one plugin element (`<bsdf type="…">`) of a Mitsuba XML document.
     pub fn from_xml_element(node: roxmltree::Node, source: &str) -> Result<Props> {
         let at = xml_at(source, node);
-        let plugin = node
-            .attribute("type")
-            .ok_or_else(|| Error::spec(&at, format!("<{}> needs a type attribute", node.tag_name().name())))?;
+        let plugin =
+            node.attribute("type").ok_or_else(|| Error::spec(&at, format!("<{}> needs a type attribute", node.tag_name().name())))?;
         let mut props = Props::new(plugin, &at);
         props.id = node.attribute("id").map(str::to_string);
         let mut unnamed = 0;
@@ -304,7 +313,8 @@ impl Props {
                 continue;
             }
             let name = child.attribute("name").ok_or_else(|| Error::spec(&cat, format!("<{tag}> needs a name attribute")))?;
-            let raw = child.attribute("value").ok_or_else(|| Error::spec(&cat, format!("<{tag} name=\"{name}\"> needs a value attribute")))?;
+            let raw =
+                child.attribute("value").ok_or_else(|| Error::spec(&cat, format!("<{tag} name=\"{name}\"> needs a value attribute")))?;
             let bad = |what: &str| Error::spec(&cat, format!("<{tag} name=\"{name}\">: expected {what}, got \"{raw}\""));
             let value = match tag {
                 "float" | "integer" => Value::Number(parse_number(raw).ok_or_else(|| bad("a number"))?),
@@ -372,10 +382,7 @@ fn json_value(v: &serde_json::Value, at: &str) -> Result<Value> {
         J::Bool(b) => Value::Bool(*b),
         J::String(s) => Value::String(s.clone()),
         J::Array(items) => Value::List(
-            items
-                .iter()
-                .map(|i| i.as_f64().ok_or_else(|| Error::spec(at, "expected a list of numbers")))
-                .collect::<Result<_>>()?,
+            items.iter().map(|i| i.as_f64().ok_or_else(|| Error::spec(at, "expected a list of numbers"))).collect::<Result<_>>()?,
         ),
         J::Object(map) => match map.get("type").and_then(J::as_str) {
             Some("rgb") | Some("spectrum") => {
@@ -402,8 +409,10 @@ mod tests {
 
     #[test]
     fn json_values_of_every_kind() {
-        let p = Props::from_json(r#"{"type": "x", "a": 0.5, "b": [0.1, 0.2, 0.3], "c": {"type": "rgb", "value": 0.25},
-            "d": "Au", "e": true, "n": {"type": "diffuse"}}"#)
+        let p = Props::from_json(
+            r#"{"type": "x", "a": 0.5, "b": [0.1, 0.2, 0.3], "c": {"type": "rgb", "value": 0.25},
+            "d": "Au", "e": true, "n": {"type": "diffuse"}}"#,
+        )
         .unwrap();
         assert_eq!(p.plugin_type(), "x");
         assert_eq!(p.float_in("a", 0.0, 0.0, 1.0).unwrap(), 0.5);

@@ -95,11 +95,17 @@ fn ior(p: &Props, name: &'static str, default: f32) -> Result<f32> {
             if v > 0.0 && v.is_finite() && v < 1e4 {
                 Ok(v as f32)
             } else {
-                Err(Error::spec(at, format!("parameter `{name}` of `{}` must be an index of refraction in (0, 10000), got {v}", p.plugin_type())))
+                Err(Error::spec(
+                    at,
+                    format!("parameter `{name}` of `{}` must be an index of refraction in (0, 10000), got {v}", p.plugin_type()),
+                ))
             }
         }
         Some(NumberOrName::Name(n, at)) => named::dielectric_ior(&n).ok_or_else(|| {
-            Error::spec(at, format!("parameter `{name}`: unknown material `{n}`; expected a number or one of: {}", named::DIELECTRICS.join(", ")))
+            Error::spec(
+                at,
+                format!("parameter `{name}`: unknown material `{n}`; expected a number or one of: {}", named::DIELECTRICS.join(", ")),
+            )
         }),
     }
 }

@@ -156,9 +156,9 @@ impl BsdfSample {
             return None;
         }
         let cos = wi.z.abs();
-        // On the horizon the delta's coefficient is unbounded; report 0 rather than Inf (2026-11: f is
-        // informational for delta lobes, the weight is what integrators use).
-        let f = if cos > 0.0 { value / cos } else { Rgb::ZERO };
+        // On (or within f32 overflow of) the horizon the delta's coefficient is unbounded; report 0 rather
+        // than Inf (2026-11: f is informational for delta lobes, the weight is what integrators use).
+        let f = value.map(|v| if cos > 0.0 && (v / cos).is_finite() { v / cos } else { 0.0 });
         Some(BsdfSample { wi, f, pdf: prob, weight: value / prob, flags: flags.union(BsdfFlags::DELTA), eta })
     }
 }

@@ -1,0 +1,2 @@
+pub mod albedo;
+pub mod check;
