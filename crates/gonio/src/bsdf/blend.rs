@@ -65,3 +65,22 @@ impl BsdfModel for BlendBsdf {
         self.mix.pdf(wo, wi)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn weight_follows_mitsuba_zero_is_first_one_is_second() {
+        let spec = |w: f32| {
+            format!(
+                r#"{{"type": "blendbsdf", "weight": {w}, "a": {{"type": "diffuse", "reflectance": 0.1}}, "b": {{"type": "diffuse", "reflectance": 0.9}}}}"#
+            )
+        };
+        let f = |w: f32| Bsdf::from_json(&spec(w)).unwrap().f(Vec3::Z, Vec3::Z).r() * std::f32::consts::PI;
+        assert!((f(0.0) - 0.1).abs() < 1e-6);
+        assert!((f(1.0) - 0.9).abs() < 1e-6);
+        assert!((f(0.5) - 0.5).abs() < 1e-6);
+        assert!(Bsdf::from_json(r#"{"type": "blendbsdf", "a": {"type": "diffuse"}}"#).is_err());
+    }
+}

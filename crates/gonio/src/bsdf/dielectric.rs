@@ -140,3 +140,64 @@ impl BsdfModel for Dielectric {
         0.0
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fresnel::fresnel_dielectric;
+
+    fn glass() -> Dielectric {
+        Dielectric::new(1.5)
+    }
+
+    #[test]
+    fn lobe_probabilities_are_fresnel_from_both_sides() {
+        let d = glass();
+        for cos in [0.9f32, 0.5, 0.1, -0.95, -0.8] {
+            let wo = Vec3::new((1.0 - cos * cos).sqrt(), 0.0, cos);
+            let r = fresnel_dielectric(cos, 1.5);
+            let refl = d.sample(wo, 0.0, Vec2::ZERO).unwrap();
+            assert!((refl.pdf - r).abs() < 1e-6 && refl.wi.z * wo.z > 0.0);
+            assert_eq!(refl.weight, Rgb::ONE);
+            let tran = d.sample(wo, 0.999_999, Vec2::ZERO).unwrap();
+            assert!((tran.pdf - (1.0 - r)).abs() < 1e-6 && tran.wi.z * wo.z < 0.0);
+            // Radiance scaling (ηᵢ/ηₜ)² = 1/eta²; eta = 1.5 entering, 1/1.5 leaving.
+            let expect_eta = if cos > 0.0 { 1.5 } else { 1.0 / 1.5 };
+            assert!((tran.eta - expect_eta).abs() < 1e-6);
+            assert!((tran.weight.g() - 1.0 / (expect_eta * expect_eta)).abs() < 1e-5);
+        }
+    }
+
+    #[test]
+    fn total_internal_reflection_beyond_the_critical_angle() {
+        let d = glass();
+        let theta_c = (1.0f32 / 1.5).asin();
+        let theta = theta_c + 0.05;
+        let wo = Vec3::new(theta.sin(), 0.0, -theta.cos());
+        for uc in [0.0, 0.5, 0.999_99] {
+            let s = d.sample(wo, uc, Vec2::ZERO).unwrap();
+            assert_eq!(s.pdf, 1.0);
+            assert!(s.wi.z < 0.0, "stays inside");
+            assert!(s.flags.contains(BsdfFlags::DELTA_REFLECTION));
+        }
+    }
+
+    #[test]
+    fn fresnel_switch_gives_a_constant_split() {
+        let d = Dielectric { fresnel: false, ..glass() };
+        for cos in [1.0f32, 0.5, 0.05] {
+            assert!((d.reflected_fraction(cos) - 0.04).abs() < 1e-6);
+        }
+        // Total internal reflection is geometry, not Fresnel: it stays.
+        assert_eq!(d.reflected_fraction(-0.1), 1.0);
+    }
+
+    #[test]
+    fn named_and_numeric_indices() {
+        let d =
+            Dielectric::from_props(&Props::from_json(r#"{"type": "dielectric", "int_ior": "bk7", "ext_ior": "vacuum"}"#).unwrap()).unwrap();
+        assert!((d.eta - 1.5046).abs() < 1e-6);
+        let d = Dielectric::from_props(&Props::from_json(r#"{"type": "dielectric"}"#).unwrap()).unwrap();
+        assert!((d.eta - 1.5046 / 1.000_277).abs() < 1e-6, "Mitsuba's defaults: bk7 in air");
+    }
+}

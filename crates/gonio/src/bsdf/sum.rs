@@ -123,3 +123,38 @@ impl BsdfModel for Sum {
         self.components.iter().zip(&self.probs).filter(|(_, p)| **p > 0.0).map(|(c, p)| c.pdf(wo, wi) * p).sum()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn mixture_of_smooth_and_delta_lobes() {
+        let s = Bsdf::from_json(
+            r#"{"type": "sum", "weights": [0.6, 0.2], "a": {"type": "diffuse", "reflectance": 1}, "b": {"type": "conductor"}}"#,
+        )
+        .unwrap();
+        let wo = Vec3::new(0.6, 0.0, 0.8);
+        // Selection probabilities 0.75 / 0.25.
+        let d = s.sample(wo, 0.9, Vec2::splat(0.3)).unwrap();
+        assert!(d.flags.has_delta());
+        assert!((d.pdf - 0.25).abs() < 1e-6 && (d.weight.r() - 0.2 / 0.25).abs() < 1e-5);
+        let m = s.sample(wo, 0.1, Vec2::splat(0.3)).unwrap();
+        assert!(!m.flags.has_delta());
+        assert!((m.pdf - 0.75 * m.wi.z / std::f32::consts::PI).abs() < 1e-6);
+        assert!((m.weight.r() - 0.6 / 0.75).abs() < 1e-5);
+        assert_eq!(s.flags(), BsdfFlags::DIFFUSE_REFLECTION | BsdfFlags::DELTA_REFLECTION);
+    }
+
+    #[test]
+    fn weights_are_validated() {
+        for bad in [
+            r#"{"type": "sum", "weights": [1], "a": {"type": "diffuse"}, "b": {"type": "diffuse"}}"#,
+            r#"{"type": "sum", "weights": [-1, 1], "a": {"type": "diffuse"}, "b": {"type": "diffuse"}}"#,
+            r#"{"type": "sum", "weights": [0, 0], "a": {"type": "diffuse"}, "b": {"type": "diffuse"}}"#,
+            r#"{"type": "sum"}"#,
+        ] {
+            assert!(Bsdf::from_json(bad).is_err(), "{bad}");
+        }
+    }
+}

@@ -92,3 +92,24 @@ impl BsdfModel for ThinDielectric {
         0.0
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn slab_reflectance_is_the_sum_of_the_interreflection_series() {
+        let slab = ThinDielectric { eta: 1.5, specular_reflectance: Rgb::ONE, specular_transmittance: Rgb::ONE };
+        for cos in [1.0f32, 0.6, 0.2, 0.01] {
+            let r = fresnel_dielectric(cos, 1.5);
+            let t = 1.0 - r;
+            // R + T²R + T²R³ + … summed term by term.
+            let series: f32 = r + (0..200).map(|k| t * t * r.powi(2 * k + 1)).sum::<f32>();
+            assert!((slab.reflected_fraction(cos) - series).abs() < 1e-5, "cos {cos}");
+            assert_eq!(slab.reflected_fraction(-cos), slab.reflected_fraction(cos), "both sides alike");
+        }
+        let s = slab.sample(Vec3::new(0.6, 0.0, -0.8), 0.99, Vec2::ZERO).unwrap();
+        assert!((s.wi - Vec3::new(-0.6, 0.0, 0.8)).length() < 1e-6, "transmission is undeviated");
+        assert_eq!(s.eta, 1.0);
+    }
+}

@@ -97,3 +97,23 @@ impl BsdfModel for TwoSided {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn back_side_mirrors_the_front_or_uses_its_own_model() {
+        let t = Bsdf::from_json(
+            r#"{"type": "twosided", "f": {"type": "diffuse", "reflectance": 0.2}, "b": {"type": "diffuse", "reflectance": 0.8}}"#,
+        )
+        .unwrap();
+        let (wo, wi) = (Vec3::new(0.0, 0.6, -0.8), Vec3::new(0.6, 0.0, -0.8));
+        assert!((t.f(wo, wi).r() - 0.8 / std::f32::consts::PI).abs() < 1e-6);
+        assert!((t.f(-wo, -wi).r() - 0.2 / std::f32::consts::PI).abs() < 1e-6);
+        assert!(t.f(wo, -wi).is_black(), "no transmission");
+        let s = t.sample(wo, 0.5, Vec2::new(0.3, 0.7)).unwrap();
+        assert!(s.wi.z < 0.0 && (s.weight.r() - 0.8).abs() < 1e-6);
+        assert!(Bsdf::from_json(r#"{"type": "twosided", "a": {"type": "dielectric"}}"#).is_err());
+    }
+}

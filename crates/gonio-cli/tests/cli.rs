@@ -1,0 +1,64 @@
+//! The `gonio` binary end to end: good input passes, bad input gets one clear line and exit code 2.
+
+use std::process::{Command, Output};
+
+fn gonio(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_gonio")).args(args).output().expect("run gonio")
+}
+
+fn data(name: &str) -> String {
+    format!("{}/tests/data/{name}", env!("CARGO_MANIFEST_DIR"))
+}
+
+#[test]
+fn check_passes_a_good_model_with_a_table() {
+    let out = gonio(&["check", r#"{"type": "diffuse", "reflectance": [0.2, 0.4, 0.6]}"#, "--samples", "200000", "--sweep", "100000"]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(0), "{stdout}");
+    for row in ["chi2", "reciprocity", "albedo max", "white furnace", "NaN/Inf sweep", "sample weight/pdf"] {
+        assert!(stdout.contains(row), "missing row {row}:\n{stdout}");
+    }
+}
+
+#[test]
+fn check_reads_an_xml_file_and_prints_json() {
+    let out = gonio(&["check", &data("rough_gold_plate.xml"), "--json", "--samples", "200000", "--sweep", "100000"]);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("valid JSON");
+    assert_eq!(v["passed"], true);
+    assert!(v["checks"].as_array().unwrap().len() >= 8);
+}
+
+#[test]
+fn bad_input_is_one_line_and_exit_code_two() {
+    let bad_xml = data("bad_param.xml");
+    let cases: &[(&[&str], &str)] = &[
+        (&["check", r#"{"type": "glass"}"#], "unknown BSDF type `glass`"),
+        (&["check", r#"{"type": "diffuse", "albedo": 0.5}"#], "unknown parameter `albedo`"),
+        (&["check", r#"{"type": "diffuse", "reflectance": 1.5}"#], "[0, 1]"),
+        (&["check", r#"{"type": "dielectric", "int_ior": -1}"#], "`int_ior`"),
+        (&["check", r#"{"type": "dielectric", "int_ior": 0}"#], "(0, 10000)"),
+        (&["check", r#"{"type": "conductor", "material": "Unobtainium"}"#], "unknown conductor material"),
+        (&["check", r#"{"type": "blendbsdf", "weight": 2, "a": {"type": "diffuse"}, "b": {"type": "diffuse"}}"#], "`weight`"),
+        (&["check", r#"{"type": "diffuse", "reflectance": "#], "not valid JSON"),
+        (&["check", "<bsdf type=\"diffuse\">"], "not valid XML"),
+        (&["check", &bad_xml], "bad_param.xml:3:5: unknown parameter `roughness`"),
+        (&["check", "/no/such/file.xml"], "/no/such/file.xml"),
+    ];
+    for (args, expect) in cases {
+        let out = gonio(args);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(stderr.contains(expect), "{args:?}: expected {expect:?} in {stderr:?}");
+        assert_eq!(stderr.trim_end().lines().count(), 1, "{args:?}: {stderr}");
+        assert!(!stderr.contains("panicked"));
+    }
+}
+
+#[test]
+fn nan_parameters_are_rejected() {
+    // JSON has no NaN literal; XML does.
+    let out = gonio(&["check", "<bsdf type=\"diffuse\"><float name=\"reflectance\" value=\"nan\"/></bsdf>"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("`reflectance`"));
+}
