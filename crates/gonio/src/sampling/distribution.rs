@@ -81,7 +81,7 @@ impl Distribution1D {
         }
         let n = func.len();
         let total: f64 = func.iter().map(|v| f64::from(*v)).sum();
-        let uniform = !(total > 0.0);
+        let uniform = total <= 0.0; // entries are finite and ≥ 0 by now, so the sum is too
         let mut cdf = Vec::with_capacity(n + 1);
         cdf.push(0.0);
         let mut acc = 0.0;

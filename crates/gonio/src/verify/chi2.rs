@@ -645,7 +645,11 @@ fn verdict(tally: Tally, grid: &Grid, integrals: &[f64], cfg: &Chi2Config, names
     let no_sample_expected = n * rest.max(0.0);
 
     // Samples where the pdf is zero: fail at once, naming the first such cell.
-    let zero_cells: Vec<usize> = (0..observed.len()).filter(|i| observed[*i] > 0.0 && !(expected[*i] > 0.0)).collect();
+    let bad_pdf: Vec<usize> = (0..expected.len()).filter(|i| !expected[*i].is_finite() || expected[*i] < 0.0).collect();
+    if let Some(first) = bad_pdf.first() {
+        problems.push(format!("the pdf is negative or not finite in {} cells (first: {})", bad_pdf.len(), grid.describe_cell(*first, names)));
+    }
+    let zero_cells: Vec<usize> = (0..observed.len()).filter(|i| observed[*i] > 0.0 && expected[*i] == 0.0).collect();
     if let Some(first) = zero_cells.first() {
         let count: f64 = zero_cells.iter().map(|i| observed[*i]).sum();
         problems.push(format!(
@@ -739,7 +743,7 @@ pub fn chi2_bsdf(bsdf: &Bsdf, wo: Vec3, cfg: &Chi2Config) -> Chi2Result {
             t.no_sample += 1;
             return;
         };
-        if !(s.pdf > 0.0) || !s.pdf.is_finite() {
+        if s.pdf <= 0.0 || !s.pdf.is_finite() {
             t.invalid(format!("pdf = {} for wi = {}", s.pdf, s.wi));
             return;
         }
@@ -949,6 +953,22 @@ mod tests {
         let r = chi2_warp(crate::sampling::warp::sample_uniform_sphere, |w| f64::from(cosine_hemisphere_pdf(w)), &cfg);
         assert!(!r.passed);
         assert!(r.message.contains("where the pdf is 0"), "{r}");
+    }
+
+    #[test]
+    fn bad_pdfs_fail_with_a_message() {
+        let cfg = Chi2Config { samples: 100_000, ..Chi2Config::default() };
+        let sample = crate::sampling::warp::sample_cosine_hemisphere;
+        // A density that integrates to 2.
+        let r = chi2_warp(sample, |w| 2.0 * f64::from(cosine_hemisphere_pdf(w)), &cfg);
+        assert!(!r.passed && r.message.contains("more than 1"), "{r}");
+        // A density that integrates to 1/2: the missing half is expected in the no-sample bin.
+        let r = chi2_warp(sample, |w| 0.5 * f64::from(cosine_hemisphere_pdf(w)), &cfg);
+        assert!(!r.passed && r.message.contains("not produced"), "{r}");
+        assert!((r.no_sample_expected - 0.5 * cfg.samples as f64).abs() < 1.0);
+        // NaN somewhere.
+        let r = chi2_warp(sample, |w| if w.x > 0.5 { f64::NAN } else { f64::from(cosine_hemisphere_pdf(w)) }, &cfg);
+        assert!(!r.passed && r.message.contains("not finite"), "{r}");
     }
 
     #[test]
