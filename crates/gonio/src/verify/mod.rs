@@ -17,6 +17,7 @@
 //! ```
 
 pub mod consistency;
+pub mod chi2;
 pub mod energy;
 pub mod reciprocity;
 pub mod sweep;
@@ -149,6 +150,13 @@ impl Report {
     }
 }
 
+/// A file-name-safe version of a report name (a JSON spec, a path).
+fn file_stem(name: &str) -> String {
+    let stem: String = name.chars().map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '_' { c } else { '_' }).collect();
+    let stem = stem.split('_').filter(|p| !p.is_empty()).collect::<Vec<_>>().join("_");
+    stem.chars().take(80).collect()
+}
+
 fn format_value(v: f64) -> String {
     if v == 0.0 {
         "0".into()
@@ -192,6 +200,36 @@ pub fn check<M: BsdfModel + Sync + ?Sized>(bsdf: &M, cfg: &CheckConfig) -> Repor
 pub fn check_named<M: BsdfModel + Sync + ?Sized>(bsdf: &M, name: &str, cfg: &CheckConfig) -> Report {
     let mut rows = Vec::new();
     let dirs = test_directions(bsdf);
+
+    // Chi-square of sample() against pdf() at every test direction, one Šidák family.
+    let chi2_cfg = chi2::Chi2Config {
+        samples: cfg.chi2_samples,
+        significance: cfg.significance,
+        tests: cfg.sidak_family.unwrap_or(dirs.len()).max(1),
+        seed: cfg.seed,
+        ..chi2::Chi2Config::default()
+    };
+    for (k, &wo) in dirs.iter().enumerate() {
+        let r = chi2::chi2_bsdf(bsdf, wo, &chi2_cfg);
+        let mut detail = r.message.clone();
+        if !r.passed {
+            if let Some(dir) = &cfg.histogram_dir {
+                let file = dir.join(format!("chi2-{}-{k}.txt", file_stem(name)));
+                let written = std::fs::create_dir_all(dir).and_then(|()| r.write_histograms(&file));
+                detail += &match written {
+                    Ok(()) => format!("; histograms in {}", file.display()),
+                    Err(e) => format!("; could not write histograms to {}: {e}", file.display()),
+                };
+            }
+        }
+        rows.push(CheckRow {
+            check: format!("chi2 cosθo={:+.2}", wo.z),
+            measured: r.p_value,
+            limit: format!("p > {:.2e}", r.alpha),
+            passed: r.passed,
+            detail,
+        });
+    }
 
     // Consistency of sample() with f() and pdf().
     let c = consistency::consistency(bsdf, &dirs, cfg.consistency_samples, cfg.seed);
