@@ -154,11 +154,7 @@ mod tests {
         // ȳ peaks at 1 at 555 nm (node 39); Mitsuba 3.9.1's `mi.cie1931_xyz(555.0)` prints
         // [0.51205, 1, 0.00575] (to 6 digits; the stored `f32` values are these).
         let at_555 = cie1931_xyz(555.0);
-        for (v, want) in at_555.iter().zip([
-            f64::from(0.512_050_1_f32),
-            1.0,
-            f64::from(0.005_749_999_f32),
-        ]) {
+        for (v, want) in at_555.iter().zip([f64::from(0.512_050_1_f32), 1.0, f64::from(0.005_749_999_f32)]) {
             assert!((v - want).abs() <= 1e-12 * want, "{v} vs {want}");
         }
         let mid = cie1931_xyz(557.5);

@@ -32,10 +32,8 @@ use super::Rgb;
 
 /// Names accepted by `conductor.material`: `"none"` (a perfect mirror) and every metal with embedded
 /// data, spelled as Mitsuba 3 spells them (its `data/ior/NAME.eta.spd` file names; case-sensitive).
-pub const CONDUCTORS: &[&str] = &[
-    "none", "a-C", "Ag", "Al", "Au", "Be", "Cr", "Cu", "Ir", "Li", "Mo", "Ni_palik", "Rh", "Ta",
-    "TiN", "V_palik", "W",
-];
+pub const CONDUCTORS: &[&str] =
+    &["none", "a-C", "Ag", "Al", "Au", "Be", "Cr", "Cu", "Ir", "Li", "Mo", "Ni_palik", "Rh", "Ta", "TiN", "V_palik", "W"];
 
 /// The embedded spectra: (name, η table, k table), in the `.spd` text format of [`parse_spd`].
 macro_rules! spd_tables {
@@ -47,10 +45,8 @@ macro_rules! spd_tables {
         )),*]
     };
 }
-const CONDUCTOR_SPECTRA: &[(&str, &str, &str)] = spd_tables!(
-    "a-C", "Ag", "Al", "Au", "Be", "Cr", "Cu", "Ir", "Li", "Mo", "Ni_palik", "Rh", "Ta", "TiN",
-    "V_palik", "W",
-);
+const CONDUCTOR_SPECTRA: &[(&str, &str, &str)] =
+    spd_tables!("a-C", "Ag", "Al", "Au", "Be", "Cr", "Cu", "Ir", "Li", "Mo", "Ni_palik", "Rh", "Ta", "TiN", "V_palik", "W",);
 
 /// (η, k) of a named conductor, reduced to linear sRGB as Mitsuba 3's RGB variants do (see the module
 /// docs). `"none"` gives (0, 1); gonio treats it as a 100 % mirror before it looks at η and k.
@@ -62,28 +58,15 @@ pub fn conductor(name: &str) -> Option<(Rgb, Rgb)> {
     // The reductions are computed once, on first use (32 spectra × 1000 samples).
     static PRESETS: OnceLock<Vec<(&'static str, Rgb, Rgb)>> = OnceLock::new();
     let presets = PRESETS.get_or_init(|| {
-        CONDUCTOR_SPECTRA
-            .iter()
-            .map(|&(name, eta, k)| {
-                (
-                    name,
-                    embedded_spd_to_rgb(name, eta),
-                    embedded_spd_to_rgb(name, k),
-                )
-            })
-            .collect()
+        CONDUCTOR_SPECTRA.iter().map(|&(name, eta, k)| (name, embedded_spd_to_rgb(name, eta), embedded_spd_to_rgb(name, k))).collect()
     });
-    presets
-        .iter()
-        .find(|p| p.0 == name)
-        .map(|&(_, eta, k)| (eta, k))
+    presets.iter().find(|p| p.0 == name).map(|&(_, eta, k)| (eta, k))
 }
 
 /// Reduces one embedded table. The tables are compiled in and checked by the tests, so a parse error
 /// here is a bug in gonio, not bad user input.
 fn embedded_spd_to_rgb(name: &str, text: &str) -> Rgb {
-    let (wavelengths, values) = parse_spd(text)
-        .unwrap_or_else(|e| panic!("embedded spectrum of `{name}` is malformed: {e}"));
+    let (wavelengths, values) = parse_spd(text).unwrap_or_else(|e| panic!("embedded spectrum of `{name}` is malformed: {e}"));
     spectrum_to_rgb(&wavelengths, &values)
 }
 
@@ -147,10 +130,7 @@ pub const DIELECTRICS: &[&str] = &[
 /// ignoring ASCII case (`"BK7"` is `"bk7"`).
 #[must_use]
 pub fn dielectric_ior(name: &str) -> Option<f32> {
-    DIELECTRIC_TABLE
-        .iter()
-        .find(|(n, _)| n.eq_ignore_ascii_case(name))
-        .map(|&(_, ior)| ior)
+    DIELECTRIC_TABLE.iter().find(|(n, _)| n.eq_ignore_ascii_case(name)).map(|&(_, ior)| ior)
 }
 
 /// Number of wavelengths at which [`spectrum_to_rgb`] samples [`CIE_MIN`, `CIE_MAX`] (Mitsuba 3's
@@ -166,10 +146,7 @@ const SPECTRUM_TO_RGB_STEPS: usize = 1000;
 #[must_use]
 pub fn spectrum_to_rgb(wavelengths: &[f64], values: &[f64]) -> Rgb {
     debug_assert_eq!(wavelengths.len(), values.len(), "one value per wavelength");
-    debug_assert!(
-        wavelengths.windows(2).all(|w| w[0] <= w[1]),
-        "wavelengths must ascend"
-    );
+    debug_assert!(wavelengths.windows(2).all(|w| w[0] <= w[1]), "wavelengths must ascend");
     let n = wavelengths.len().min(values.len());
     if n < 2 {
         return Rgb::ZERO;
@@ -180,28 +157,15 @@ pub fn spectrum_to_rgb(wavelengths: &[f64], values: &[f64]) -> Rgb {
     let mut xyz = [0.0_f64; 3];
     for i in 0..SPECTRUM_TO_RGB_STEPS {
         // Step 1: 1000 wavelengths spanning the CIE range, both ends included.
-        let lambda =
-            CIE_MIN + (i as f64 / (SPECTRUM_TO_RGB_STEPS - 1) as f64) * (CIE_MAX - CIE_MIN);
+        let lambda = CIE_MIN + (i as f64 / (SPECTRUM_TO_RGB_STEPS - 1) as f64) * (CIE_MAX - CIE_MIN);
         // Step 2: outside the table the spectrum counts as 0.
         if !(first..=last).contains(&lambda) {
             continue;
         }
         // Step 3: the interval [x0, x1] holding λ (the last one for λ = last), and the linear interpolant.
-        let i0 = (wavelengths
-            .partition_point(|&w| w <= lambda)
-            .saturating_sub(1))
-        .min(n - 2);
-        let (x0, x1, y0, y1) = (
-            wavelengths[i0],
-            wavelengths[i0 + 1],
-            values[i0],
-            values[i0 + 1],
-        );
-        let s = if x1 > x0 {
-            y0 + (y1 - y0) * (lambda - x0) / (x1 - x0)
-        } else {
-            y1
-        };
+        let i0 = (wavelengths.partition_point(|&w| w <= lambda).saturating_sub(1)).min(n - 2);
+        let (x0, x1, y0, y1) = (wavelengths[i0], wavelengths[i0 + 1], values[i0], values[i0 + 1]);
+        let s = if x1 > x0 { y0 + (y1 - y0) * (lambda - x0) / (x1 - x0) } else { y1 };
         let cmf = cie1931_xyz(lambda);
         for c in 0..3 {
             xyz[c] += cmf[c] * s;
@@ -211,25 +175,15 @@ pub fn spectrum_to_rgb(wavelengths: &[f64], values: &[f64]) -> Rgb {
     let scale = (CIE_MAX - CIE_MIN) / SPECTRUM_TO_RGB_STEPS as f64 * CIE_Y_NORMALIZATION;
     let rgb = xyz_to_linear_srgb(xyz.map(|v| v * scale));
     #[allow(clippy::cast_possible_truncation)] // gonio renders in f32
-    Rgb::new(
-        rgb[0].max(0.0) as f32,
-        rgb[1].max(0.0) as f32,
-        rgb[2].max(0.0) as f32,
-    )
+    Rgb::new(rgb[0].max(0.0) as f32, rgb[1].max(0.0) as f32, rgb[2].max(0.0) as f32)
 }
 
 /// CIE XYZ → linear sRGB (Rec. 709 primaries, D65 white), with the coefficients Mitsuba 3 uses
 /// (`xyz_to_srgb`: IEC 61966-2-1 to 6 decimals, stored as `f32`).
 #[must_use]
 pub fn xyz_to_linear_srgb(xyz: [f64; 3]) -> [f64; 3] {
-    const M: [[f32; 3]; 3] = [
-        [3.240_479, -1.537_15, -0.498_535],
-        [-0.969_256, 1.875_991, 0.041_556],
-        [0.055_648, -0.204_043, 1.057_311],
-    ];
-    M.map(|row| {
-        f64::from(row[0]) * xyz[0] + f64::from(row[1]) * xyz[1] + f64::from(row[2]) * xyz[2]
-    })
+    const M: [[f32; 3]; 3] = [[3.240_479, -1.537_15, -0.498_535], [-0.969_256, 1.875_991, 0.041_556], [0.055_648, -0.204_043, 1.057_311]];
+    M.map(|row| f64::from(row[0]) * xyz[0] + f64::from(row[1]) * xyz[1] + f64::from(row[2]) * xyz[2])
 }
 
 /// Why a `.spd` text could not be read.
@@ -264,9 +218,7 @@ pub fn parse_spd(text: &str) -> Result<(Vec<f64>, Vec<f64>), SpdError> {
         let syntax = |reason: String| SpdError::Syntax { line, reason };
         let mut tokens = trimmed.split_whitespace();
         let mut number = |what: &str| -> Result<f64, SpdError> {
-            let token = tokens
-                .next()
-                .ok_or_else(|| syntax(format!("missing {what}")))?;
+            let token = tokens.next().ok_or_else(|| syntax(format!("missing {what}")))?;
             match token.parse::<f64>() {
                 Ok(v) if v.is_finite() => Ok(v),
                 _ => Err(syntax(format!("{what} `{token}` is not a finite number"))),
@@ -275,14 +227,9 @@ pub fn parse_spd(text: &str) -> Result<(Vec<f64>, Vec<f64>), SpdError> {
         let wavelength = number("wavelength")?;
         let value = number("value")?;
         if let Some(extra) = tokens.next() {
-            return Err(syntax(format!(
-                "unexpected `{extra}` after the wavelength-value pair"
-            )));
+            return Err(syntax(format!("unexpected `{extra}` after the wavelength-value pair")));
         }
-        if wavelengths
-            .last()
-            .is_some_and(|&previous| wavelength <= previous)
-        {
+        if wavelengths.last().is_some_and(|&previous| wavelength <= previous) {
             return Err(SpdError::NotAscending { line, wavelength });
         }
         wavelengths.push(wavelength);
@@ -331,11 +278,7 @@ mod tests {
     const TOLERANCE: f64 = 1e-7;
 
     fn max_relative_error(got: Rgb, want: [f64; 3]) -> f64 {
-        got.to_f64()
-            .iter()
-            .zip(want)
-            .map(|(g, w)| (g - w).abs() / w.abs().max(1e-30))
-            .fold(0.0, f64::max)
+        got.to_f64().iter().zip(want).map(|(g, w)| (g - w).abs() / w.abs().max(1e-30)).fold(0.0, f64::max)
     }
 
     #[test]
@@ -344,10 +287,7 @@ mod tests {
         for &(name, eta_ref, k_ref) in MITSUBA_REFERENCE {
             let (eta, k) = conductor(name).unwrap();
             let error = max_relative_error(eta, eta_ref).max(max_relative_error(k, k_ref));
-            assert!(
-                error < TOLERANCE,
-                "{name}: η {eta} vs {eta_ref:?}, k {k} vs {k_ref:?}: {error:e}"
-            );
+            assert!(error < TOLERANCE, "{name}: η {eta} vs {eta_ref:?}, k {k} vs {k_ref:?}: {error:e}");
         }
     }
 
@@ -358,10 +298,7 @@ mod tests {
         assert_eq!(&CONDUCTORS[1..], &data_names[..]);
         for name in CONDUCTORS {
             let (eta, k) = conductor(name).unwrap_or_else(|| panic!("{name}"));
-            assert!(
-                eta.is_finite() && k.is_finite() && eta.min_component() >= 0.0,
-                "{name}"
-            );
+            assert!(eta.is_finite() && k.is_finite() && eta.min_component() >= 0.0, "{name}");
         }
         for &(name, eta, k) in CONDUCTOR_SPECTRA {
             assert!(parse_spd(eta).is_ok() && parse_spd(k).is_ok(), "{name}");
@@ -386,9 +323,7 @@ mod tests {
         assert_eq!(dielectric_ior("diamond"), Some(2.419));
         let table_names: Vec<&str> = DIELECTRIC_TABLE.iter().map(|d| d.0).collect();
         assert_eq!(DIELECTRICS, &table_names[..]);
-        assert!(DIELECTRICS
-            .iter()
-            .all(|n| dielectric_ior(n).is_some_and(|ior| ior >= 1.0)));
+        assert!(DIELECTRICS.iter().all(|n| dielectric_ior(n).is_some_and(|ior| ior >= 1.0)));
     }
 
     /// Mitsuba 3.9.1 through the same double-precision path as the presets: files `data/ior/one.eta.spd`
@@ -405,19 +340,11 @@ mod tests {
         // 1 over the whole CIE range: the equal-energy white with Y = 1 — not (1, 1, 1), as no
         // illuminant enters the integral.
         let white = spectrum_to_rgb(&[300.0, 900.0], &[1.0, 1.0]);
-        assert!(
-            max_relative_error(white, [1.204_883_695, 0.948_228_180_4, 0.909_266_829_5])
-                < TOLERANCE
-        );
+        assert!(max_relative_error(white, [1.204_883_695, 0.948_228_180_4, 0.909_266_829_5]) < TOLERANCE);
         assert!((f64::from(white.luminance()) - 1.0).abs() < 1e-3);
         // 1 on [500, 600] nm only: zero outside the table, and blue (−0.0856) clamped to 0.
         let band = spectrum_to_rgb(&[500.0, 600.0], &[1.0, 1.0]);
-        assert!(
-            max_relative_error(
-                band + Rgb::new(0.0, 0.0, 1.0),
-                [0.273_065_120_0, 0.987_912_774_1, 1.0]
-            ) < TOLERANCE
-        );
+        assert!(max_relative_error(band + Rgb::new(0.0, 0.0, 1.0), [0.273_065_120_0, 0.987_912_774_1, 1.0]) < TOLERANCE);
         assert_eq!(band.b(), 0.0);
         // Linear in the spectrum.
         let doubled = spectrum_to_rgb(&[300.0, 900.0], &[2.0, 2.0]);
@@ -434,10 +361,7 @@ mod tests {
     #[test]
     fn parse_spd_reads_comments_and_pairs() {
         let text = "# comment\n\n  # indented comment\n400 1.5\n500\t2.0  \n600 2.5e0\n";
-        assert_eq!(
-            parse_spd(text),
-            Ok((vec![400.0, 500.0, 600.0], vec![1.5, 2.0, 2.5]))
-        );
+        assert_eq!(parse_spd(text), Ok((vec![400.0, 500.0, 600.0], vec![1.5, 2.0, 2.5])));
     }
 
     #[test]
@@ -451,24 +375,9 @@ mod tests {
         assert_eq!(syntax_line("# x\n400 one\n"), 2); // not a number
         assert_eq!(syntax_line("400 1\nnan 2\n"), 2); // not finite
         assert_eq!(syntax_line("400 1\n500 inf\n"), 2);
-        assert_eq!(
-            parse_spd("500 1\n400 2\n"),
-            Err(SpdError::NotAscending {
-                line: 2,
-                wavelength: 400.0
-            })
-        );
-        assert_eq!(
-            parse_spd("500 1\n500 2\n"),
-            Err(SpdError::NotAscending {
-                line: 2,
-                wavelength: 500.0
-            })
-        );
-        assert_eq!(
-            parse_spd("# only a comment\n"),
-            Err(SpdError::TooFewPoints(0))
-        );
+        assert_eq!(parse_spd("500 1\n400 2\n"), Err(SpdError::NotAscending { line: 2, wavelength: 400.0 }));
+        assert_eq!(parse_spd("500 1\n500 2\n"), Err(SpdError::NotAscending { line: 2, wavelength: 500.0 }));
+        assert_eq!(parse_spd("# only a comment\n"), Err(SpdError::TooFewPoints(0)));
         assert_eq!(parse_spd("500 1\n"), Err(SpdError::TooFewPoints(1)));
         assert_eq!(parse_spd(""), Err(SpdError::TooFewPoints(0)));
     }

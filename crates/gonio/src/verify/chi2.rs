@@ -187,7 +187,11 @@ impl Chi2Result {
             writeln!(out, "# {self}")?;
             writeln!(out, "# no_sample observed {} expected {:.3}", self.no_sample_observed, self.no_sample_expected)?;
             for d in &self.delta_bins {
-                writeln!(out, "# delta wi ({:.6}, {:.6}, {:.6}) observed {} expected {:.3}", d.wi.x, d.wi.y, d.wi.z, d.observed, d.expected)?;
+                writeln!(
+                    out,
+                    "# delta wi ({:.6}, {:.6}, {:.6}) observed {} expected {:.3}",
+                    d.wi.x, d.wi.y, d.wi.z, d.observed, d.expected
+                )?;
             }
             writeln!(out, "# load: a = numpy.loadtxt(path); observed, expected = a[:{0}], a[{0}:]", self.res.0)?;
             for (name, m) in [("observed", &self.observed), ("expected", &self.expected)] {
@@ -615,7 +619,8 @@ fn verdict(tally: Tally, grid: &Grid, integrals: &[f64], cfg: &Chi2Config, names
     let mut delta_total = 0.0;
     for d in tally.deltas.values() {
         if d.pdf_max - d.pdf_min > DELTA_PDF_TOLERANCE * d.pdf_max {
-            problems.push(format!("samples of the delta lobe towards {} report different probabilities {} .. {}", d.wi, d.pdf_min, d.pdf_max));
+            problems
+                .push(format!("samples of the delta lobe towards {} report different probabilities {} .. {}", d.wi, d.pdf_min, d.pdf_max));
         }
         let p = f64::from(d.pdf_max);
         delta_total += p;
@@ -637,9 +642,8 @@ fn verdict(tally: Tally, grid: &Grid, integrals: &[f64], cfg: &Chi2Config, names
     // The probability not accounted for by the pdf and the delta lobes belongs to "no sample".
     let rest = 1.0 - integral - delta_total;
     if rest < -EXCESS_TOLERANCE {
-        problems.push(format!(
-            "the pdf integrates to {integral:.6} and the delta probabilities sum to {delta_total:.6}: together more than 1"
-        ));
+        problems
+            .push(format!("the pdf integrates to {integral:.6} and the delta probabilities sum to {delta_total:.6}: together more than 1"));
     }
     let no_sample_observed = (tally.no_sample + tally.outside) as f64;
     let no_sample_expected = n * rest.max(0.0);
@@ -647,7 +651,11 @@ fn verdict(tally: Tally, grid: &Grid, integrals: &[f64], cfg: &Chi2Config, names
     // Samples where the pdf is zero: fail at once, naming the first such cell.
     let bad_pdf: Vec<usize> = (0..expected.len()).filter(|i| !expected[*i].is_finite() || expected[*i] < 0.0).collect();
     if let Some(first) = bad_pdf.first() {
-        problems.push(format!("the pdf is negative or not finite in {} cells (first: {})", bad_pdf.len(), grid.describe_cell(*first, names)));
+        problems.push(format!(
+            "the pdf is negative or not finite in {} cells (first: {})",
+            bad_pdf.len(),
+            grid.describe_cell(*first, names)
+        ));
     }
     let zero_cells: Vec<usize> = (0..observed.len()).filter(|i| observed[*i] > 0.0 && expected[*i] == 0.0).collect();
     if let Some(first) = zero_cells.first() {
@@ -809,13 +817,17 @@ pub fn chi2_plane(
     let tally = draw(cfg, grid.len(), &one);
     let density = |x: f64, y: f64| pdf(Vec2::new(x as f32, y as f32));
     let integrals = grid.integrate(&density, cfg.integration_res);
-    let domain = format!("plane: rows = {} bins of x over [{}, {}], columns = {} bins of y over [{}, {}]", grid.res.0, lo.x, hi.x, grid.res.1, lo.y, hi.y);
+    let domain = format!(
+        "plane: rows = {} bins of x over [{}, {}], columns = {} bins of y over [{}, {}]",
+        grid.res.0, lo.x, hi.x, grid.res.1, lo.y, hi.y
+    );
     verdict(tally, &grid, &integrals, cfg, ["x", "y"], domain)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bsdf::Bsdf;
     use crate::sampling::warp::{cosine_hemisphere_pdf, sample_uniform_hemisphere};
     use std::time::Instant;
 
@@ -1031,11 +1043,8 @@ mod tests {
         let text = std::fs::read_to_string(&path).unwrap();
         assert!(text.contains("# delta wi"));
         // What numpy.loadtxt sees: the non-comment lines, 2 × rows of `phi_res` numbers.
-        let rows: Vec<Vec<f64>> = text
-            .lines()
-            .filter(|l| !l.starts_with('#'))
-            .map(|l| l.split_whitespace().map(|v| v.parse().unwrap()).collect())
-            .collect();
+        let rows: Vec<Vec<f64>> =
+            text.lines().filter(|l| !l.starts_with('#')).map(|l| l.split_whitespace().map(|v| v.parse().unwrap()).collect()).collect();
         assert_eq!(rows.len(), 2 * cfg.theta_res);
         assert!(rows.iter().all(|r| r.len() == cfg.phi_res));
         let observed: f64 = rows[..cfg.theta_res].iter().flatten().sum();
