@@ -2,6 +2,8 @@
 
 pub mod frame;
 pub mod spherical;
+pub mod transform;
 
 pub use frame::Frame;
+pub use transform::Transform;
 pub use glam::{DVec3, Vec2, Vec3};

@@ -1,0 +1,19 @@
+//! Geometry: rays, bounding boxes, the shapes of Mitsuba's scene format (sphere, rectangle, cube, disk,
+//! triangle meshes), surface interactions and the bounding volume hierarchy over all primitives.
+
+pub mod bounds;
+pub mod builtin_meshes;
+pub mod bvh;
+pub mod disk;
+pub mod interaction;
+pub mod mesh;
+pub mod ray;
+pub mod shape;
+pub mod sphere;
+
+pub use bounds::Bounds3;
+pub use bvh::Bvh;
+pub use interaction::{PositionSample, SurfaceInteraction};
+pub use mesh::Mesh;
+pub use ray::Ray;
+pub use shape::{PrimHit, Shape};

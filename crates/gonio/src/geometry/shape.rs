@@ -1,0 +1,86 @@
+//! The closed set of shapes. A shape has one or more primitives (a mesh has one per triangle); the scene's
+//! BVH indexes (shape, primitive) pairs.
+
+use super::disk::Disk;
+use super::interaction::{PositionSample, SurfaceInteraction};
+use super::mesh::Mesh;
+use super::sphere::Sphere;
+use super::{Bounds3, Ray};
+use glam::Vec2;
+
+/// A ray's hit on one primitive, before the full interaction is computed: the ray parameter and
+/// shape-specific coordinates (barycentrics for triangles, object-space (x, y) for disks).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PrimHit {
+    pub t: f32,
+    pub uv: Vec2,
+}
+
+/// Any gonio shape, in world space.
+#[derive(Clone, Debug)]
+pub enum Shape {
+    Sphere(Sphere),
+    Disk(Disk),
+    Mesh(Mesh),
+}
+
+impl Shape {
+    #[must_use]
+    pub fn primitive_count(&self) -> usize {
+        match self {
+            Shape::Mesh(m) => m.triangle_count(),
+            Shape::Sphere(_) | Shape::Disk(_) => 1,
+        }
+    }
+
+    #[must_use]
+    pub fn primitive_bounds(&self, prim: u32) -> Bounds3 {
+        match self {
+            Shape::Sphere(s) => s.bounds(),
+            Shape::Disk(d) => d.bounds(),
+            Shape::Mesh(m) => m.triangle_bounds(prim),
+        }
+    }
+
+    #[inline]
+    #[must_use]
+    pub fn intersect(&self, prim: u32, ray: &Ray) -> Option<PrimHit> {
+        match self {
+            Shape::Mesh(m) => m.intersect(prim, ray),
+            Shape::Sphere(s) => s.intersect(ray),
+            Shape::Disk(d) => d.intersect(ray),
+        }
+    }
+
+    /// The full interaction of a hit found by [`Shape::intersect`]; `shape` and `prim` are filled in.
+    #[must_use]
+    pub fn interaction(&self, shape: u32, prim: u32, ray: &Ray, hit: &PrimHit) -> SurfaceInteraction {
+        let mut si = match self {
+            Shape::Mesh(m) => m.interaction(prim, ray, hit),
+            Shape::Sphere(s) => s.interaction(ray, hit.t),
+            Shape::Disk(d) => d.interaction(ray, hit),
+        };
+        si.shape = shape;
+        si.prim = prim;
+        si
+    }
+
+    #[must_use]
+    pub fn area(&self) -> f32 {
+        match self {
+            Shape::Sphere(s) => s.area(),
+            Shape::Disk(d) => d.area(),
+            Shape::Mesh(m) => m.area(),
+        }
+    }
+
+    /// A point uniformly distributed over the surface, density 1/area.
+    #[must_use]
+    pub fn sample_position(&self, uc: f32, u: Vec2) -> PositionSample {
+        match self {
+            Shape::Sphere(s) => s.sample_position(u),
+            Shape::Disk(d) => d.sample_position(u),
+            Shape::Mesh(m) => m.sample_position(uc, u),
+        }
+    }
+}
