@@ -16,14 +16,21 @@
 //! ```
 
 pub mod bsdf;
+pub mod camera;
 pub mod error;
+pub mod film;
 pub mod fresnel;
 pub mod geometry;
+pub mod integrator;
+pub mod light;
 pub mod math;
 pub mod props;
+pub mod render;
 pub mod sampling;
+pub mod scene;
 pub mod spectrum;
 pub mod verify;
+pub mod xml;
 
 pub use bsdf::{Bsdf, BsdfFlags, BsdfModel, BsdfSample};
 pub use error::{Error, Result};

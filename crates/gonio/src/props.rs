@@ -15,6 +15,7 @@
 
 use crate::error::{Error, Result};
 use crate::spectrum::Rgb;
+use crate::xml::{parse_numbers, parse_spectrum, parse_transform, parse_vector, xml_at, XmlEnv};
 use std::cell::{Cell, RefCell};
 
 /// One parameter value.
@@ -25,6 +26,10 @@ pub enum Value {
     String(String),
     /// A list of numbers (a colour when it has three).
     List(Vec<f64>),
+    /// A `<point>` or `<vector>`.
+    Vector(glam::Vec3),
+    /// A `<transform>`.
+    Transform(crate::math::Transform),
     Nested(Props),
 }
 
@@ -35,6 +40,8 @@ impl Value {
             Value::Bool(_) => "a boolean",
             Value::String(_) => "a string",
             Value::List(_) => "a list of numbers",
+            Value::Vector(_) => "a point or vector",
+            Value::Transform(_) => "a transform",
             Value::Nested(_) => "a nested plugin",
         }
     }
@@ -51,6 +58,8 @@ struct Entry {
 /// The parameters of one plugin.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Props {
+    /// The element the plugin was given as (`bsdf`, `shape`, `emitter`, `texture`, …); empty for JSON.
+    class: String,
     plugin: String,
     id: Option<String>,
     at: String,
@@ -63,7 +72,7 @@ impl Props {
     /// An empty description of plugin `plugin`, located at `at` (for messages).
     #[must_use]
     pub fn new(plugin: &str, at: &str) -> Self {
-        Props { plugin: plugin.into(), id: None, at: at.into(), entries: Vec::new(), asked: RefCell::new(Vec::new()) }
+        Props { class: String::new(), plugin: plugin.into(), id: None, at: at.into(), entries: Vec::new(), asked: RefCell::new(Vec::new()) }
     }
 
     /// Add a parameter (the last of equal names wins, as in Mitsuba's dictionaries).
@@ -75,6 +84,12 @@ impl Props {
     #[must_use]
     pub fn plugin_type(&self) -> &str {
         &self.plugin
+    }
+
+    /// The kind of plugin (`bsdf`, `shape`, `emitter`, `texture`, `sensor`, …): the XML tag; empty for JSON.
+    #[must_use]
+    pub fn class(&self) -> &str {
+        &self.class
     }
 
     #[must_use]
@@ -137,6 +152,8 @@ impl Props {
         let c = match &e.value {
             Value::Number(v) => [*v; 3],
             Value::List(l) if l.len() == 3 => [l[0], l[1], l[2]],
+            Value::Nested(t) if t.class == "texture" => return Err(Error::spec(&e.at, format!(
+                "textures are not yet supported: parameter `{name}` of `{}` is a `{}` texture; give a colour", self.plugin, t.plugin))),
             _ => return Err(self.wrong(e, "a colour (a number or three numbers)")),
         };
         if c.iter().any(|v| !(*v >= lo as f64 && *v <= hi as f64)) {
@@ -173,6 +190,59 @@ impl Props {
             return Err(Error::spec(&e.at, format!("parameter `{name}` of `{}` must hold finite numbers", self.plugin)));
         }
         Ok(Some(list))
+    }
+
+    /// An integer in `[lo, hi]`, or `default` when absent.
+    pub fn integer_in(&self, name: &'static str, default: i64, lo: i64, hi: i64) -> Result<i64> {
+        let Some(e) = self.entry(name) else { return Ok(default) };
+        let v = match &e.value {
+            Value::Number(v) if v.fract() == 0.0 => *v,
+            _ => return Err(self.wrong(e, "an integer")),
+        };
+        if !(v >= lo as f64 && v <= hi as f64) {
+            return Err(Error::spec(&e.at, format!("parameter `{name}` of `{}` must be an integer in [{lo}, {hi}], got {v}", self.plugin)));
+        }
+        Ok(v as i64)
+    }
+
+    /// A point or vector, or `None` when absent.
+    pub fn vector(&self, name: &'static str) -> Result<Option<glam::Vec3>> {
+        let Some(e) = self.entry(name) else { return Ok(None) };
+        match &e.value {
+            Value::Vector(v) => Ok(Some(*v)),
+            Value::List(l) if l.len() == 3 => Ok(Some(glam::Vec3::new(l[0] as f32, l[1] as f32, l[2] as f32))),
+            _ => Err(self.wrong(e, "a point (x, y, z)")),
+        }
+    }
+
+    /// A transform, or the identity when absent.
+    pub fn transform(&self, name: &'static str) -> Result<crate::math::Transform> {
+        let Some(e) = self.entry(name) else { return Ok(crate::math::Transform::IDENTITY) };
+        match &e.value {
+            Value::Transform(t) => Ok(*t),
+            _ => Err(self.wrong(e, "a <transform>")),
+        }
+    }
+
+    /// Where parameter `name` was given, or where the plugin was when it was not.
+    #[must_use]
+    pub fn at_param(&self, name: &str) -> &str {
+        self.entries.iter().find(|e| e.name == name).map_or(&self.at, |e| &e.at)
+    }
+
+    /// Nested plugins of one class (`"emitter"`, `"bsdf"`, …), marking them as read.
+    #[must_use]
+    pub fn nested_of(&self, class: &str) -> Vec<&Props> {
+        self.entries
+            .iter()
+            .filter_map(|e| match &e.value {
+                Value::Nested(p) if p.class == class => {
+                    e.used.set(true);
+                    Some(p)
+                }
+                _ => None,
+            })
+            .collect()
     }
 
     /// A string, or `None` when absent.
@@ -289,57 +359,85 @@ impl Props {
         Props::from_xml_element(bsdf, source)
     }
 
-    /// Build from one plugin element (`<bsdf type="…">`) of a Mitsuba XML document.
+    /// Build from one plugin element (`<bsdf type="…">`) of a Mitsuba XML document, outside a scene
+    /// (no parameters, references or search paths).
     pub fn from_xml_element(node: roxmltree::Node, source: &str) -> Result<Props> {
+        Props::from_xml_element_in(node, source, &XmlEnv::default())
+    }
+
+    /// Build from one plugin element within a scene: `$name` substituted, `<ref id>` resolved, file
+    /// names resolved against the search paths, nested plugins of every kind, points, vectors,
+    /// transforms and spectra read.
+    pub fn from_xml_element_in(node: roxmltree::Node, source: &str, env: &XmlEnv) -> Result<Props> {
         let at = xml_at(source, node);
-        let plugin =
-            node.attribute("type").ok_or_else(|| Error::spec(&at, format!("<{}> needs a type attribute", node.tag_name().name())))?;
-        let mut props = Props::new(plugin, &at);
-        props.id = node.attribute("id").map(str::to_string);
+        let tag = node.tag_name().name();
+        let plugin = env.attr(node, "type", source)?.ok_or_else(|| Error::spec(&at, format!("<{tag}> needs a type attribute")))?;
+        let mut props = Props::new(&plugin, &at);
+        props.class = tag.to_string();
+        props.id = env.attr(node, "id", source)?;
         let mut unnamed = 0;
-        for child in node.children().filter(|n| n.is_element()) {
+        for child in node.children().filter(roxmltree::Node::is_element) {
             let cat = xml_at(source, child);
-            let tag = child.tag_name().name();
-            if matches!(tag, "bsdf") {
-                let name = match child.attribute("name") {
-                    Some(n) => n.to_string(),
-                    None => {
-                        unnamed += 1;
-                        format!("_arg_{unnamed}")
-                    }
-                };
-                let nested = Props::from_xml_element(child, source)?;
-                props.set(&name, Value::Nested(nested), &cat);
+            let ctag = child.tag_name().name();
+            let name = env.attr(child, "name", source)?;
+            let mut auto_name = || {
+                unnamed += 1;
+                format!("_arg_{unnamed}")
+            };
+            if PLUGIN_TAGS.contains(&ctag) {
+                let nested = Props::from_xml_element_in(child, source, env)?;
+                let key = name.unwrap_or_else(&mut auto_name);
+                props.set(&key, Value::Nested(nested), &cat);
                 continue;
             }
-            let name = child.attribute("name").ok_or_else(|| Error::spec(&cat, format!("<{tag}> needs a name attribute")))?;
-            let raw =
-                child.attribute("value").ok_or_else(|| Error::spec(&cat, format!("<{tag} name=\"{name}\"> needs a value attribute")))?;
-            let bad = |what: &str| Error::spec(&cat, format!("<{tag} name=\"{name}\">: expected {what}, got \"{raw}\""));
-            let value = match tag {
-                "float" | "integer" => Value::Number(parse_number(raw).ok_or_else(|| bad("a number"))?),
-                "boolean" => Value::Bool(match raw.trim() {
-                    "true" => true,
-                    "false" => false,
-                    _ => return Err(bad("true or false")),
-                }),
-                "string" => Value::String(raw.to_string()),
-                "rgb" => match parse_numbers(raw).as_deref() {
-                    Some([v]) => Value::Number(*v),
-                    Some([r, g, b]) => Value::List(vec![*r, *g, *b]),
-                    _ => return Err(bad("one or three numbers")),
-                },
-                "spectrum" => match parse_numbers(raw).as_deref() {
-                    Some([v]) => Value::Number(*v),
-                    _ => return Err(bad("a single number (wavelength:value lists need the scene loader)")),
-                },
-                _ => return Err(Error::spec(&cat, format!("unsupported element <{tag}> inside <{}>", node.tag_name().name()))),
+            if ctag == "ref" {
+                let id = env.required(child, "id", source)?;
+                let target = env.refs.get(&id).ok_or_else(|| Error::spec(&cat, format!("<ref id=\"{id}\">: no plugin with this id was declared before")))?;
+                let key = name.unwrap_or_else(&mut auto_name);
+                props.set(&key, Value::Nested(target.clone()), &cat);
+                continue;
+            }
+            let name = name.ok_or_else(|| Error::spec(&cat, format!("<{ctag}> needs a name attribute")))?;
+            let value = match ctag {
+                "point" | "vector" => Value::Vector(parse_vector(child, env, source, 0.0)?),
+                "transform" => Value::Transform(parse_transform(child, env, source)?),
+                "spectrum" => {
+                    let c = parse_spectrum(child, env, source, tag == "emitter")?;
+                    if c.r() == c.g() && c.g() == c.b() { Value::Number(f64::from(c.r())) } else { Value::List(c.to_f64().to_vec()) }
+                }
+                "float" | "integer" | "boolean" | "string" | "rgb" => {
+                    let raw = env.attr(child, "value", source)?
+                        .ok_or_else(|| Error::spec(&cat, format!("<{ctag} name=\"{name}\"> needs a value attribute")))?;
+                    let bad = |what: &str| Error::spec(&cat, format!("<{ctag} name=\"{name}\">: expected {what}, got \"{raw}\""));
+                    match ctag {
+                        "float" => Value::Number(parse_number(&raw).ok_or_else(|| bad("a number"))?),
+                        "integer" => Value::Number(raw.trim().parse::<i64>().map_err(|_| bad("an integer"))? as f64),
+                        "boolean" => Value::Bool(match raw.trim() {
+                            "true" => true,
+                            "false" => false,
+                            _ => return Err(bad("true or false")),
+                        }),
+                        "string" if name == "filename" && !env.search_paths.is_empty() => {
+                            Value::String(env.resolve_file(&raw, &cat)?.to_string_lossy().into_owned())
+                        }
+                        "string" => Value::String(raw.clone()),
+                        _ => match parse_numbers(&raw).as_deref() {
+                            Some([v]) => Value::Number(*v),
+                            Some([r, g, b]) => Value::List(vec![*r, *g, *b]),
+                            _ => return Err(bad("one or three numbers")),
+                        },
+                    }
+                }
+                _ => return Err(Error::spec(&cat, format!("unsupported element <{ctag}> inside <{tag} type=\"{plugin}\">"))),
             };
-            props.set(name, value, &cat);
+            props.set(&name, value, &cat);
         }
         Ok(props)
     }
 }
+
+/// Elements that describe a plugin (and may nest).
+const PLUGIN_TAGS: &[&str] = &["bsdf", "emitter", "texture", "shape", "sensor", "film", "sampler", "rfilter", "integrator", "medium", "phase", "volume"];
 
 /// A parameter given as a number or a name (e.g. an index of refraction).
 #[derive(Clone, Debug, PartialEq)]
@@ -358,21 +456,8 @@ fn range(lo: f32, hi: f32) -> String {
     }
 }
 
-fn xml_at(source: &str, node: roxmltree::Node) -> String {
-    let p = node.document().text_pos_at(node.range().start);
-    format!("{source}:{}:{}", p.row, p.col)
-}
-
 fn parse_number(s: &str) -> Option<f64> {
     s.trim().parse::<f64>().ok()
-}
-
-fn parse_numbers(s: &str) -> Option<Vec<f64>> {
-    let parts: Vec<&str> = s.split(|c: char| c == ',' || c.is_whitespace()).filter(|p| !p.is_empty()).collect();
-    if parts.is_empty() {
-        return None;
-    }
-    parts.into_iter().map(parse_number).collect()
 }
 
 fn json_value(v: &serde_json::Value, at: &str) -> Result<Value> {

@@ -1,0 +1,93 @@
+//! Integrators: [`direct`] (the reflection equation, one bounce) and [`path`] (unidirectional path tracing),
+//! both with next-event estimation combined with BSDF sampling by the power heuristic (Veach & Guibas 1995,
+//! "Optimally Combining Sampling Techniques for Monte Carlo Rendering", eq. 8 with β = 2).
+//!
+//! The two techniques below are shared: [`sample_emitter`] (a light sample and its weight) and
+//! [`emitter_hit`] (radiance found by a BSDF-sampled ray and its weight).
+
+pub mod direct;
+pub mod path;
+
+use crate::bsdf::{Bsdf, BsdfModel};
+use crate::geometry::{Ray, SurfaceInteraction};
+use crate::sampling::mis::power_heuristic;
+use crate::sampling::Pcg32;
+use crate::scene::{IntegratorKind, Scene};
+use crate::spectrum::Rgb;
+use glam::Vec3;
+
+/// The radiance along a camera ray, by the scene's integrator.
+#[must_use]
+pub fn radiance(scene: &Scene, ray: &Ray, rng: &mut Pcg32) -> Rgb {
+    match scene.integrator {
+        IntegratorKind::Path { max_depth, rr_depth, hide_emitters } => path::radiance(scene, ray, rng, max_depth, rr_depth, hide_emitters),
+        IntegratorKind::Direct { emitter_samples, bsdf_samples, hide_emitters } => {
+            direct::radiance(scene, ray, rng, emitter_samples, bsdf_samples, hide_emitters)
+        }
+    }
+}
+
+/// How a direction was sampled at the previous vertex, for weighting an emitter it hits.
+#[derive(Clone, Copy, Debug)]
+pub struct BsdfSampled {
+    /// The vertex the ray left from.
+    pub from: Vec3,
+    /// Solid-angle density of the BSDF sample.
+    pub pdf: f32,
+    /// The sample came from a delta lobe (light sampling could not have produced it).
+    pub delta: bool,
+    /// Number of BSDF samples taken there (`n_b` of the power heuristic), and of light samples (`n_l`).
+    pub n_bsdf: f32,
+    pub n_light: f32,
+}
+
+/// Next-event estimation at `si`: pick a light uniformly, sample it, and return
+/// f · |cos θi| · Lᵢ · w / p_light, with w the power-heuristic weight against `n_bsdf` BSDF samples.
+/// `wo` is local; the caller divides by its number of light samples.
+pub fn sample_emitter(scene: &Scene, si: &SurfaceInteraction, wo: Vec3, bsdf: &Bsdf, rng: &mut Pcg32, n_light: f32, n_bsdf: f32) -> Rgb {
+    let n = scene.lights.len();
+    if n == 0 {
+        return Rgb::ZERO;
+    }
+    let index = ((rng.next_f32() * n as f32) as usize).min(n - 1);
+    let (uc, u) = (rng.next_f32(), rng.next_vec2());
+    let Some(ls) = scene.lights[index].sample_li(&scene.shapes, si.p, si.n, uc, u) else { return Rgb::ZERO };
+    if !(ls.pdf > 0.0) || ls.li.is_black() {
+        return Rgb::ZERO;
+    }
+    let wi = si.shading.to_local(ls.wi);
+    let f = bsdf.f(wo, wi);
+    if f.is_black() || scene.occluded(&ls.shadow) {
+        return Rgb::ZERO;
+    }
+    let light_pdf = ls.pdf / n as f32;
+    let w = if ls.delta || n_bsdf == 0.0 { 1.0 } else { power_heuristic(n_light, light_pdf, n_bsdf, bsdf.pdf(wo, wi)) };
+    f * ls.li * (wi.z.abs() * w / light_pdf)
+}
+
+/// Radiance reaching the previous vertex along a BSDF-sampled ray that found `hit` (or escaped when
+/// `None`), weighted against light sampling.
+pub fn emitter_hit(scene: &Scene, ray: &Ray, hit: Option<&SurfaceInteraction>, prev: Option<&BsdfSampled>) -> Rgb {
+    let n = scene.lights.len() as f32;
+    let (le, light_pdf) = match hit {
+        Some(si) => {
+            let Some(index) = scene.shape_lights[si.shape as usize] else { return Rgb::ZERO };
+            let crate::light::Light::Area(area) = &scene.lights[index as usize] else { return Rgb::ZERO };
+            let le = area.radiance_towards(si.shading.n, -ray.d);
+            if le.is_black() {
+                return Rgb::ZERO;
+            }
+            let pdf = prev.map_or(0.0, |p| area.pdf_li(&scene.shapes[si.shape as usize], p.from, si));
+            (le, pdf / n)
+        }
+        None => {
+            let Some(index) = scene.environment else { return Rgb::ZERO };
+            let crate::light::Light::Constant(env) = &scene.lights[index as usize] else { return Rgb::ZERO };
+            (env.radiance, env.pdf_li(ray.d) / n)
+        }
+    };
+    match prev {
+        Some(p) if !p.delta && p.n_light > 0.0 => le * power_heuristic(p.n_bsdf, p.pdf, p.n_light, light_pdf),
+        _ => le,
+    }
+}

@@ -1,0 +1,58 @@
+//! Light sources: `area` (emission from a shape), `point`, `constant` (a uniform environment).
+//! Later: `directional`, `spot`, `envmap` (importance sampled) — one file each, one variant each below.
+//!
+//! Every light answers three questions for next-event estimation and multiple importance sampling:
+//! sample a direction from a reference point ([`Light::sample_li`]), the solid-angle density of a
+//! direction that BSDF sampling found ([`Light::pdf_li`]), and the radiance seen along it.
+
+pub mod area;
+pub mod constant;
+pub mod point;
+
+pub use area::AreaLight;
+pub use constant::ConstantLight;
+pub use point::PointLight;
+
+use crate::geometry::{Ray, Shape};
+use crate::spectrum::Rgb;
+use glam::{Vec2, Vec3};
+
+/// A sampled direction towards a light.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightSample {
+    /// World-space unit direction from the reference point towards the light.
+    pub wi: Vec3,
+    /// Radiance arriving along `wi` if unoccluded (for a point light: intensity / distance²).
+    pub li: Rgb,
+    /// Solid-angle density of `wi`; for delta lights 1 (with `delta` set).
+    pub pdf: f32,
+    pub delta: bool,
+    /// The visibility ray (already offset at both ends).
+    pub shadow: Ray,
+}
+
+/// Any gonio light.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Light {
+    Area(AreaLight),
+    Point(PointLight),
+    Constant(ConstantLight),
+}
+
+impl Light {
+    /// Sample a direction towards the light from `p` (geometric normal `n`, zero for no surface).
+    #[must_use]
+    pub fn sample_li(&self, shapes: &[Shape], p: Vec3, n: Vec3, uc: f32, u: Vec2) -> Option<LightSample> {
+        match self {
+            Light::Area(l) => l.sample_li(&shapes[l.shape as usize], p, n, uc, u),
+            Light::Point(l) => l.sample_li(p, n),
+            Light::Constant(l) => l.sample_li(p, n, u),
+        }
+    }
+
+    /// Whether the light is a delta distribution (no chance of hitting it by BSDF sampling).
+    #[must_use]
+    pub fn is_delta(&self) -> bool {
+        matches!(self, Light::Point(_))
+    }
+}

@@ -1,0 +1,106 @@
+//! The render loop: passes of a few samples per pixel over 16×16 tiles on rayon's threads.
+//!
+//! Deterministic for a seed whatever the number of threads: sample `k` of pixel `i` draws from its own PCG32
+//! stream, `Pcg32::new(mix(seed, k), i)`, and every pixel sums its samples in order. Cancellation (the
+//! `cancel` flag, e.g. set by Ctrl-C) is checked between tiles; the pass in flight is dropped, so the image
+//! holds exactly `spp_done` samples in every pixel.
+
+use crate::film::Film;
+use crate::integrator;
+use crate::sampling::Pcg32;
+use crate::scene::Scene;
+use glam::Vec2;
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::time::Instant;
+
+const TILE: u32 = 16;
+
+/// What a render produced.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderOutput {
+    pub width: u32,
+    pub height: u32,
+    /// Linear RGB, row-major, top row first (the layout of `image::Image`).
+    pub data: Vec<f32>,
+    /// Samples per pixel in `data` (less than requested when cancelled).
+    pub spp_done: u32,
+    pub spp_requested: u32,
+    /// Samples that were NaN or infinite, dropped (counted as black).
+    pub nonfinite: u64,
+    pub cancelled: bool,
+    pub seconds: f64,
+}
+
+/// Mix a seed and a sample index into a PCG32 seed (the SplitMix64 finaliser, Steele et al. 2014).
+fn mix(seed: u64, sample: u64) -> u64 {
+    let mut z = seed.wrapping_add(sample.wrapping_mul(0x9e37_79b9_7f4a_7c15));
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
+}
+
+/// Render `spp` samples per pixel with `seed`. `progress(samples_done)` is called after every tile
+/// (samples = pixel samples over the whole image); `cancel` stops the render between tiles.
+pub fn render(scene: &Scene, spp: u32, seed: u64, cancel: &AtomicBool, progress: &(dyn Fn(u64) + Sync)) -> RenderOutput {
+    let start = Instant::now();
+    let (w, h) = (scene.film.width, scene.film.height);
+    let mut film = Film::new(w, h);
+    let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE)).flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE))).collect();
+    let nonfinite = AtomicU64::new(0);
+    let done = AtomicU64::new(0);
+    let mut spp_done = 0u32;
+    // Passes grow so that early ones show a picture quickly and later ones keep the threads busy.
+    let mut pass = 1u32;
+    while spp_done < spp && !cancel.load(Ordering::Relaxed) {
+        let n = pass.min(spp - spp_done);
+        let first = spp_done;
+        let results: Vec<Option<Vec<[f64; 3]>>> = tiles
+            .par_iter()
+            .map(|&(x0, y0)| {
+                if cancel.load(Ordering::Relaxed) {
+                    return None;
+                }
+                let (tw, th) = (TILE.min(w - x0), TILE.min(h - y0));
+                let mut tile = Film::new(tw, th);
+                let mut bad = 0;
+                for y in y0..y0 + th {
+                    for x in x0..x0 + tw {
+                        let pixel = u64::from(y) * u64::from(w) + u64::from(x);
+                        let local = ((y - y0) * tw + (x - x0)) as usize;
+                        for k in first..first + n {
+                            let mut rng = Pcg32::new(mix(seed, u64::from(k)), pixel);
+                            let s = Vec2::new((x as f32 + rng.next_f32()) / w as f32, (y as f32 + rng.next_f32()) / h as f32);
+                            let ray = scene.camera.ray(s);
+                            if !tile.add(local, integrator::radiance(scene, &ray, &mut rng)) {
+                                bad += 1;
+                            }
+                        }
+                    }
+                }
+                nonfinite.fetch_add(bad, Ordering::Relaxed);
+                let total = done.fetch_add(u64::from(tw * th * n), Ordering::Relaxed) + u64::from(tw * th * n);
+                progress(total);
+                Some(tile.into_sums())
+            })
+            .collect();
+        if results.iter().any(Option::is_none) {
+            break;
+        }
+        for (&(x0, y0), sums) in tiles.iter().zip(results.into_iter().flatten()) {
+            film.add_tile(x0, y0, TILE.min(w - x0), &sums);
+        }
+        spp_done += n;
+        pass = (pass * 2).min(16);
+    }
+    RenderOutput {
+        width: w,
+        height: h,
+        data: film.mean(spp_done),
+        spp_done,
+        spp_requested: spp,
+        nonfinite: nonfinite.load(Ordering::Relaxed),
+        cancelled: spp_done < spp,
+        seconds: start.elapsed().as_secs_f64(),
+    }
+}

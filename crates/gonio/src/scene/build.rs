@@ -1,0 +1,168 @@
+//! From plugin descriptions to scene objects: shapes (with their BSDF and area light), lights, the
+//! sensor with its film and sampler, and the integrator. Every plugin type or parameter gonio does not
+//! know is an error naming the place in the file.
+
+use super::mitsuba_xml::SceneDescription;
+use super::{IntegratorKind, SamplerSpec, Scene};
+use crate::bsdf::{Bsdf, Diffuse};
+use crate::camera::PerspectiveCamera;
+use crate::error::{Error, Result};
+use crate::film::FilmSpec;
+use crate::geometry::builtin_meshes::{cube, rectangle};
+use crate::geometry::disk::Disk;
+use crate::geometry::sphere::Sphere;
+use crate::geometry::{Mesh, Shape};
+use crate::light::{AreaLight, ConstantLight, Light, PointLight};
+use crate::props::Props;
+use crate::spectrum::Rgb;
+use glam::Vec3;
+
+const SHAPES: &str = "sphere, rectangle, cube, disk, obj, ply";
+
+impl Scene {
+    /// Build every plugin of a parsed scene.
+    pub fn build(desc: SceneDescription) -> Result<Scene> {
+        let mut warnings = Vec::new();
+        let mut shapes = Vec::new();
+        let mut bsdfs = Vec::new();
+        let mut shape_lights = Vec::new();
+        let mut lights = Vec::new();
+        for p in &desc.shapes {
+            shapes.push(shape_from_props(p)?);
+            let nested = p.nested_of("bsdf");
+            bsdfs.push(match nested.as_slice() {
+                [] => Bsdf::Diffuse(Diffuse::new(Rgb::splat(0.5))),
+                [one] => Bsdf::from_props(one)?,
+                [_, second, ..] => return Err(Error::spec(second.at(), "a shape takes one <bsdf>")),
+            });
+            let emitters = p.nested_of("emitter");
+            shape_lights.push(match emitters.as_slice() {
+                [] => None,
+                [e] => {
+                    if e.plugin_type() != "area" {
+                        return Err(Error::spec(e.at(), format!("a shape can only carry an `area` emitter, not `{}`", e.plugin_type())));
+                    }
+                    let radiance = e.rgb_in("radiance", Rgb::ONE, 0.0, f32::MAX)?;
+                    e.finish()?;
+                    lights.push(Light::Area(AreaLight { shape: (shapes.len() - 1) as u32, radiance }));
+                    Some((lights.len() - 1) as u32)
+                }
+                [_, second, ..] => return Err(Error::spec(second.at(), "a shape takes one <emitter>")),
+            });
+            p.finish()?;
+        }
+        for e in &desc.emitters {
+            let light = light_from_props(e)?;
+            if matches!(light, Light::Constant(_)) && lights.iter().any(|l| matches!(l, Light::Constant(_))) {
+                return Err(Error::spec(e.at(), "a scene takes at most one environment emitter"));
+            }
+            lights.push(light);
+        }
+        let sensor = desc.sensor.as_ref().ok_or_else(|| Error::spec(&desc.source, "the scene has no <sensor>"))?;
+        let film = match sensor.nested_of("film").as_slice() {
+            [] => FilmSpec { width: 768, height: 576 },
+            [f] => FilmSpec::from_props(f, &mut warnings)?,
+            [_, second, ..] => return Err(Error::spec(second.at(), "a sensor takes one <film>")),
+        };
+        let sampler = match sensor.nested_of("sampler").as_slice() {
+            [] => SamplerSpec { sample_count: 4, seed: 0 },
+            [s] => sampler_from_props(s)?,
+            [_, second, ..] => return Err(Error::spec(second.at(), "a sensor takes one <sampler>")),
+        };
+        let camera = PerspectiveCamera::from_props(sensor, film.width, film.height)?;
+        sensor.finish()?;
+        let integrator = match &desc.integrator {
+            Some(p) => integrator_from_props(p)?,
+            None => IntegratorKind::Path { max_depth: -1, rr_depth: 5, hide_emitters: false },
+        };
+        Ok(Scene::assemble(shapes, bsdfs, shape_lights, lights, camera, film, sampler, integrator, warnings))
+    }
+}
+
+fn shape_from_props(p: &Props) -> Result<Shape> {
+    let to_world = p.transform("to_world")?;
+    let flip = p.bool("flip_normals", false)?;
+    let at = p.at();
+    Ok(match p.plugin_type() {
+        "sphere" => {
+            let center = p.vector("center")?.unwrap_or(Vec3::ZERO);
+            let radius = p.float_positive("radius", 1.0)?;
+            Shape::Sphere(Sphere::new(center, radius, to_world, flip).ok_or_else(|| {
+                Error::spec(p.at_param("to_world"), "a sphere's `to_world` must scale uniformly (rotate, translate and scale by one factor)")
+            })?)
+        }
+        "rectangle" => Shape::Mesh(rectangle(&to_world, flip, at)?),
+        "cube" => Shape::Mesh(cube(&to_world, flip, at)?),
+        "disk" => Shape::Disk(Disk::new(to_world, flip)),
+        kind @ ("obj" | "ply") => {
+            let filename = p.string("filename")?.ok_or_else(|| Error::spec(at, format!("`{kind}` needs a `filename`")))?;
+            let face_normals = p.bool("face_normals", false)?;
+            // Mitsuba's OBJ loader flips v (v ↦ 1 − v) by default; mesh_io returns the file's values.
+            let flip_tex = if kind == "obj" { p.bool("flip_tex_coords", true)? } else { false };
+            let data = super::mesh_files::load(kind, std::path::Path::new(&filename), at)?;
+            let uvs = data.uvs.map(|uv| uv.into_iter().map(|t| if flip_tex { glam::Vec2::new(t.x, 1.0 - t.y) } else { t }).collect());
+            Shape::Mesh(Mesh::new(data.positions, data.normals, uvs, data.indices, &to_world, face_normals, flip, &format!("{at} ({filename})"))?)
+        }
+        other => return Err(Error::spec(at, format!("unsupported shape `{other}` (gonio has: {SHAPES})"))),
+    })
+}
+
+fn light_from_props(e: &Props) -> Result<Light> {
+    let light = match e.plugin_type() {
+        "point" => {
+            let to_world = e.transform("to_world")?;
+            let position = match e.vector("position")? {
+                Some(p) if e.has("to_world") => {
+                    return Err(Error::spec(e.at_param("position"), format!("give `position` or `to_world`, not both (position {p})")))
+                }
+                Some(p) => p,
+                None => to_world.point(Vec3::ZERO),
+            };
+            Light::Point(PointLight { position, intensity: e.rgb_in("intensity", Rgb::ONE, 0.0, f32::MAX)? })
+        }
+        "constant" => Light::Constant(ConstantLight { radiance: e.rgb_in("radiance", Rgb::ONE, 0.0, f32::MAX)? }),
+        "area" => return Err(Error::spec(e.at(), "an `area` emitter must be nested in a <shape>")),
+        other => return Err(Error::spec(e.at(), format!("unsupported emitter `{other}` (gonio has: area, point, constant)"))),
+    };
+    e.finish()?;
+    Ok(light)
+}
+
+fn sampler_from_props(s: &Props) -> Result<SamplerSpec> {
+    if s.plugin_type() != "independent" {
+        return Err(Error::spec(s.at(), format!("unsupported sampler `{}` (gonio has: independent)", s.plugin_type())));
+    }
+    let sample_count = s.integer_in("sample_count", 4, 1, i64::from(u32::MAX))? as u32;
+    let seed = s.integer_in("seed", 0, 0, i64::MAX)? as u64;
+    s.finish()?;
+    Ok(SamplerSpec { sample_count, seed })
+}
+
+fn integrator_from_props(p: &Props) -> Result<IntegratorKind> {
+    let kind = match p.plugin_type() {
+        "moment" => {
+            // Mitsuba's `moment` adds the second moment as extra channels; gonio renders the inner integrator.
+            let inner = p.nested_of("integrator");
+            match inner.as_slice() {
+                [one] => integrator_from_props(one)?,
+                _ => return Err(Error::spec(p.at(), format!("`moment` needs exactly one nested <integrator>, got {}", inner.len()))),
+            }
+        }
+        "path" => IntegratorKind::Path {
+            max_depth: p.integer_in("max_depth", -1, -1, i64::from(i32::MAX))? as i32,
+            rr_depth: p.integer_in("rr_depth", 5, 1, i64::from(i32::MAX))? as i32,
+            hide_emitters: p.bool("hide_emitters", false)?,
+        },
+        "direct" => {
+            let shading = p.integer_in("shading_samples", 1, 0, 1 << 20)? as u32;
+            IntegratorKind::Direct {
+                emitter_samples: p.integer_in("emitter_samples", i64::from(shading), 0, 1 << 20)? as u32,
+                bsdf_samples: p.integer_in("bsdf_samples", i64::from(shading), 0, 1 << 20)? as u32,
+                hide_emitters: p.bool("hide_emitters", false)?,
+            }
+        }
+        other => return Err(Error::spec(p.at(), format!("unsupported integrator `{other}` (gonio has: path, direct, moment)"))),
+    };
+    p.finish()?;
+    Ok(kind)
+}

@@ -1,0 +1,272 @@
+//! Values in Mitsuba's XML scene format: `$name` substitution, file resolution, points and vectors,
+//! spectra and transforms. [`crate::props::Props::from_xml_element_in`] reads plugin elements with these;
+//! [`crate::scene::mitsuba_xml`] handles the document level (defaults, includes, paths, ids).
+
+use crate::error::{Error, Result};
+use crate::math::Transform;
+use crate::props::Props;
+use crate::spectrum::named::{parse_spd, spectrum_to_rgb};
+use crate::spectrum::Rgb;
+use glam::{Mat4, Vec3};
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+/// The state a plugin element is read in: parameters for `$name`, plugins with an `id` for `<ref>`, and
+/// the directories file names are resolved against (searched in order).
+#[derive(Clone, Debug, Default)]
+pub struct XmlEnv {
+    pub params: HashMap<String, String>,
+    pub refs: HashMap<String, Props>,
+    pub search_paths: Vec<PathBuf>,
+}
+
+/// "file:line:col" of a node.
+#[must_use]
+pub fn xml_at(source: &str, node: roxmltree::Node) -> String {
+    let p = node.document().text_pos_at(node.range().start);
+    format!("{source}:{}:{}", p.row, p.col)
+}
+
+impl XmlEnv {
+    /// Replace every `$name` in `raw` by its parameter value.
+    pub fn substitute(&self, raw: &str, at: &str) -> Result<String> {
+        if !raw.contains('$') {
+            return Ok(raw.to_string());
+        }
+        let mut out = String::with_capacity(raw.len());
+        let mut rest = raw;
+        while let Some(i) = rest.find('$') {
+            out.push_str(&rest[..i]);
+            let tail = &rest[i + 1..];
+            let len = tail.find(|c: char| !(c.is_ascii_alphanumeric() || c == '_')).unwrap_or(tail.len());
+            let name = &tail[..len];
+            let value = self.params.get(name).ok_or_else(|| {
+                Error::spec(at, format!("`${name}` is not defined (add <default name=\"{name}\" value=\"…\"/> or pass -D {name}=…)"))
+            })?;
+            out.push_str(value);
+            rest = &tail[len..];
+        }
+        out.push_str(rest);
+        Ok(out)
+    }
+
+    /// An attribute with parameters substituted.
+    pub fn attr(&self, node: roxmltree::Node, name: &str, source: &str) -> Result<Option<String>> {
+        node.attribute(name).map(|raw| self.substitute(raw, &xml_at(source, node))).transpose()
+    }
+
+    /// A required attribute with parameters substituted.
+    pub fn required(&self, node: roxmltree::Node, name: &str, source: &str) -> Result<String> {
+        self.attr(node, name, source)?.ok_or_else(|| {
+            Error::spec(xml_at(source, node), format!("<{}> needs a `{name}` attribute", node.tag_name().name()))
+        })
+    }
+
+    /// A file name resolved against the search paths (an absolute name is taken as is).
+    pub fn resolve_file(&self, name: &str, at: &str) -> Result<PathBuf> {
+        let p = Path::new(name);
+        if p.is_absolute() {
+            return if p.exists() { Ok(p.to_path_buf()) } else { Err(Error::spec(at, format!("file `{name}` does not exist"))) };
+        }
+        self.search_paths.iter().map(|dir| dir.join(p)).find(|c| c.exists()).ok_or_else(|| {
+            let dirs: Vec<String> = self.search_paths.iter().map(|d| d.display().to_string()).collect();
+            Error::spec(at, format!("file `{name}` not found (searched: {})", dirs.join(", ")))
+        })
+    }
+}
+
+/// Numbers separated by commas and/or whitespace.
+#[must_use]
+pub fn parse_numbers(s: &str) -> Option<Vec<f64>> {
+    let parts: Vec<&str> = s.split(|c: char| c == ',' || c.is_whitespace()).filter(|p| !p.is_empty()).collect();
+    if parts.is_empty() {
+        return None;
+    }
+    parts.into_iter().map(|p| p.parse::<f64>().ok()).collect()
+}
+
+/// A vector given as `value="x, y, z"` (or one number for all three) or as `x`, `y`, `z` attributes,
+/// each defaulting to `default` (0 for points, 1 for `<scale>`).
+pub fn parse_vector(node: roxmltree::Node, env: &XmlEnv, source: &str, default: f32) -> Result<Vec3> {
+    let at = xml_at(source, node);
+    if let Some(v) = env.attr(node, "value", source)? {
+        return match parse_numbers(&v).as_deref() {
+            Some([x, y, z]) => Ok(Vec3::new(*x as f32, *y as f32, *z as f32)),
+            Some([s]) => Ok(Vec3::splat(*s as f32)),
+            _ => Err(Error::spec(at, format!("<{}>: expected \"x, y, z\", got \"{v}\"", node.tag_name().name()))),
+        };
+    }
+    let mut out = Vec3::splat(default);
+    for (i, axis) in ["x", "y", "z"].iter().enumerate() {
+        if let Some(v) = env.attr(node, axis, source)? {
+            out[i] = v.trim().parse::<f32>().map_err(|_| {
+                Error::spec(&at, format!("<{}>: attribute `{axis}` must be a number, got \"{v}\"", node.tag_name().name()))
+            })?;
+        }
+    }
+    Ok(out)
+}
+
+/// `<spectrum value="0.5"/>` (uniform), `value="400:0.1, 500:0.3, …"` or `filename="x.spd"`, reduced to
+/// linear sRGB as Mitsuba's RGB variants do.
+///
+/// Inside an `<emitter>` the spectrum is radiance: [`spectrum_to_rgb`] (no illuminant). Elsewhere it is a
+/// reflectance, which Mitsuba weights by D65 so that a flat spectrum stays grey; gonio approximates that by
+/// dividing each channel by the response to the equal-energy white (exact for flat spectra: a flat 0.78
+/// over 400–700 nm gives (0.777, 0.781, 0.775) here and (0.776, 0.780, 0.776) in Mitsuba 3.5; 2026-11,
+/// until a D65 table lands in `spectrum`).
+pub fn parse_spectrum(node: roxmltree::Node, env: &XmlEnv, source: &str, within_emitter: bool) -> Result<Rgb> {
+    let reduce = |w: &[f64], v: &[f64]| {
+        let c = spectrum_to_rgb(w, v);
+        if within_emitter {
+            c
+        } else {
+            let white = spectrum_to_rgb(&[crate::spectrum::cie::CIE_MIN, crate::spectrum::cie::CIE_MAX], &[1.0, 1.0]);
+            c.zip(white, |a, b| if b > 0.0 { a / b } else { 0.0 })
+        }
+    };
+    let at = xml_at(source, node);
+    if let Some(file) = env.attr(node, "filename", source)? {
+        let path = env.resolve_file(&file, &at)?;
+        let text = std::fs::read_to_string(&path).map_err(|source| Error::Io { path: path.clone(), source })?;
+        let (w, v) = parse_spd(&text).map_err(|e| Error::spec(&at, format!("{}: {e}", path.display())))?;
+        return Ok(reduce(&w, &v));
+    }
+    let raw = env.required(node, "value", source)?;
+    if !raw.contains(':') {
+        return match parse_numbers(&raw).as_deref() {
+            Some([v]) => Ok(Rgb::splat(*v as f32)),
+            _ => Err(Error::spec(at, format!("<spectrum>: expected a number or \"λ:value, …\" pairs, got \"{raw}\""))),
+        };
+    }
+    let mut wavelengths = Vec::new();
+    let mut values = Vec::new();
+    for pair in raw.split(',').map(str::trim).filter(|p| !p.is_empty()) {
+        let parsed = pair.split_once(':').and_then(|(l, v)| Some((l.trim().parse::<f64>().ok()?, v.trim().parse::<f64>().ok()?)));
+        let Some((l, v)) = parsed else {
+            return Err(Error::spec(at, format!("<spectrum>: expected \"wavelength:value\", got \"{pair}\"")));
+        };
+        if wavelengths.last().is_some_and(|&prev| l <= prev) {
+            return Err(Error::spec(at, format!("<spectrum>: wavelengths must increase, {l} follows {}", wavelengths.last().unwrap_or(&0.0))));
+        }
+        wavelengths.push(l);
+        values.push(v);
+    }
+    if wavelengths.len() < 2 {
+        return Err(Error::spec(at, "<spectrum>: a wavelength list needs at least two entries"));
+    }
+    Ok(reduce(&wavelengths, &values))
+}
+
+/// A `<transform>` element: its operations in document order, each left-multiplying the result so far
+/// (Mitsuba's order: the first operation is applied to the object first).
+pub fn parse_transform(node: roxmltree::Node, env: &XmlEnv, source: &str) -> Result<Transform> {
+    let mut acc = Transform::IDENTITY;
+    for op in node.children().filter(roxmltree::Node::is_element) {
+        let at = xml_at(source, op);
+        let tag = op.tag_name().name();
+        let bad = |what: &str| Error::spec(&at, format!("<{tag}>: {what}"));
+        let t = match tag {
+            "translate" => Transform::translate(parse_vector(op, env, source, 0.0)?),
+            "scale" => Transform::scale(parse_vector(op, env, source, 1.0)?).ok_or_else(|| bad("a scale factor is zero"))?,
+            "rotate" => {
+                let axis = parse_vector(op, env, source, 0.0)?;
+                let angle = env.required(op, "angle", source)?;
+                let angle: f32 = angle.trim().parse().map_err(|_| bad(&format!("`angle` must be a number of degrees, got \"{angle}\"")))?;
+                Transform::rotate(axis, angle).ok_or_else(|| bad("the rotation axis is zero (give x, y and/or z)"))?
+            }
+            "matrix" => {
+                let v = env.required(op, "value", source)?;
+                let m = match parse_numbers(&v) {
+                    Some(m) if m.len() == 16 => m,
+                    Some(m) => return Err(bad(&format!("expected 16 numbers (row-major 4×4), got {}", m.len()))),
+                    None => return Err(bad(&format!("expected 16 numbers, got \"{v}\""))),
+                };
+                let rows: Vec<f32> = m.iter().map(|&x| x as f32).collect();
+                // The value lists rows; glam stores columns.
+                Transform::from_matrix(Mat4::from_cols_slice(&rows).transpose()).ok_or_else(|| bad("the matrix is singular"))?
+            }
+            "lookat" => {
+                let vec = |name: &str| -> Result<Vec3> {
+                    let v = env.required(op, name, source)?;
+                    match parse_numbers(&v).as_deref() {
+                        Some([x, y, z]) => Ok(Vec3::new(*x as f32, *y as f32, *z as f32)),
+                        _ => Err(bad(&format!("`{name}` must be \"x, y, z\", got \"{v}\""))),
+                    }
+                };
+                let (origin, target) = (vec("origin")?, vec("target")?);
+                let up = if op.attribute("up").is_some() { vec("up")? } else { Vec3::Y };
+                Transform::look_at(origin, target, up).ok_or_else(|| bad("origin equals target, or `up` is parallel to the view direction"))?
+            }
+            _ => return Err(bad("unknown transform operation (expected translate, rotate, scale, matrix or lookat)")),
+        };
+        for a in op.attributes() {
+            let known: &[&str] = match tag {
+                "translate" | "scale" => &["x", "y", "z", "value"],
+                "rotate" => &["x", "y", "z", "angle", "value"],
+                "matrix" => &["value"],
+                _ => &["origin", "target", "up"],
+            };
+            if !known.contains(&a.name()) {
+                return Err(bad(&format!("unknown attribute `{}` (expected {})", a.name(), known.join(", "))));
+            }
+        }
+        acc = t.then_after(acc);
+    }
+    Ok(acc)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn first<'a, 'b>(doc: &'a roxmltree::Document<'b>) -> roxmltree::Node<'a, 'b> {
+        doc.root_element()
+    }
+
+    #[test]
+    fn transform_ops_compose_left() {
+        let doc = roxmltree::Document::parse(
+            "<transform name=\"to_world\"><scale value=\"2\"/><rotate z=\"1\" angle=\"90\"/><translate x=\"1\"/></transform>",
+        )
+        .unwrap();
+        let t = parse_transform(first(&doc), &XmlEnv::default(), "t.xml").unwrap();
+        assert!((t.point(Vec3::X) - Vec3::new(1.0, 2.0, 0.0)).length() < 1e-5);
+        let doc = roxmltree::Document::parse("<transform><matrix value=\"1 0 0 5  0 1 0 6  0 0 1 7  0 0 0 1\"/></transform>").unwrap();
+        let t = parse_transform(first(&doc), &XmlEnv::default(), "t.xml").unwrap();
+        assert!((t.point(Vec3::ZERO) - Vec3::new(5.0, 6.0, 7.0)).length() < 1e-6);
+    }
+
+    #[test]
+    fn bad_transforms_name_the_place() {
+        for (xml, want) in [
+            ("<transform>\n<rotate angle=\"3\"/></transform>", "t.xml:2:1: <rotate>: the rotation axis is zero"),
+            ("<transform>\n<skew x=\"1\"/></transform>", "t.xml:2:1: <skew>: unknown transform"),
+            ("<transform>\n<matrix value=\"1 2 3\"/></transform>", "t.xml:2:1: <matrix>: expected 16 numbers"),
+            ("<transform>\n<lookat origin=\"0,0,0\" target=\"0,0,0\"/></transform>", "t.xml:2:1: <lookat>: origin equals target"),
+            ("<transform>\n<translate x=\"a\"/></transform>", "t.xml:2:1: <translate>: attribute `x`"),
+            ("<transform>\n<scale x=\"0\"/></transform>", "t.xml:2:1: <scale>: a scale factor is zero"),
+        ] {
+            let doc = roxmltree::Document::parse(xml).unwrap();
+            let e = parse_transform(first(&doc), &XmlEnv::default(), "t.xml").unwrap_err().to_string();
+            assert!(e.starts_with(want), "{e}");
+        }
+    }
+
+    #[test]
+    fn substitution_and_spectra() {
+        let mut env = XmlEnv::default();
+        env.params.insert("spp".into(), "64".into());
+        assert_eq!(env.substitute("$spp", "x").unwrap(), "64");
+        assert_eq!(env.substitute("a$spp-b", "x").unwrap(), "a64-b");
+        assert!(env.substitute("$nope", "f.xml:3:4").unwrap_err().to_string().starts_with("f.xml:3:4: `$nope` is not defined"));
+        let doc = roxmltree::Document::parse("<spectrum name=\"r\" value=\"400:0.78, 500:0.78, 600:0.78, 700:0.78\"/>").unwrap();
+        let c = parse_spectrum(first(&doc), &env, "s.xml", false).unwrap();
+        // Mitsuba 3.5 (scalar_rgb) loads this reflectance as (0.776367, 0.77981, 0.776029).
+        assert!((c.r() - 0.776).abs() < 2e-3 && (c.g() - 0.780).abs() < 2e-3 && (c.b() - 0.776).abs() < 2e-3, "{c}");
+        let doc = roxmltree::Document::parse("<spectrum name=\"radiance\" value=\"400:0, 500:8, 600:15.6, 700:18.4\"/>").unwrap();
+        let c = parse_spectrum(first(&doc), &env, "s.xml", true).unwrap();
+        // Mitsuba 3.5 loads this area-light radiance as (20.7108, 10.8546, 2.77115).
+        assert!((c.r() / 20.7108 - 1.0).abs() < 2e-3 && (c.g() / 10.8546 - 1.0).abs() < 2e-3 && (c.b() / 2.77115 - 1.0).abs() < 5e-3, "{c}");
+    }
+}

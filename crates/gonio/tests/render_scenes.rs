@@ -1,0 +1,152 @@
+//! Renders with analytic answers, loader error messages, and determinism.
+
+use gonio::render::{render, RenderOutput};
+use gonio::scene::{mitsuba_xml, Scene};
+use std::path::Path;
+use std::sync::atomic::AtomicBool;
+
+fn scene(xml: &str) -> Scene {
+    Scene::build(mitsuba_xml::load_str(xml, "test.xml", Path::new("."), &[]).unwrap()).unwrap()
+}
+
+fn run(scene: &Scene) -> RenderOutput {
+    render(scene, scene.sampler.sample_count, scene.sampler.seed, &AtomicBool::new(false), &|_| {})
+}
+
+/// Mean and standard error of the mean of one channel over all pixels.
+fn mean_and_se(img: &RenderOutput, channel: usize) -> (f64, f64) {
+    let v: Vec<f64> = img.data.chunks(3).map(|p| f64::from(p[channel])).collect();
+    let n = v.len() as f64;
+    let mean = v.iter().sum::<f64>() / n;
+    let var = v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0);
+    (mean, (var / n).sqrt())
+}
+
+/// A camera at (0, 0, `dist`) looking at the origin, `fov` degrees, `res`² pixels, `spp` samples.
+fn sensor(dist: f32, fov: f32, res: u32, spp: u32) -> String {
+    format!(
+        r#"<sensor type="perspective"><float name="fov" value="{fov}"/>
+            <transform name="to_world"><lookat origin="0, 0, {dist}" target="0, 0, 0" up="0, 1, 0"/></transform>
+            <sampler type="independent"><integer name="sample_count" value="{spp}"/></sampler>
+            <film type="hdrfilm"><integer name="width" value="{res}"/><integer name="height" value="{res}"/></film></sensor>"#
+    )
+}
+
+fn assert_close(img: &RenderOutput, expected: [f64; 3], what: &str) {
+    for c in 0..3 {
+        let (mean, se) = mean_and_se(img, c);
+        // 5 standard errors, plus 1e-4 relative for f32 rounding (2026-11).
+        assert!((mean - expected[c]).abs() <= 5.0 * se + 1e-4 * expected[c], "{what}: channel {c}: {mean} ± {se}, expected {}", expected[c]);
+    }
+}
+
+/// A convex diffuse object under a constant environment: every bounce escapes, so L = ρ L_env exactly.
+#[test]
+fn furnace_diffuse_sphere_is_rho_times_l() {
+    let s = scene(&format!(
+        r#"<scene version="3.0.0"><integrator type="path"/>{}
+        <emitter type="constant"><rgb name="radiance" value="2, 1, 0.5"/></emitter>
+        <shape type="sphere"><bsdf type="diffuse"><rgb name="reflectance" value="0.6, 0.3, 0.9"/></bsdf></shape></scene>"#,
+        sensor(5.0, 10.0, 16, 64)
+    ));
+    let img = run(&s);
+    assert_close(&img, [1.2, 0.3, 0.45], "furnace sphere");
+}
+
+#[test]
+fn lambertian_plane_under_constant_environment() {
+    let s = scene(&format!(
+        r#"<scene version="3.0.0"><integrator type="direct"/>{}
+        <emitter type="constant"><rgb name="radiance" value="1.5"/></emitter>
+        <shape type="rectangle"><transform name="to_world"><scale value="100"/></transform>
+            <bsdf type="diffuse"><rgb name="reflectance" value="0.4"/></bsdf></shape></scene>"#,
+        sensor(3.0, 30.0, 16, 64)
+    ));
+    assert_close(&run(&s), [0.6; 3], "plane");
+}
+
+/// A sphere of radius r lit by a point light of intensity I at distance d from its centre, seen from the
+/// light's side along the axis: L = ρ/π · I / (d − r)².
+#[test]
+fn point_light_on_sphere_nearest_point() {
+    let s = scene(&format!(
+        r#"<scene version="3.0.0"><integrator type="path"><integer name="max_depth" value="3"/></integrator>{}
+        <emitter type="point"><point name="position" x="0" y="0" z="5"/><rgb name="intensity" value="10"/></emitter>
+        <shape type="sphere"><float name="radius" value="1"/><bsdf type="diffuse"><rgb name="reflectance" value="0.5"/></bsdf></shape></scene>"#,
+        sensor(10.0, 0.2, 4, 4)
+    ));
+    let img = run(&s);
+    let expected = 0.5 / std::f64::consts::PI * 10.0 / 16.0;
+    for p in img.data.chunks(3) {
+        assert!((f64::from(p[0]) / expected - 1.0).abs() < 1e-3, "{} vs {expected}", p[0]);
+    }
+}
+
+/// An area light seen directly: max_depth = 1 shows emitters only; the back of the light is black.
+#[test]
+fn max_depth_one_shows_only_emitters_on_their_front() {
+    let xml = |flip: bool| {
+        format!(
+            r#"<scene version="3.0.0"><integrator type="path"><integer name="max_depth" value="1"/></integrator>{}
+            <emitter type="constant"><rgb name="radiance" value="0"/></emitter>
+            <shape type="rectangle"><boolean name="flip_normals" value="{flip}"/><transform name="to_world"><scale value="10"/></transform>
+                <emitter type="area"><rgb name="radiance" value="3, 2, 1"/></emitter></shape></scene>"#,
+            sensor(3.0, 30.0, 4, 2)
+        )
+    };
+    assert!(run(&scene(&xml(false))).data.chunks(3).all(|p| p == [3.0, 2.0, 1.0]));
+    assert!(run(&scene(&xml(true))).data.iter().all(|&v| v == 0.0));
+}
+
+/// A small Cornell-like box: same seed, same bits with one and with two threads.
+#[test]
+fn same_seed_same_image_with_one_or_two_threads() {
+    let s = scene(&format!(
+        r#"<scene version="3.0.0"><integrator type="path"><integer name="max_depth" value="6"/><integer name="rr_depth" value="2"/></integrator>{}
+        <shape type="cube"><boolean name="flip_normals" value="true"/><transform name="to_world"><scale value="3"/></transform></shape>
+        <shape type="sphere"><float name="radius" value="0.5"/><bsdf type="conductor"><string name="material" value="Au"/></bsdf></shape>
+        <shape type="disk"><transform name="to_world"><rotate x="1" angle="90"/><translate y="2.9"/></transform>
+            <emitter type="area"><rgb name="radiance" value="5"/></emitter></shape></scene>"#,
+        sensor(2.5, 60.0, 40, 8)
+    ));
+    let render_with = |threads| rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap().install(|| run(&s));
+    let (a, b) = (render_with(1), render_with(2));
+    assert!(a.data.iter().zip(&b.data).all(|(x, y)| x.to_bits() == y.to_bits()));
+    assert!(a.data.iter().any(|&v| v > 0.0) && a.nonfinite == 0);
+}
+
+fn load_error(xml: &str) -> String {
+    match mitsuba_xml::load_str(xml, "bad.xml", Path::new("."), &[]).and_then(Scene::build) {
+        Ok(_) => panic!("expected an error for {xml}"),
+        Err(e) => e.to_string(),
+    }
+}
+
+#[test]
+fn loader_errors_name_file_line_and_element() {
+    let cases = [
+        ("<scene version=\"3.0.0\">\n  <shape type=\"torus\"/></scene>", "bad.xml:2:3: unsupported shape `torus`"),
+        ("<scene version=\"3.0.0\">\n  <shape type=\"sphere\">\n    <float name=\"radius2\" value=\"1\"/></shape></scene>", "bad.xml:3:5: unknown parameter `radius2` for `sphere`"),
+        ("<scene version=\"3.0.0\">\n <include filename=\"missing.xml\"/></scene>", "bad.xml:2:2: file `missing.xml` not found"),
+        ("<scene version=\"3.0.0\">\n<shape type=\"sphere\"><transform name=\"to_world\">\n<rotate angle=\"30\"/></transform></shape></scene>", "bad.xml:3:1: <rotate>: the rotation axis is zero"),
+        ("<scene version=\"3.0.0\">\n<shape type=\"sphere\"><bsdf type=\"velvet\"/></shape></scene>", "bad.xml:2:22: unknown BSDF type `velvet`"),
+        ("<scene version=\"3.0.0\">\n<shape type=\"sphere\"><ref id=\"nope\"/></shape></scene>", "bad.xml:2:22: <ref id=\"nope\">"),
+        ("<scene version=\"3.0.0\">\n<integrator type=\"path\"><integer name=\"max_depth\" value=\"$d\"/></integrator></scene>", "bad.xml:2:25: `$d` is not defined"),
+        ("<scene version=\"3.0.0\">\n<emitter type=\"envmapp\"/></scene>", "bad.xml:2:1: unsupported emitter `envmapp`"),
+        ("<scene version=\"3.0.0\">\n<shape type=\"sphere\"><bsdf type=\"diffuse\">\n<texture name=\"reflectance\" type=\"bitmap\"/></bsdf></shape></scene>", "bad.xml:3:1: textures are not yet supported"),
+        ("<scene>\n</scene>", "bad.xml:1:1: <scene> needs a version"),
+    ];
+    for (xml, want) in cases {
+        let e = load_error(xml);
+        assert!(e.starts_with(want), "got: {e}\nwant: {want}");
+    }
+}
+
+#[test]
+fn defaults_and_overrides_substitute() {
+    let xml = r#"<scene version="3.0.0"><default name="spp" value="3"/><default name="res" value="8"/>
+        <sensor type="perspective"><sampler type="independent"><integer name="sample_count" value="$spp"/></sampler>
+        <film type="hdrfilm"><integer name="width" value="$res"/><integer name="height" value="$res"/></film></sensor></scene>"#;
+    let s = Scene::build(mitsuba_xml::load_str(xml, "t.xml", Path::new("."), &[("spp".into(), "7".into())]).unwrap()).unwrap();
+    assert_eq!((s.sampler.sample_count, s.film.width), (7, 8));
+}
