@@ -191,3 +191,23 @@ fn lookat_orientation_matches_mitsuba() {
         assert!((mean - m).abs() < 0.01, "channel {c}: {mean} vs Mitsuba {m}");
     }
 }
+
+/// A spherical area light (radiance L, radius r) at height d above a Lambertian plane: the irradiance
+/// below its centre is π L r²/d², so the plane's radiance there is ρ L r²/d².
+#[test]
+fn sphere_area_light_over_plane() {
+    let s = scene(
+        r#"<scene version="3.0.0"><integrator type="direct"/>
+        <sensor type="perspective"><float name="fov" value="0.5"/>
+            <transform name="to_world"><lookat origin="3, 0, 1" target="0, 0, 0" up="0, 0, 1"/></transform>
+            <sampler type="independent"><integer name="sample_count" value="64"/></sampler>
+            <film type="hdrfilm"><integer name="width" value="4"/><integer name="height" value="4"/></film></sensor>
+        <shape type="sphere"><point name="center" x="0" y="0" z="2"/><float name="radius" value="0.5"/>
+            <emitter type="area"><rgb name="radiance" value="4"/></emitter></shape>
+        <shape type="rectangle"><transform name="to_world"><scale value="10"/></transform>
+            <bsdf type="diffuse"><rgb name="reflectance" value="0.5"/></bsdf></shape></scene>"#,
+    );
+    let img = run(&s);
+    // The 0.5° field of view spans ±0.014 around the origin: the irradiance varies by < 1e-4 there.
+    assert_close(&img, [0.125; 3], "sphere light");
+}

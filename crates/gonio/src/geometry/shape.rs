@@ -74,6 +74,38 @@ impl Shape {
         }
     }
 
+    /// A point on the surface sampled for lighting a reference point `p`, with its solid-angle density at
+    /// `p`: spheres sample the cone they subtend, other shapes sample by area (p_ω = p_A d² / |cos θ|).
+    /// `None` when the point is seen edge-on.
+    #[must_use]
+    pub fn sample_from(&self, p: glam::Vec3, uc: f32, u: Vec2) -> Option<(PositionSample, f32)> {
+        if let Shape::Sphere(s) = self {
+            return s.sample_from(p, u);
+        }
+        let ps = self.sample_position(uc, u);
+        let d = ps.p - p;
+        let dist2 = d.length_squared();
+        let cos = ps.ng.dot(d).abs() / dist2.sqrt();
+        (cos > 0.0 && dist2 > 0.0).then(|| (ps, ps.pdf_area * dist2 / cos))
+    }
+
+    /// The solid-angle density with which [`Self::sample_from`] at `p` finds the surface point `q` (geometric
+    /// normal `n`).
+    #[must_use]
+    pub fn pdf_from(&self, p: glam::Vec3, q: glam::Vec3, n: glam::Vec3) -> f32 {
+        if let Shape::Sphere(s) = self {
+            return s.pdf_from(p, q, n);
+        }
+        let d = q - p;
+        let dist2 = d.length_squared();
+        let cos = n.dot(d).abs() / dist2.sqrt();
+        if cos == 0.0 {
+            0.0
+        } else {
+            dist2 / (cos * self.area())
+        }
+    }
+
     /// A point uniformly distributed over the surface, density 1/area.
     #[must_use]
     pub fn sample_position(&self, uc: f32, u: Vec2) -> PositionSample {

@@ -91,6 +91,63 @@ impl Sphere {
         SurfaceInteraction { t, p, n, shading: Frame::from_normal(n), uv, shape: 0, prim: 0 }
     }
 
+    /// For a reference point outside the sphere: `1 − cos θmax` of the cone of directions it subtends,
+    /// computed as sin²θmax / (1 + cos θmax) to keep precision for small or distant spheres.
+    fn cone(&self, p: Vec3) -> Option<(Vec3, f32, f32)> {
+        let to_center = self.center - p;
+        let dc2 = to_center.length_squared();
+        let r2 = self.radius * self.radius;
+        // 2026-11: 1.0001 r² keeps points on (or rounding-close to) the surface on the area-sampling path.
+        if dc2 <= r2 * 1.0001 {
+            return None;
+        }
+        let sin2 = r2 / dc2;
+        let cos_max = (1.0 - sin2).max(0.0).sqrt();
+        Some((to_center / dc2.sqrt(), cos_max, sin2 / (1.0 + cos_max)))
+    }
+
+    /// A point on the sphere sampled from reference point `p`: uniformly in the cone of directions the
+    /// sphere subtends when `p` is outside (pbrt-v4 §6.2.4), else uniformly by area. The density is in
+    /// solid angle at `p`.
+    #[must_use]
+    pub fn sample_from(&self, p: Vec3, u: Vec2) -> Option<(PositionSample, f32)> {
+        let Some((axis, cos_max, one_minus_cos)) = self.cone(p) else {
+            let ps = self.sample_position(u);
+            let d = ps.p - p;
+            let cos = ps.n.dot(-d.normalize_or_zero()).abs();
+            return (cos > 0.0).then(|| (ps, ps.pdf_area * d.length_squared() / cos));
+        };
+        let local = crate::sampling::warp::sample_uniform_cone(u, cos_max);
+        let w = Frame::from_normal(axis).to_world(local);
+        let ray = Ray::new(p, w, f32::INFINITY);
+        let t = match self.intersect(&ray) {
+            Some(h) => h.t,
+            // Grazing directions can miss by rounding: take the closest point of the ray.
+            None => (self.center - p).dot(w),
+        };
+        let outward = (ray.at(t) - self.center).normalize();
+        let n = if self.flip_normals { -outward } else { outward };
+        let ps = PositionSample { p: self.center + outward * self.radius, n, ng: n, pdf_area: 1.0 / self.area() };
+        Some((ps, 1.0 / (2.0 * PI * one_minus_cos)))
+    }
+
+    /// The solid-angle density with which [`Self::sample_from`] at `p` produces the surface point `q`.
+    #[must_use]
+    pub fn pdf_from(&self, p: Vec3, q: Vec3, n: Vec3) -> f32 {
+        match self.cone(p) {
+            Some((_, _, one_minus_cos)) => 1.0 / (2.0 * PI * one_minus_cos),
+            None => {
+                let d = q - p;
+                let cos = n.dot(d.normalize_or_zero()).abs();
+                if cos == 0.0 {
+                    0.0
+                } else {
+                    d.length_squared() / (cos * self.area())
+                }
+            }
+        }
+    }
+
     /// A point uniformly distributed over the surface.
     #[must_use]
     pub fn sample_position(&self, u: Vec2) -> PositionSample {
@@ -115,6 +172,19 @@ mod tests {
         assert!(s.intersect(&Ray::new(Vec3::ZERO, Vec3::Z, 3.0)).is_none());
         let si = s.interaction(&Ray::new(Vec3::ZERO, Vec3::Z, f32::INFINITY), 4.0);
         assert!((si.n + Vec3::Z).length() < 1e-5);
+    }
+
+    /// The cone density integrates to one over the visible cap, and samples land on the near side.
+    #[test]
+    fn cone_sampling_is_consistent() {
+        let s = Sphere::new(Vec3::new(0.0, 0.0, 4.0), 1.0, Transform::IDENTITY, false).unwrap();
+        let mut rng = crate::sampling::Pcg32::new(5, 5);
+        let expected = 1.0 / (2.0 * PI * (1.0 - (15.0f32 / 16.0).sqrt()));
+        for _ in 0..1000 {
+            let (ps, pdf) = s.sample_from(Vec3::ZERO, rng.next_vec2()).unwrap();
+            assert!(((ps.p - s.center).length() - 1.0).abs() < 1e-5 && ps.p.z < 4.0 + 1e-3);
+            assert!((pdf / expected - 1.0).abs() < 1e-4 && (s.pdf_from(Vec3::ZERO, ps.p, ps.n) - pdf).abs() < 1e-3 * pdf);
+        }
     }
 
     #[test]
