@@ -29,6 +29,7 @@ pub mod render;
 pub mod sampling;
 pub mod scene;
 pub mod spectrum;
+pub mod texture;
 pub mod verify;
 pub mod xml;
 

@@ -288,6 +288,46 @@ impl Props {
             .collect()
     }
 
+    /// Remove every nested `<texture>` parameter, here and in nested plugins, and return them with their
+    /// paths (`["reflectance"]`, `["_arg_1", "reflectance"]` for a texture inside a nested BSDF).
+    /// [`Props::set_path`] puts a value back at such a path.
+    pub fn take_textures(&mut self) -> Vec<(Vec<String>, Props)> {
+        let mut found = Vec::new();
+        let mut keep = Vec::with_capacity(self.entries.len());
+        for mut e in std::mem::take(&mut self.entries) {
+            match &mut e.value {
+                Value::Nested(p) if p.class == "texture" => {
+                    let Value::Nested(p) = e.value else { unreachable!() };
+                    found.push((vec![e.name], p));
+                    continue;
+                }
+                Value::Nested(p) => {
+                    for (mut path, t) in p.take_textures() {
+                        path.insert(0, e.name.clone());
+                        found.push((path, t));
+                    }
+                }
+                _ => {}
+            }
+            keep.push(e);
+        }
+        self.entries = keep;
+        found
+    }
+
+    /// Set a parameter at a path returned by [`Props::take_textures`]; `at` locates it in messages.
+    pub fn set_path(&mut self, path: &[String], value: Value, at: &str) {
+        match path {
+            [] => {}
+            [name] => self.set(name, value, at),
+            [first, rest @ ..] => {
+                if let Some(Value::Nested(p)) = self.entries.iter_mut().find(|e| &e.name == first).map(|e| &mut e.value) {
+                    p.set_path(rest, value, at);
+                }
+            }
+        }
+    }
+
     /// Reject parameters that no model asked for.
     pub fn finish(&self) -> Result<()> {
         if let Some(e) = self.entries.iter().find(|e| !e.used.get()) {

@@ -133,7 +133,7 @@ fn loader_errors_name_file_line_and_element() {
         ("<scene version=\"3.0.0\">\n<shape type=\"sphere\"><ref id=\"nope\"/></shape></scene>", "bad.xml:2:22: <ref id=\"nope\">"),
         ("<scene version=\"3.0.0\">\n<integrator type=\"path\"><integer name=\"max_depth\" value=\"$d\"/></integrator></scene>", "bad.xml:2:25: `$d` is not defined"),
         ("<scene version=\"3.0.0\">\n<emitter type=\"envmapp\"/></scene>", "bad.xml:2:1: unsupported emitter `envmapp`"),
-        ("<scene version=\"3.0.0\">\n<shape type=\"sphere\"><bsdf type=\"diffuse\">\n<texture name=\"reflectance\" type=\"bitmap\"/></bsdf></shape></scene>", "bad.xml:3:1: textures are not yet supported"),
+        ("<scene version=\"3.0.0\">\n<shape type=\"sphere\"><bsdf type=\"diffuse\">\n<texture name=\"reflectance\" type=\"bitmap\"/></bsdf></shape></scene>", "bad.xml:3:1: unsupported texture `bitmap`"),
         ("<scene>\n</scene>", "bad.xml:1:1: <scene> needs a version"),
     ];
     for (xml, want) in cases {
@@ -210,4 +210,22 @@ fn sphere_area_light_over_plane() {
     let img = run(&s);
     // The 0.5° field of view spans ±0.014 around the origin: the irradiance varies by < 1e-4 there.
     assert_close(&img, [0.125; 3], "sphere light");
+}
+
+/// A checkerboard on Mitsuba's rectangle (uv = ((x + 1)/2, (y + 1)/2)) framed exactly by the camera:
+/// top-left and bottom-right quadrants show `color1`, the others `color0` (times L = 1).
+#[test]
+fn checkerboard_on_rectangle_follows_mitsuba_uv() {
+    let s = scene(&format!(
+        r#"<scene version="3.0.0"><integrator type="direct"/>{}
+        <emitter type="constant"/>
+        <shape type="rectangle"><bsdf type="diffuse"><texture type="checkerboard" name="reflectance">
+            <rgb name="color0" value="0.8"/><rgb name="color1" value="0.2"/></texture></bsdf></shape></scene>"#,
+        sensor(1.0, 90.0, 4, 256)
+    ));
+    let img = run(&s);
+    let px = |x: usize, y: usize| img.data[3 * (y * 4 + x)];
+    for (x, y, want) in [(0, 0, 0.2), (3, 0, 0.8), (0, 3, 0.8), (3, 3, 0.2)] {
+        assert!((px(x, y) - want).abs() < 0.05 * want + 0.01, "pixel ({x}, {y}) = {}, expected {want}", px(x, y));
+    }
 }

@@ -40,7 +40,8 @@ pub fn radiance(scene: &Scene, ray: &Ray, rng: &mut Pcg32, max_depth: i32, rr_de
         if max_depth >= 0 && depth + 1 >= max_depth {
             break;
         }
-        let bsdf = &scene.bsdfs[si.shape as usize];
+        let material = scene.materials[si.shape as usize].at(si.uv);
+        let bsdf = &*material;
         let wo = si.shading.to_local(-ray.d);
         if bsdf.flags().has_smooth() {
             l += beta * sample_emitter(scene, &si, wo, bsdf, rng, 1.0, 1.0);

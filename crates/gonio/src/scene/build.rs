@@ -3,7 +3,7 @@
 //! know is an error naming the place in the file.
 
 use super::mitsuba_xml::SceneDescription;
-use super::{IntegratorKind, SamplerSpec, Scene};
+use super::{IntegratorKind, Material, SamplerSpec, Scene};
 use crate::bsdf::{Bsdf, Diffuse};
 use crate::camera::PerspectiveCamera;
 use crate::error::{Error, Result};
@@ -24,15 +24,15 @@ impl Scene {
     pub fn build(desc: SceneDescription) -> Result<Scene> {
         let mut warnings = Vec::new();
         let mut shapes = Vec::new();
-        let mut bsdfs = Vec::new();
+        let mut materials = Vec::new();
         let mut shape_lights = Vec::new();
         let mut lights = Vec::new();
         for p in &desc.shapes {
             shapes.push(shape_from_props(p)?);
             let nested = p.nested_of("bsdf");
-            bsdfs.push(match nested.as_slice() {
-                [] => Bsdf::Diffuse(Diffuse::new(Rgb::splat(0.5))),
-                [one] => Bsdf::from_props(one)?,
+            materials.push(match nested.as_slice() {
+                [] => Material::Fixed(Bsdf::Diffuse(Diffuse::new(Rgb::splat(0.5)))),
+                [one] => Material::from_props(one)?,
                 [_, second, ..] => return Err(Error::spec(second.at(), "a shape takes one <bsdf>")),
             });
             let emitters = p.nested_of("emitter");
@@ -75,7 +75,7 @@ impl Scene {
             Some(p) => integrator_from_props(p)?,
             None => IntegratorKind::Path { max_depth: -1, rr_depth: 5, hide_emitters: false },
         };
-        Ok(Scene::assemble(shapes, bsdfs, shape_lights, lights, camera, film, sampler, integrator, warnings))
+        Ok(Scene::assemble(shapes, materials, shape_lights, lights, camera, film, sampler, integrator, warnings))
     }
 }
 

@@ -3,10 +3,12 @@
 //! [`Scene::build`] (in `build.rs`) turns its plugins into these types.
 
 pub mod build;
+pub mod material;
 pub mod mesh_files;
 pub mod mitsuba_xml;
 
-use crate::bsdf::Bsdf;
+pub use material::Material;
+
 use crate::camera::PerspectiveCamera;
 use crate::error::Result;
 use crate::film::FilmSpec;
@@ -36,8 +38,8 @@ pub struct SamplerSpec {
 #[derive(Debug)]
 pub struct Scene {
     pub shapes: Vec<Shape>,
-    /// The BSDF of each shape.
-    pub bsdfs: Vec<Bsdf>,
+    /// The material (BSDF, possibly textured) of each shape.
+    pub materials: Vec<Material>,
     /// The area light of each shape (index into `lights`), if it emits.
     pub shape_lights: Vec<Option<u32>>,
     pub lights: Vec<Light>,
@@ -64,7 +66,7 @@ impl Scene {
     #[must_use]
     pub fn assemble(
         shapes: Vec<Shape>,
-        bsdfs: Vec<Bsdf>,
+        materials: Vec<Material>,
         shape_lights: Vec<Option<u32>>,
         lights: Vec<Light>,
         camera: PerspectiveCamera,
@@ -83,7 +85,7 @@ impl Scene {
         }
         let bvh = Bvh::build(&bounds);
         let environment = lights.iter().position(|l| matches!(l, Light::Constant(_))).map(|i| i as u32);
-        Scene { shapes, bsdfs, shape_lights, lights, environment, camera, film, sampler, integrator, warnings, bvh, prims }
+        Scene { shapes, materials, shape_lights, lights, environment, camera, film, sampler, integrator, warnings, bvh, prims }
     }
 
     /// Number of primitives in the BVH.

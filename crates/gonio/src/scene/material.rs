@@ -1,0 +1,67 @@
+//! Materials: a BSDF whose parameters may be textures. Evaluated at a hit into a plain [`Bsdf`]; an
+//! untextured material is that `Bsdf` already.
+
+use crate::bsdf::{Bsdf, Diffuse};
+use crate::error::Result;
+use crate::props::{Props, Value};
+use crate::texture::Texture;
+use glam::Vec2;
+use std::borrow::Cow;
+use std::sync::Mutex;
+
+/// One shape's reflection model.
+#[derive(Debug)]
+pub enum Material {
+    Fixed(Bsdf),
+    /// A `diffuse` whose reflectance is a texture (the common case, built without `Props`).
+    TexturedDiffuse(Texture),
+    /// Any other BSDF with texture parameters: the description without them, and the textures with their
+    /// parameter paths. Rebuilt at every hit from a copy of the template (`Props` tracks which parameters
+    /// were read, so it is not `Sync`: the template sits behind a mutex held only for the copy). A slow,
+    /// general path; models gain direct texture support as they need it, like `TexturedDiffuse`.
+    Textured { template: Mutex<Props>, textures: Vec<(Vec<String>, Texture)> },
+}
+
+impl Material {
+    /// Build from a `<bsdf>` description (textures included).
+    pub fn from_props(p: &Props) -> Result<Material> {
+        let mut template = p.clone();
+        let taken = template.take_textures();
+        if taken.is_empty() {
+            return Ok(Material::Fixed(Bsdf::from_props(p)?));
+        }
+        let textures = taken.iter().map(|(path, t)| Ok((path.clone(), Texture::from_props(t)?))).collect::<Result<Vec<_>>>()?;
+        let material = match (template.plugin_type(), textures.as_slice()) {
+            ("diffuse", [(path, t)]) if path == &["reflectance"] => Material::TexturedDiffuse(t.clone()),
+            _ => Material::Textured { template: Mutex::new(template), textures },
+        };
+        // Build once now so that parameter errors surface at load time.
+        if let Material::Textured { .. } = &material {
+            material.try_at(Vec2::splat(0.5))?;
+        }
+        Ok(material)
+    }
+
+    fn try_at(&self, uv: Vec2) -> Result<Cow<'_, Bsdf>> {
+        Ok(match self {
+            Material::Fixed(b) => Cow::Borrowed(b),
+            Material::TexturedDiffuse(t) => Cow::Owned(Bsdf::Diffuse(Diffuse::new(t.eval(uv).map(|v| v.clamp(0.0, 1.0))))),
+            Material::Textured { template, textures } => {
+                let mut p = template.lock().map_or_else(|poisoned| poisoned.into_inner().clone(), |t| t.clone());
+                let at = p.at().to_string();
+                for (path, t) in textures {
+                    let c = t.eval(uv);
+                    p.set_path(path, Value::List(c.to_f64().to_vec()), &at);
+                }
+                Cow::Owned(Bsdf::from_props(&p)?)
+            }
+        })
+    }
+
+    /// The BSDF at texture coordinates `uv`. A texture value a model rejects (e.g. a reflectance above 1)
+    /// gives a black diffuse rather than a panic; load-time validation catches constant mistakes.
+    #[must_use]
+    pub fn at(&self, uv: Vec2) -> Cow<'_, Bsdf> {
+        self.try_at(uv).unwrap_or_else(|_| Cow::Owned(Bsdf::Diffuse(Diffuse::new(crate::spectrum::Rgb::ZERO))))
+    }
+}

@@ -1,0 +1,40 @@
+//! Textures: colours that vary over a surface, evaluated at a hit's uv. Materials evaluate them into a
+//! plain [`crate::bsdf::Bsdf`] (see [`crate::scene::material`]).
+//!
+//! Plugins: `checkerboard` ([`checkerboard`]); `bitmap` arrives with image I/O.
+
+pub mod checkerboard;
+
+pub use checkerboard::Checkerboard;
+
+use crate::error::{Error, Result};
+use crate::props::Props;
+use crate::spectrum::Rgb;
+use glam::Vec2;
+
+/// Any gonio texture.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Texture {
+    Checkerboard(Checkerboard),
+}
+
+impl Texture {
+    /// Build from a `<texture>` description.
+    pub fn from_props(p: &Props) -> Result<Texture> {
+        let t = match p.plugin_type() {
+            "checkerboard" => Texture::Checkerboard(Checkerboard::from_props(p)?),
+            other => return Err(Error::spec(p.at(), format!("unsupported texture `{other}` (gonio has: checkerboard)"))),
+        };
+        p.finish()?;
+        Ok(t)
+    }
+
+    /// The colour at texture coordinates `uv`.
+    #[inline]
+    #[must_use]
+    pub fn eval(&self, uv: Vec2) -> Rgb {
+        match self {
+            Texture::Checkerboard(c) => c.eval(uv),
+        }
+    }
+}
