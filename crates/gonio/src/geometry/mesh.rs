@@ -98,30 +98,20 @@ impl Mesh {
         Bounds3::from_point(p0).with_point(p1).with_point(p2)
     }
 
-    /// Möller–Trumbore; `uv` of the hit holds the barycentrics (b₁, b₂).
+    /// The triangle as (p₀, p₁ − p₀, p₂ − p₀), the form [`intersect_triangle`] takes.
+    #[inline]
+    #[must_use]
+    pub fn triangle_edges(&self, tri: u32) -> [Vec3; 3] {
+        let [p0, p1, p2] = self.vertices(tri);
+        [p0, p1 - p0, p2 - p0]
+    }
+
+    /// `uv` of the hit holds the barycentrics (b₁, b₂).
     #[inline]
     #[must_use]
     pub fn intersect(&self, tri: u32, ray: &Ray) -> Option<PrimHit> {
-        let [p0, p1, p2] = self.vertices(tri);
-        let (e1, e2) = (p1 - p0, p2 - p0);
-        let pv = ray.d.cross(e2);
-        let det = e1.dot(pv);
-        if det == 0.0 {
-            return None;
-        }
-        let inv_det = 1.0 / det;
-        let tv = ray.o - p0;
-        let b1 = tv.dot(pv) * inv_det;
-        if !(0.0..=1.0).contains(&b1) {
-            return None;
-        }
-        let qv = tv.cross(e1);
-        let b2 = ray.d.dot(qv) * inv_det;
-        if b2 < 0.0 || b1 + b2 > 1.0 {
-            return None;
-        }
-        let t = e2.dot(qv) * inv_det;
-        (t > 0.0 && t < ray.tmax).then_some(PrimHit { t, uv: Vec2::new(b1, b2) })
+        let [p0, e1, e2] = self.triangle_edges(tri);
+        intersect_triangle(p0, e1, e2, ray)
     }
 
     /// Geometric normal, shading normal and uv at barycentrics (b₁, b₂) of triangle `tri`.
@@ -171,6 +161,30 @@ impl Mesh {
         let (ng, ns, _) = self.surface_at(tri, b);
         PositionSample { p, n: ns, ng, pdf_area: 1.0 / self.area }
     }
+}
+
+/// Möller–Trumbore for the triangle p₀ + b₁ e₁ + b₂ e₂; the hit's `uv` holds (b₁, b₂).
+#[inline]
+#[must_use]
+pub fn intersect_triangle(p0: Vec3, e1: Vec3, e2: Vec3, ray: &Ray) -> Option<PrimHit> {
+    let pv = ray.d.cross(e2);
+    let det = e1.dot(pv);
+    if det == 0.0 {
+        return None;
+    }
+    let inv_det = 1.0 / det;
+    let tv = ray.o - p0;
+    let b1 = tv.dot(pv) * inv_det;
+    if !(0.0..=1.0).contains(&b1) {
+        return None;
+    }
+    let qv = tv.cross(e1);
+    let b2 = ray.d.dot(qv) * inv_det;
+    if b2 < 0.0 || b1 + b2 > 1.0 {
+        return None;
+    }
+    let t = e2.dot(qv) * inv_det;
+    (t > 0.0 && t < ray.tmax).then_some(PrimHit { t, uv: Vec2::new(b1, b2) })
 }
 
 #[cfg(test)]

@@ -12,7 +12,9 @@ pub use material::Material;
 use crate::camera::PerspectiveCamera;
 use crate::error::Result;
 use crate::film::FilmSpec;
-use crate::geometry::{Bvh, Ray, Shape, SurfaceInteraction};
+use crate::geometry::mesh::intersect_triangle;
+use crate::geometry::{Bvh, PrimHit, Ray, Shape, SurfaceInteraction};
+use glam::Vec3;
 use crate::light::Light;
 use std::path::Path;
 
@@ -52,8 +54,26 @@ pub struct Scene {
     /// Things accepted but approximated (e.g. a Gaussian filter rendered as a box).
     pub warnings: Vec<String>,
     bvh: Bvh,
-    /// (shape, primitive) of each BVH primitive.
-    prims: Vec<(u32, u32)>,
+    /// The primitives in BVH leaf order.
+    prims: Vec<Primitive>,
+}
+
+/// One primitive as the BVH's leaves need it: triangles inline (no index lookups in the inner loop),
+/// other shapes by reference.
+#[derive(Clone, Copy, Debug)]
+enum Primitive {
+    Triangle { p0: Vec3, e1: Vec3, e2: Vec3, shape: u32, prim: u32 },
+    Other { shape: u32, prim: u32 },
+}
+
+impl Primitive {
+    #[inline]
+    fn intersect(&self, shapes: &[Shape], ray: &Ray) -> Option<(u32, u32, PrimHit)> {
+        match *self {
+            Primitive::Triangle { p0, e1, e2, shape, prim } => intersect_triangle(p0, e1, e2, ray).map(|h| (shape, prim, h)),
+            Primitive::Other { shape, prim } => shapes[shape as usize].intersect(prim, ray).map(|h| (shape, prim, h)),
+        }
+    }
 }
 
 impl Scene {
@@ -75,15 +95,29 @@ impl Scene {
         integrator: IntegratorKind,
         warnings: Vec<String>,
     ) -> Scene {
-        let mut prims = Vec::new();
+        let mut refs = Vec::new();
         let mut bounds = Vec::new();
         for (s, shape) in shapes.iter().enumerate() {
             for p in 0..shape.primitive_count() as u32 {
-                prims.push((s as u32, p));
+                refs.push((s as u32, p));
                 bounds.push(shape.primitive_bounds(p));
             }
         }
         let bvh = Bvh::build(&bounds);
+        let prims = bvh
+            .order()
+            .iter()
+            .map(|&i| {
+                let (shape, prim) = refs[i as usize];
+                match &shapes[shape as usize] {
+                    Shape::Mesh(m) => {
+                        let [p0, e1, e2] = m.triangle_edges(prim);
+                        Primitive::Triangle { p0, e1, e2, shape, prim }
+                    }
+                    _ => Primitive::Other { shape, prim },
+                }
+            })
+            .collect();
         let environment = lights.iter().position(|l| matches!(l, Light::Constant(_))).map(|i| i as u32);
         Scene { shapes, materials, shape_lights, lights, environment, camera, film, sampler, integrator, warnings, bvh, prims }
     }
@@ -97,10 +131,10 @@ impl Scene {
     /// The closest surface along `ray`.
     #[must_use]
     pub fn intersect(&self, ray: &Ray) -> Option<SurfaceInteraction> {
-        let (_, (shape, prim, hit)) = self.bvh.closest(ray, |i, tmax| {
-            let (shape, prim) = self.prims[i as usize];
-            let r = Ray { tmax, ..*ray };
-            self.shapes[shape as usize].intersect(prim, &r).map(|h| (h.t, (shape, prim, h)))
+        let mut r = *ray;
+        let (_, (shape, prim, hit)) = self.bvh.closest(ray, |slot, tmax| {
+            r.tmax = tmax;
+            self.prims[slot as usize].intersect(&self.shapes, &r).map(|h| (h.2.t, h))
         })?;
         Some(self.shapes[shape as usize].interaction(shape, prim, ray, &hit))
     }
@@ -108,9 +142,6 @@ impl Scene {
     /// Whether anything blocks `ray` before its `tmax`.
     #[must_use]
     pub fn occluded(&self, ray: &Ray) -> bool {
-        self.bvh.any(ray, |i| {
-            let (shape, prim) = self.prims[i as usize];
-            self.shapes[shape as usize].intersect(prim, ray).is_some()
-        })
+        self.bvh.any(ray, |slot| self.prims[slot as usize].intersect(&self.shapes, ray).is_some())
     }
 }
