@@ -30,6 +30,7 @@ pub struct PerspectiveCamera {
 
 impl PerspectiveCamera {
     /// A camera for a film of `width × height` pixels with field of view `fov_deg` along `axis`.
+    #[allow(clippy::too_many_arguments)] // one argument per plugin parameter, as in the table above
     pub fn new(to_world: Transform, fov_deg: f32, axis: &str, width: u32, height: u32, near: f32, far: f32, at: &str) -> Result<Self> {
         let aspect = width as f32 / height as f32;
         let t = (fov_deg.to_radians() * 0.5).tan();

@@ -61,9 +61,8 @@ impl Film {
         if !v.is_finite() {
             return false;
         }
-        let s = &mut self.sum[index];
-        for c in 0..3 {
-            s[c] += f64::from(v.0[c]);
+        for (s, c) in self.sum[index].iter_mut().zip(v.0) {
+            *s += f64::from(c);
         }
         true
     }

@@ -33,10 +33,10 @@ fn sensor(dist: f32, fov: f32, res: u32, spp: u32) -> String {
 }
 
 fn assert_close(img: &RenderOutput, expected: [f64; 3], what: &str) {
-    for c in 0..3 {
+    for (c, &want) in expected.iter().enumerate() {
         let (mean, se) = mean_and_se(img, c);
         // 5 standard errors, plus 1e-4 relative for f32 rounding (2026-11).
-        assert!((mean - expected[c]).abs() <= 5.0 * se + 1e-4 * expected[c], "{what}: channel {c}: {mean} ± {se}, expected {}", expected[c]);
+        assert!((mean - want).abs() <= 5.0 * se + 1e-4 * want, "{what}: channel {c}: {mean} ± {se}, expected {want}");
     }
 }
 

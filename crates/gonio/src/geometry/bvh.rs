@@ -4,14 +4,15 @@
 //! the first child of an interior node follows it, the node stores the second.
 //!
 //! Traversal is geometry-agnostic: the caller passes a closure that intersects primitive `i` with the
-//! ray, as obvhs does. Children are visited near-first by the sign of the ray direction on the split axis.
+//! ray, as obvhs does. Children are visited nearest first (by box entry distance); farther ones are culled when a
+//! closer hit has been found by the time they are popped.
 
 use super::{Bounds3, Ray};
 use glam::Vec3;
 
 /// Number of SAH bins.
 const BINS: usize = 16;
-/// Leaves never hold more primitives than this (u16 count, and traversal cost).
+/// Leaves hold at most this many primitives when the SAH would rather split.
 const MAX_LEAF: usize = 4;
 /// Relative cost of a node traversal step against one primitive test (pbrt uses 1/8; 2026-11: 1/2 measured
 /// faster for triangle-dominated scenes with gonio's Möller–Trumbore).
@@ -25,8 +26,7 @@ struct Node {
     offset: u32,
     max: Vec3,
     /// 0 for interior nodes; else the number of primitives.
-    count: u16,
-    axis: u16,
+    count: u32,
 }
 
 /// The hierarchy: nodes, and the permutation of primitive indices its leaves refer to.
@@ -78,7 +78,7 @@ impl Bvh {
     fn push_leaf(&mut self, bounds: Bounds3, prims: &[BuildPrim]) {
         let offset = self.order.len() as u32;
         self.order.extend(prims.iter().map(|p| p.index));
-        self.nodes.push(Node { min: bounds.min, max: bounds.max, offset, count: prims.len() as u16, axis: 0 });
+        self.nodes.push(Node { min: bounds.min, max: bounds.max, offset, count: prims.len() as u32 });
     }
 
     fn build_node(&mut self, prims: &mut [BuildPrim]) {
@@ -108,7 +108,7 @@ impl Bvh {
             median_split(prims, axis)
         };
         let me = self.nodes.len();
-        self.nodes.push(Node { min: bounds.min, max: bounds.max, offset: 0, count: 0, axis: axis as u16 });
+        self.nodes.push(Node { min: bounds.min, max: bounds.max, offset: 0, count: 0 });
         let (left, right) = prims.split_at_mut(mid);
         self.build_node(left);
         self.nodes[me].offset = self.nodes.len() as u32;
@@ -205,7 +205,7 @@ impl Bvh {
         loop {
             let node = &self.nodes[node_index as usize];
             if node.count > 0 {
-                for slot in node.offset..node.offset + u32::from(node.count) {
+                for slot in node.offset..node.offset + node.count {
                     let (stop, t) = visit(slot, tmax);
                     if stop {
                         return;

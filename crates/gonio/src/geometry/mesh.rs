@@ -32,6 +32,7 @@ pub struct Mesh {
 
 impl Mesh {
     /// A mesh from object-space data. `at` names the shape in errors (bad indices, non-finite vertices).
+    #[allow(clippy::too_many_arguments)] // one argument per plugin parameter, as in the table above
     pub fn new(
         positions: Vec<Vec3>,
         normals: Option<Vec<Vec3>>,

@@ -84,6 +84,7 @@ impl Scene {
 
     /// Assemble a scene and build its BVH.
     #[must_use]
+    #[allow(clippy::too_many_arguments)] // one argument per plugin parameter, as in the table above
     pub fn assemble(
         shapes: Vec<Shape>,
         materials: Vec<Material>,
