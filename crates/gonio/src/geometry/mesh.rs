@@ -7,7 +7,10 @@
 //! | `flip_normals` | boolean   | false    | reverse both geometric and shading normals                    |
 //!
 //! The geometric normal is `normalize((p₁ − p₀) × (p₂ − p₀))` in world space, as in Mitsuba; the shading
-//! normal interpolates vertex normals with the barycentrics. Without texture coordinates, uv = (b₁, b₂).
+//! normal interpolates vertex normals with the barycentrics. A mesh file without normals gets smooth ones
+//! unless `face_normals` is set, as in Mitsuba: each face's normal weighted by its angle at the vertex
+//! (Thürmer & Wüthrich 1998, "Computing Vertex Normals from Polygonal Facets"). Without texture
+//! coordinates, uv = (b₁, b₂).
 //! Rays are intersected with Möller & Trumbore 1997, "Fast, Minimum Storage Ray/Triangle Intersection".
 
 use super::interaction::{PositionSample, SurfaceInteraction};
@@ -31,6 +34,26 @@ pub struct Mesh {
 }
 
 impl Mesh {
+    /// [`Mesh::new`] for a mesh file: without normals in the file and without `face_normals`, smooth vertex
+    /// normals are computed (as Mitsuba's `obj` and `ply` do).
+    #[allow(clippy::too_many_arguments)] // one argument per plugin parameter, as in the table above
+    pub fn from_file_data(
+        positions: Vec<Vec3>,
+        normals: Option<Vec<Vec3>>,
+        uvs: Option<Vec<Vec2>>,
+        indices: Vec<[u32; 3]>,
+        to_world: &Transform,
+        face_normals: bool,
+        flip_normals: bool,
+        at: &str,
+    ) -> Result<Mesh> {
+        let mut mesh = Mesh::new(positions, normals, uvs, indices, to_world, face_normals, flip_normals, at)?;
+        if !face_normals && mesh.normals.is_none() {
+            mesh.normals = Some(angle_weighted_normals(&mesh.positions, &mesh.indices));
+        }
+        Ok(mesh)
+    }
+
     /// A mesh from object-space data. `at` names the shape in errors (bad indices, non-finite vertices).
     #[allow(clippy::too_many_arguments)] // one argument per plugin parameter, as in the table above
     pub fn new(
@@ -164,6 +187,22 @@ impl Mesh {
     }
 }
 
+/// Vertex normals as the angle-weighted mean of the adjacent face normals (world space, unit length;
+/// a vertex of degenerate faces only gets the zero vector, and shading falls back to the face normal).
+fn angle_weighted_normals(positions: &[Vec3], indices: &[[u32; 3]]) -> Vec<Vec3> {
+    let mut normals = vec![Vec3::ZERO; positions.len()];
+    for tri in indices {
+        let p = tri.map(|i| positions[i as usize]);
+        let Some(n) = (p[1] - p[0]).cross(p[2] - p[0]).try_normalize() else { continue };
+        for k in 0..3 {
+            let (a, b) = ((p[(k + 1) % 3] - p[k]).normalize_or_zero(), (p[(k + 2) % 3] - p[k]).normalize_or_zero());
+            let angle = a.dot(b).clamp(-1.0, 1.0).acos();
+            normals[tri[k] as usize] += n * angle;
+        }
+    }
+    normals.iter().map(|n| n.normalize_or_zero()).collect()
+}
+
 /// Möller–Trumbore for the triangle p₀ + b₁ e₁ + b₂ e₂; the hit's `uv` holds (b₁, b₂).
 #[inline]
 #[must_use]
@@ -206,6 +245,15 @@ mod tests {
         assert!((h.1.t - 2.0).abs() < 1e-6);
         let si = m.interaction(h.0, &r, &h.1);
         assert!((si.n - Vec3::Z).length() < 1e-6 && (si.p - Vec3::new(0.3, 0.2, 0.0)).length() < 1e-6);
+    }
+
+    #[test]
+    fn smooth_normals_of_a_tent_bisect_its_faces() {
+        let p = vec![Vec3::new(-1.0, 0.0, 0.0), Vec3::new(0.0, 0.0, 1.0), Vec3::new(0.0, 1.0, 1.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(1.0, 1.0, 0.0)];
+        let idx = vec![[0, 1, 2], [1, 3, 4], [1, 4, 2]];
+        let m = Mesh::from_file_data(p, None, None, idx, &Transform::IDENTITY, false, false, "t").unwrap();
+        let n = m.normals.as_ref().unwrap()[1];
+        assert!(n.x.abs() < 1e-5 && n.z > 0.99, "{n}");
     }
 
     #[test]

@@ -101,7 +101,7 @@ fn shape_from_props(p: &Props) -> Result<Shape> {
             let flip_tex = if kind == "obj" { p.bool("flip_tex_coords", true)? } else { false };
             let data = super::mesh_files::load(kind, std::path::Path::new(&filename), at)?;
             let uvs = data.uvs.map(|uv| uv.into_iter().map(|t| if flip_tex { glam::Vec2::new(t.x, 1.0 - t.y) } else { t }).collect());
-            Shape::Mesh(Mesh::new(data.positions, data.normals, uvs, data.indices, &to_world, face_normals, flip, &format!("{at} ({filename})"))?)
+            Shape::Mesh(Mesh::from_file_data(data.positions, data.normals, uvs, data.indices, &to_world, face_normals, flip, &format!("{at} ({filename})"))?)
         }
         other => return Err(Error::spec(at, format!("unsupported shape `{other}` (gonio has: {SHAPES})"))),
     })
