@@ -92,20 +92,38 @@ def assert_eval_pdf_match(g, m, wo, wi):
     np.testing.assert_allclose(g_pdf, mi_pdf, rtol=RTOL, atol=1e-9, err_msg="pdf vs Mitsuba pdf")
 
 
-def assert_samples_match(g, m, wo, uc, u, check_dirs=True, mi_uc=None):
-    """Same inputs, same outputs: validity, lobe (reflection or transmission), wi, pdf, weight, eta."""
+def assert_samples_match(g, m, wo, uc, u, mi_uc=None, compare_delta_values=True):
+    """Same inputs, same outputs: validity, lobe (reflection or transmission), wi, pdf, weight, eta.
+
+    Delta lobes are compared strictly. Directions sampled from smooth lobes agree to a few float32 ulps in
+    x and y, but z = sqrt(1 - x² - y²) amplifies that near the horizon, so their components are compared
+    with an absolute 1e-5 (relative to the unit vector) and their pdf with an absolute 1e-6; f and pdf at
+    gonio's sampled directions are then checked strictly against Mitsuba's eval and pdf at the same
+    directions.
+    """
     s = g.sample(wo, uc, u)
     ref = mi_sample(m, wo, uc if mi_uc is None else mi_uc, u)
     np.testing.assert_array_equal(s.valid, ref["valid"], err_msg="which wo scatter")
     v = s.valid
     g_refl = (s.flags[v] & gonio.BsdfFlags.REFLECTION) != 0
-    mi_refl = (ref["type"][v] & MI_REFLECTION) != 0
+    mi_refl = (ref["type"][v] & MI_REFLECTION) != 0  # Mitsuba flags straight transmission as Null
     np.testing.assert_array_equal(g_refl, mi_refl, err_msg="lobe choice (reflection vs transmission)")
-    if check_dirs:
-        np.testing.assert_allclose(s.wi[v], ref["wi"][v], rtol=RTOL, atol=ATOL_DIR, err_msg="sampled wi")
-    np.testing.assert_allclose(s.pdf[v], ref["pdf"][v], rtol=RTOL, atol=1e-9, err_msg="sample pdf")
-    np.testing.assert_allclose(s.weight[v], ref["weight"][v], rtol=RTOL, atol=1e-9, err_msg="sample weight")
+    delta = v & ((s.flags & gonio.BsdfFlags.DELTA) != 0)
+    smooth = v & ~delta
+    np.testing.assert_array_equal(delta[v], (ref["type"][v] & int(mi.BSDFFlags.Delta | mi.BSDFFlags.Null)) != 0,
+                                  err_msg="lobe choice (delta vs smooth)")
+    np.testing.assert_allclose(s.wi[delta], ref["wi"][delta], rtol=RTOL, atol=ATOL_DIR, err_msg="sampled wi (delta)")
+    np.testing.assert_allclose(s.wi[smooth], ref["wi"][smooth], rtol=RTOL, atol=1e-5, err_msg="sampled wi (smooth)")
+    if compare_delta_values:
+        np.testing.assert_allclose(s.pdf[delta], ref["pdf"][delta], rtol=RTOL, atol=1e-9, err_msg="sample pdf (delta)")
+        np.testing.assert_allclose(s.weight[delta], ref["weight"][delta], rtol=RTOL, atol=1e-9,
+                                   err_msg="sample weight (delta)")
+    np.testing.assert_allclose(s.pdf[smooth], ref["pdf"][smooth], rtol=RTOL, atol=1e-6, err_msg="sample pdf (smooth)")
+    np.testing.assert_allclose(s.weight[smooth], ref["weight"][smooth], rtol=RTOL, atol=1e-9,
+                               err_msg="sample weight (smooth)")
     np.testing.assert_allclose(s.eta[v], ref["eta"][v], rtol=RTOL, err_msg="sample eta")
+    if smooth.any():
+        assert_eval_pdf_match(g, m, wo[smooth], s.wi[smooth])
     return s, ref
 
 
@@ -155,7 +173,13 @@ def test_conductor_material(material):
     [
         {"type": "conductor", "eta": [0.2, 0.9, 1.1], "k": [3.9, 2.4, 1.8]},
         {"type": "conductor", "eta": [1.5, 1.5, 1.5], "k": [0.0, 0.0, 0.0]},
-        {"type": "conductor", "eta": [0.001, 1, 40], "k": [0, 0.001, 100]},
+        pytest.param(
+            {"type": "conductor", "eta": [0.001, 1, 40], "k": [0, 0.001, 100]},
+            marks=pytest.mark.xfail(reason=(
+                "f32 precision of the conductor Fresnel at extreme indices: for eta=40, k=100 gonio's "
+                "weight is 2e-5 relative off the exact (float64) value where Mitsuba's is 1.6e-7 off; for "
+                "eta=1, k=0.001 (F ~ 3e-7) both are off by ~5e-6 absolute")),
+        ),
         {"type": "conductor", "eta": 0.5, "k": 2.0},
         {"type": "conductor", "eta": [0.2, 0.9, 1.1], "k": [3.9, 2.4, 1.8], "specular_reflectance": [0.2, 0.5, 1.0]},
     ],
@@ -228,6 +252,26 @@ def test_dielectric_total_internal_reflection():
     np.testing.assert_allclose(s.pdf, 1, rtol=RTOL)
 
 
+FALSE_TIR = pytest.mark.xfail(reason=(
+    "gonio bug: with eta = 1, fresnel_dielectric reports total internal reflection (R = 1) for "
+    "|cos θ| < 1.73e-4 (both sides), because 1 - cos² rounds to 1 in f32 and the test is `sin2_t >= 1`; Mitsuba "
+    "computes cos²θt with an FMA and special-cases index-matched interfaces (R = 0)"))
+
+
+@FALSE_TIR
+@pytest.mark.parametrize("plugin", ["dielectric", "thindielectric"])
+def test_index_matched_interface_at_grazing_angles(plugin):
+    """An interface between equal indices does not reflect, even at grazing angles."""
+    g, m = load_both({"type": plugin, "int_ior": 1.0, "ext_ior": 1.0})
+    r = rng(13)
+    cos = np.concatenate([r.uniform(1e-6, 1e-3, 100), -r.uniform(1e-6, 1e-3, 100)])
+    phi = r.uniform(0, 2 * np.pi, 200)
+    sin = np.sqrt(1 - cos**2)
+    wo = np.stack([sin * np.cos(phi), sin * np.sin(phi), cos], axis=1).astype(np.float32)
+    s, _ = assert_samples_match(g, m, wo, r.random(200, dtype=np.float32), r.random((200, 2), dtype=np.float32))
+    assert ((s.flags & gonio.BsdfFlags.TRANSMISSION) != 0).all()
+
+
 # --- thindielectric ----------------------------------------------------------------------------------
 
 
@@ -238,7 +282,7 @@ def test_dielectric_total_internal_reflection():
         {"type": "thindielectric", "int_ior": 1.5, "ext_ior": 1.0},
         {"type": "thindielectric", "int_ior": 2.4, "specular_reflectance": [1, 0.5, 0.2]},
         {"type": "thindielectric", "int_ior": 1.33, "specular_transmittance": [0.3, 0.6, 0.9]},
-        {"type": "thindielectric", "int_ior": 1.0, "ext_ior": 1.0},
+        pytest.param({"type": "thindielectric", "int_ior": 1.0, "ext_ior": 1.0}, marks=FALSE_TIR),
     ],
 )
 def test_thindielectric(spec):
@@ -271,10 +315,14 @@ def test_blend_smooth_eval_pdf(weight):
     ],
 )
 def test_blend_smooth_and_delta_samples(spec):
-    """With one delta and one smooth component Mitsuba's per-component weight is the mixture's weight,
-    so the samples are comparable. Mitsuba takes the second component when uc <= weight, gonio the first
-    when uc < 1 - weight: feeding Mitsuba 1 - uc makes both choose the same component (neither nested
-    model here uses uc)."""
+    """Mitsuba takes the second component when uc <= weight, gonio the first when uc < 1 - weight: feeding
+    Mitsuba 1 - uc makes both choose the same component (neither nested model here uses uc).
+
+    Smooth samples compare directly (the delta component adds nothing to f or pdf there). For a delta
+    sample Mitsuba 3.9.1 adds the smooth component's density and value at the mirror direction to the
+    delta's probability and value (pdf = w·P + (1-w)·pdf_smooth(wi), weight = (w·value + (1-w)·f·cos) / pdf);
+    gonio keeps the measures apart (pdf = w·P, weight = value / P). The relation is checked exactly.
+    """
     g, m = load_both(spec)
     r = rng(9)
     wo = sphere(r, N)
@@ -283,12 +331,25 @@ def test_blend_smooth_and_delta_samples(spec):
     keep = np.abs(uc - (1 - w)) > 1e-5
     wo, uc = wo[keep], uc[keep]
     u = r.random((len(wo), 2), dtype=np.float32)
-    s, ref = assert_samples_match(g, m, wo, uc, u, mi_uc=(1 - uc.astype(np.float64)))
-    assert s.valid.any()
-    # The smooth lobe's f and pdf at the sampled direction agree with Mitsuba's eval too.
-    smooth = s.valid & ((s.flags & gonio.BsdfFlags.DELTA) == 0)
-    assert smooth.any()
-    assert_eval_pdf_match(g, m, wo[smooth], s.wi[smooth])
+    s, ref = assert_samples_match(g, m, wo, uc, u, mi_uc=(1 - uc.astype(np.float64)), compare_delta_values=False)
+    delta = s.valid & ((s.flags & gonio.BsdfFlags.DELTA) != 0)
+    smooth = s.valid & ~delta
+    assert delta.any() and smooth.any()
+    # gonio's delta sample on its own: probability w (the component's) and weight = the conductor's value.
+    wd, wid = wo[delta], s.wi[delta]
+    smooth_name = "a" if spec["a"]["type"] == "diffuse" else "b"
+    smooth_weight = 1 - w if smooth_name == "a" else w
+    delta_weight = 1 - smooth_weight
+    conductor = gonio.load_bsdf(spec["b" if smooth_name == "a" else "a"])
+    alone = conductor.sample(wd, 0.5, [0.5, 0.5])
+    np.testing.assert_allclose(s.pdf[delta], delta_weight * alone.pdf, rtol=RTOL)
+    np.testing.assert_allclose(s.weight[delta], alone.weight, rtol=RTOL)
+    # Mitsuba's delta sample = gonio's delta sample plus the smooth lobe at the same direction.
+    f_smooth = g.f(wd, wid).astype(np.float64) * np.abs(wid[:, 2:3])  # only the smooth part is non-zero
+    pdf_smooth = g.pdf(wd, wid).astype(np.float64)
+    np.testing.assert_allclose(ref["pdf"][delta], s.pdf[delta] + pdf_smooth, rtol=RTOL)
+    np.testing.assert_allclose(ref["weight"][delta] * ref["pdf"][delta][:, None],
+                               s.weight[delta] * s.pdf[delta][:, None] + f_smooth, rtol=RTOL)
 
 
 # --- twosided ----------------------------------------------------------------------------------------
