@@ -114,8 +114,9 @@ fn read_directions(obj: &Bound<'_, PyAny>, name: &str, normalize: bool) -> PyRes
         }
         let len = (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]).sqrt();
         let w = if normalize {
-            if !(len > 0.0) {
-                return Err(PyValueError::new_err(format!("{at} = {w:?} has zero length and cannot be normalized")));
+            // len ≥ 0 here; it is infinite when the squares overflow f64.
+            if len == 0.0 || !len.is_finite() {
+                return Err(PyValueError::new_err(format!("{at} = {w:?} has zero or overflowing length and cannot be normalized")));
             }
             [w[0] / len, w[1] / len, w[2] / len]
         } else {
@@ -249,14 +250,24 @@ impl PyBsdf {
     /// Directional albedo ∫ f(wo, wi) |cos θi| dωi, estimated with `samples` of the model's own sampling
     /// (seeded, so reproducible). Float32 RGB of shape (N, 3), or (3,) for a single `wo`.
     #[pyo3(signature = (wo, *, samples = 100_000, seed = 0, normalize = false))]
-    fn albedo<'py>(&self, py: Python<'py>, wo: &Bound<'py, PyAny>, samples: usize, seed: u64, normalize: bool) -> PyResult<Bound<'py, PyAny>> {
+    fn albedo<'py>(
+        &self,
+        py: Python<'py>,
+        wo: &Bound<'py, PyAny>,
+        samples: usize,
+        seed: u64,
+        normalize: bool,
+    ) -> PyResult<Bound<'py, PyAny>> {
         if samples == 0 {
             return Err(PyValueError::new_err("`samples` must be at least 1"));
         }
         let (ro, wo) = read_directions(wo, "wo", normalize)?;
         let bsdf = &self.bsdf;
         let out = run_released(py, || {
-            wo.iter().enumerate().map(|(i, &w)| gonio::verify::energy::albedo(bsdf, w, samples, seed.wrapping_add(i as u64))).collect::<Vec<Rgb>>()
+            wo.iter()
+                .enumerate()
+                .map(|(i, &w)| gonio::verify::energy::albedo(bsdf, w, samples, seed.wrapping_add(i as u64)))
+                .collect::<Vec<Rgb>>()
         })?;
         rgb_array(py, &out, ro.batched)
     }
@@ -320,7 +331,15 @@ struct PySample {
 impl PySample {
     fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
         let mut parts = Vec::new();
-        for (name, v) in [("wi", &self.wi), ("f", &self.f), ("pdf", &self.pdf), ("weight", &self.weight), ("flags", &self.flags), ("eta", &self.eta), ("valid", &self.valid)] {
+        for (name, v) in [
+            ("wi", &self.wi),
+            ("f", &self.f),
+            ("pdf", &self.pdf),
+            ("weight", &self.weight),
+            ("flags", &self.flags),
+            ("eta", &self.eta),
+            ("valid", &self.valid),
+        ] {
             parts.push(format!("{name}={}", v.bind(py).repr()?));
         }
         Ok(format!("BsdfSample({})", parts.join(", ")))

@@ -234,3 +234,15 @@ def test_threads_share_a_model():
     with ThreadPoolExecutor(4) as pool:
         for got in pool.map(lambda _: b.f(wo, wi), range(8)):
             np.testing.assert_array_equal(got, expected)
+
+
+def test_docstring_examples():
+    import doctest
+
+    failures, tried = doctest.testmod(gonio, optionflags=doctest.NORMALIZE_WHITESPACE)
+    assert tried > 0 and failures == 0
+
+
+def test_spec_error_is_public():
+    assert gonio.SpecError.__module__ == "gonio"
+    assert issubclass(gonio.SpecError, ValueError)
