@@ -38,13 +38,13 @@ demo: build
 
 test: build
 	$(CARGO) test --release -p gonio -p gonio-cli
-	$(VPY) -m pytest -q crates/gonio-py/tests
+	$(VPY) -m pytest -q -rxX crates/gonio-py/tests
 
 test-rust:
 	$(CARGO) test --release -p gonio -p gonio-cli
 
 test-python:
-	$(VPY) -m pytest -q crates/gonio-py/tests
+	$(VPY) -m pytest -q -rxX crates/gonio-py/tests
 
 bench:
 	$(CARGO) bench -p gonio
