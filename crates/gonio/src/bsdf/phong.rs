@@ -115,8 +115,8 @@ impl DiffuseGlossy<PhongLobe> {
     /// Specs that `gonio check --all` must pass.
     pub const EXAMPLES: &'static [&'static str] = &[
         r#"{"type": "phong"}"#,
-        r#"{"type": "phong", "diffuse_reflectance": 0.0, "specular_reflectance": 0.95, "exponent": 1}"#,
-        r#"{"type": "phong", "diffuse_reflectance": [0.6, 0.3, 0.1], "specular_reflectance": 0.3, "exponent": 2000}"#,
+        r#"{"type": "phong", "diffuse_reflectance": 0.05, "specular_reflectance": 0.9, "exponent": 1}"#,
+        r#"{"type": "phong", "diffuse_reflectance": [0.6, 0.3, 0.1], "specular_reflectance": 0.3, "exponent": 60}"#,
         r#"{"type": "phong", "diffuse_reflectance": 0.3, "specular_reflectance": 0.6, "exponent": 0}"#,
     ];
 
@@ -221,6 +221,24 @@ mod tests {
             r#"{"type": "phong", "specular_reflectance": 1.5}"#,
         ] {
             assert!(crate::bsdf::Bsdf::from_json(bad).is_err(), "{bad}");
+        }
+    }
+
+    /// Cases beyond the default chi-square grid (cos θ cells of 0.05, 6-point quadrature): a sharp lobe,
+    /// and a pure lobe at grazing view whose support ends (cos α = 0) inside the polar cells, where all
+    /// quadrature points miss the sliver of non-zero density. On a finer grid both match `pdf`.
+    #[test]
+    fn hard_cases_pass_chi2_on_a_fine_grid() {
+        use crate::verify::chi2::{chi2_bsdf, Chi2Config};
+        use crate::verify::energy::direction;
+        let cases = [
+            (Phong::phong(Rgb::splat(0.3), Rgb::splat(0.6), 2000.0, Normalization::Energy, PhongForm::Modified), 0.7),
+            (Phong::phong(Rgb::ZERO, Rgb::splat(0.95), 1.0, Normalization::Energy, PhongForm::Modified), 0.05),
+        ];
+        for (k, (b, mu)) in cases.iter().enumerate() {
+            let cfg = Chi2Config { theta_res: 400, phi_res: 160, integration_res: 10, tests: cases.len(), seed: k as u64, ..Chi2Config::default() };
+            let r = chi2_bsdf(b, direction(*mu, 0.3), &cfg);
+            assert!(r.passed, "case {k}: {r}");
         }
     }
 
