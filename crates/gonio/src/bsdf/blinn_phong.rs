@@ -24,7 +24,8 @@
 //!
 //! Sampling mixes cosine-weighted hemisphere sampling (k_d) with half vectors drawn from D(h) cos θh,
 //! D = (e+2)/(2π) cosᵉθh, i.e. the power-cosine warp with exponent e+1, cos θh = u^(1/(e+2)), reflected
-//! about h with the Jacobian dωh/dωi = 1/(4 |ωo·h|) (Torrance & Sparrow 1967; pbrt-v4 eq. 9.28), in
+//! about h with the Jacobian dωh/dωi = 1/(4 |ωo·h|) (Torrance & Sparrow 1967, "Theory for Off-Specular
+//! Reflection from Roughened Surfaces", JOSA 57(9)), in
 //! proportion to the luminances of k_d and k_s (see [`glossy_mix`](super::glossy_mix)).
 //!
 //! ```
@@ -108,7 +109,10 @@ impl DiffuseGlossy<BlinnPhongLobe> {
 
     /// Specs that break physics on purpose, with the check row that must catch them.
     pub const VIOLATIONS: &'static [(&'static str, &'static str)] = &[
-        (r#"{"type": "blinn_phong", "diffuse_reflectance": 0.5, "specular_reflectance": 0.5, "exponent": 1, "normalization": "none"}"#, "albedo max"),
+        (
+            r#"{"type": "blinn_phong", "diffuse_reflectance": 0.5, "specular_reflectance": 0.5, "exponent": 1, "normalization": "none"}"#,
+            "albedo max",
+        ),
         (r#"{"type": "blinn_phong", "diffuse_reflectance": 0.0, "specular_reflectance": 1.0, "exponent": 8}"#, "albedo max"),
     ];
 

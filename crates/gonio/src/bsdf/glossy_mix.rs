@@ -62,10 +62,7 @@ pub(super) fn choice<T: Copy>(p: &Props, name: &'static str, options: &[(&str, T
     let Some(given) = p.string(name)? else { return Ok(default) };
     options.iter().find(|(n, _)| *n == given).map(|(_, v)| *v).ok_or_else(|| {
         let names: Vec<&str> = options.iter().map(|(n, _)| *n).collect();
-        Error::spec(
-            p.at(),
-            format!("parameter `{name}` of `{}` must be one of {}, got `{given}`", p.plugin_type(), names.join(" | ")),
-        )
+        Error::spec(p.at(), format!("parameter `{name}` of `{}` must be one of {}, got `{given}`", p.plugin_type(), names.join(" | ")))
     })
 }
 
@@ -140,7 +137,7 @@ impl<L: GlossyLobe> BsdfModel for DiffuseGlossy<L> {
         }
         // Either lobe may have produced wi: f and pdf are those of the whole mixture.
         let pdf = self.pdf(wo, wi);
-        if !(pdf > MIN_PDF) {
+        if pdf.is_nan() || pdf <= MIN_PDF {
             return None;
         }
         BsdfSample::smooth(wi, self.f(wo, wi), pdf, lobe, 1.0)
@@ -170,11 +167,7 @@ pub(super) mod testing {
             let theta = (i as f64 + 0.5) * dt;
             for j in 0..4 * steps {
                 let phi = (j as f64 + 0.5) * dp;
-                let w = crate::math::Vec3::new(
-                    (theta.sin() * phi.cos()) as f32,
-                    (theta.sin() * phi.sin()) as f32,
-                    theta.cos() as f32,
-                );
+                let w = crate::math::Vec3::new((theta.sin() * phi.cos()) as f32, (theta.sin() * phi.sin()) as f32, theta.cos() as f32);
                 sum += g(w) * theta.sin() * dt * dp;
             }
         }
@@ -201,11 +194,7 @@ pub(super) mod testing {
             "expected a `{kind}` violation:\n{}",
             report.to_table()
         );
-        assert!(
-            report.rows.iter().filter(|r| !related(&r.check)).all(|r| r.passed),
-            "only `{kind}` may fail:\n{}",
-            report.to_table()
-        );
+        assert!(report.rows.iter().filter(|r| !related(&r.check)).all(|r| r.passed), "only `{kind}` may fail:\n{}", report.to_table());
         report
     }
 }

@@ -4,8 +4,8 @@
 //!
 //! - qualitative model (eq. 30): f = ρ/π [A + B max(0, cos Δφ) sin α tan β],
 //!   A = 1 − 0.5 σ²/(σ² + 0.33), B = 0.45 σ²/(σ² + 0.09);
-//! - full model (eqs. 24–29, `full = true`): f = ρ/π [C₁ + cos Δφ C₂ tan β + (1 − |cos Δφ|) C₃ tan((α+β)/2)]
-//!   + 0.17 ρ²/π σ²/(σ² + 0.13) [1 − cos Δφ (2β/π)²], with C₁ = A, C₂ = B sin α when cos Δφ ≥ 0 and
+//! - full model (eqs. 24–29, `full = true`): f = ρ/π [C₁ + cos Δφ C₂ tan β + (1 − |cos Δφ|) C₃ tan((α+β)/2)] +
+//!   0.17 ρ²/π σ²/(σ² + 0.13) [1 − cos Δφ (2β/π)²], with C₁ = A, C₂ = B sin α when cos Δφ ≥ 0 and
 //!   B (sin α − (2β/π)³) otherwise, C₃ = 0.125 σ²/(σ² + 0.09) (4αβ/π²)²; the last term is the light
 //!   inter-reflected between facets (eq. 29).
 //!
@@ -79,7 +79,8 @@ impl Geometry {
         let sin_product = sin_o * sin_i;
         let cos_dphi = if sin_product > 0.0 { ((wo.x * wi.x + wo.y * wi.y) / sin_product).clamp(-1.0, 1.0) } else { 0.0 };
         // α is the angle of the direction nearer the horizon (the smaller cosine).
-        let ((cos_a, sin_a), (cos_b, sin_b)) = if cos_o < cos_i { ((cos_o, sin_o), (cos_i, sin_i)) } else { ((cos_i, sin_i), (cos_o, sin_o)) };
+        let ((cos_a, sin_a), (cos_b, sin_b)) =
+            if cos_o < cos_i { ((cos_o, sin_o), (cos_i, sin_i)) } else { ((cos_i, sin_i), (cos_o, sin_o)) };
         Geometry { alpha: cos_a.acos(), beta: cos_b.acos(), sin_alpha: sin_a, tan_beta: sin_b / cos_b.max(MIN_COS), cos_dphi }
     }
 }

@@ -12,7 +12,7 @@
 //! (Defaults as in Mitsuba 0.6's `phong` plugin.)
 //!
 //! # The forms and where they break physics
-//! - **Phong 1975** ("Illumination for Computer Generated Pictures", CACM 18(6), eq. on p. 314) wrote
+//! - **Phong 1975** ("Illumination for Computer Generated Pictures", CACM 18(6), 311–317) wrote
 //!   reflected *intensity* as k_s cosⁿα. Read as a BRDF that is f·cos θi = k_s cosⁿα, i.e.
 //!   `form = "original"`: S/cos θi. Not reciprocal, since f(ωo, ωi)/f(ωi, ωo) = cos θo/cos θi: measured
 //!   relative error 0.9994 (the largest possible is 1; at wo = (0.916, 0.402, 0.00007), a grazing pair),
@@ -26,7 +26,8 @@
 //!   The example `k_d = k_s = 0.5, n = 1` measures a maximal albedo of 1.53 at cos θo = 0.984 (1.547 at
 //!   normal incidence) and a white furnace of 1.27.
 //! - **Modified, normalised** (`energy`, the default): S = (n+2)/(2π) cosⁿα (Lewis 1994, "Making Shaders
-//!   More Physically Plausible", Computer Graphics Forum 13(2), eq. 6; Lafortune & Willems 1994, §3).
+//!   More Physically Plausible", Computer Graphics Forum 13(2), the normalised Phong lobe; Lafortune & Willems
+//!   1994, "Using the Modified Phong Reflectance Model for Physically Based Rendering", KU Leuven CW 197).
 //!   Reciprocal (r·ωi = 2 cos θo cos θi − ωo·ωi is symmetric) and the lobe's albedo is exactly 1 at normal
 //!   incidence (measured 1.0000 by quadrature) and smaller elsewhere, where part of the lobe falls below the
 //!   surface: energy is conserved whenever k_d + k_s ≤ 1.
@@ -87,7 +88,7 @@ impl GlossyLobe for PhongLobe {
         }
         let scale = match self.normalization {
             Normalization::None => 1.0,
-            // Lewis 1994, eq. 6: ∫ cosⁿα cos θ dω = 2π/(n+2) around the normal.
+            // Lewis 1994: ∫ cosⁿα cos θ dω = 2π/(n+2) when the lobe is centred on the normal.
             Normalization::Energy => (self.exponent + 2.0) / (2.0 * PI),
         };
         let s = scale * cos_alpha.min(1.0).powf(self.exponent);
@@ -122,8 +123,14 @@ impl DiffuseGlossy<PhongLobe> {
 
     /// Specs that break physics on purpose, with the check row that must catch them.
     pub const VIOLATIONS: &'static [(&'static str, &'static str)] = &[
-        (r#"{"type": "phong", "diffuse_reflectance": 0.5, "specular_reflectance": 0.5, "exponent": 1, "normalization": "none"}"#, "albedo max"),
-        (r#"{"type": "phong", "diffuse_reflectance": 0.2, "specular_reflectance": 0.6, "exponent": 20, "form": "original"}"#, "reciprocity"),
+        (
+            r#"{"type": "phong", "diffuse_reflectance": 0.5, "specular_reflectance": 0.5, "exponent": 1, "normalization": "none"}"#,
+            "albedo max",
+        ),
+        (
+            r#"{"type": "phong", "diffuse_reflectance": 0.2, "specular_reflectance": 0.6, "exponent": 20, "form": "original"}"#,
+            "reciprocity",
+        ),
     ];
 
     /// The Phong model with the given reflectances and lobe.
@@ -236,7 +243,14 @@ mod tests {
             (Phong::phong(Rgb::ZERO, Rgb::splat(0.95), 1.0, Normalization::Energy, PhongForm::Modified), 0.05),
         ];
         for (k, (b, mu)) in cases.iter().enumerate() {
-            let cfg = Chi2Config { theta_res: 400, phi_res: 160, integration_res: 10, tests: cases.len(), seed: k as u64, ..Chi2Config::default() };
+            let cfg = Chi2Config {
+                theta_res: 400,
+                phi_res: 160,
+                integration_res: 10,
+                tests: cases.len(),
+                seed: k as u64,
+                ..Chi2Config::default()
+            };
             let r = chi2_bsdf(b, direction(*mu, 0.3), &cfg);
             assert!(r.passed, "case {k}: {r}");
         }
