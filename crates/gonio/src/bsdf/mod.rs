@@ -25,9 +25,13 @@
 //! ```
 
 pub mod blend;
+pub mod blinn_phong;
 pub mod conductor;
 pub mod dielectric;
 pub mod diffuse;
+pub mod glossy_mix;
+pub mod oren_nayar;
+pub mod phong;
 pub mod sum;
 pub mod thin_dielectric;
 pub mod twosided;
@@ -38,9 +42,12 @@ use crate::props::Props;
 use crate::spectrum::Rgb;
 
 pub use blend::BlendBsdf;
+pub use blinn_phong::BlinnPhong;
 pub use conductor::Conductor;
 pub use dielectric::Dielectric;
 pub use diffuse::Diffuse;
+pub use oren_nayar::OrenNayar;
+pub use phong::Phong;
 pub use sum::Sum;
 pub use thin_dielectric::ThinDielectric;
 pub use twosided::TwoSided;
@@ -247,6 +254,9 @@ bsdf_models! {
     Blend(BlendBsdf) = "blendbsdf",
     Sum(Sum) = "sum",
     TwoSided(TwoSided) = "twosided",
+    Phong(Phong) = "phong",
+    BlinnPhong(BlinnPhong) = "blinn_phong",
+    OrenNayar(OrenNayar) = "oren_nayar",
 }
 
 impl Bsdf {
