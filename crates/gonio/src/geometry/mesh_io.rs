@@ -13,6 +13,9 @@
 //! `o`, `g`, `s`, `usemtl`, `mtllib`, `l`, `p` and unknown statements are ignored. Vertices are
 //! de-duplicated per unique (v, vt, vn) triple, so normals and texture coordinates become per-vertex.
 //! Normals (texture coordinates) are returned only if every face corner references one.
+//! Mitsuba 3's `obj` plugin flips the vertical texture coordinate by default (`flip_tex_coords = true`,
+//! v → 1 − v) and normalises normals; this loader does neither, so a scene loader that wants Mitsuba's
+//! behaviour calls [`MeshData::flip_tex_coords`].
 //!
 //! ## PLY
 //! `ascii 1.0`, `binary_little_endian 1.0`, `binary_big_endian 1.0`. From the `vertex` element: `x y z`,
@@ -60,6 +63,16 @@ pub struct MeshData {
 }
 
 impl MeshData {
+    /// Replaces every texture coordinate (u, v) by (u, 1 − v), the convention Mitsuba 3's `obj` plugin
+    /// applies by default (`flip_tex_coords`).
+    pub fn flip_tex_coords(&mut self) {
+        if let Some(uvs) = &mut self.uvs {
+            for uv in uvs {
+                uv.y = 1.0 - uv.y;
+            }
+        }
+    }
+
     /// Checks the invariants every loader promises: finite positions, attribute arrays as long as the
     /// position array, indices in range.
     fn validate(&self, path: &Path) -> Result<()> {
@@ -875,6 +888,9 @@ mod tests {
     fn obj_rectangle_and_cornell_box() {
         let rect = load_obj(&Path::new(MESHES).join("rectangle.obj")).unwrap();
         assert_eq!(rect.indices.len(), 2);
+        let mut flipped = rect.clone();
+        flipped.flip_tex_coords();
+        assert_eq!(flipped.uvs.as_ref().unwrap()[1], Vec2::new(0.0, 1.0));
         assert_eq!(rect.positions.len(), 4);
         assert!(rect.normals.is_none() && rect.uvs.is_some());
         let mut names: Vec<_> = std::fs::read_dir(Path::new(MESHES).join("cbox")).unwrap().map(|e| e.unwrap().path()).collect();

@@ -11,8 +11,23 @@ use ::exr::prelude::{ReadChannels as _, ReadLayers as _, WritableImage as _};
 use super::Image;
 use crate::error::{Error, Result};
 
+/// More pixels than this in one layer is taken as a hostile or corrupt header: refused before the
+/// decoder allocates for it (2²⁸ pixels = a 16384² image, 3 GiB as f32 RGB).
+const MAX_PIXELS: usize = 1 << 28;
+
 pub(super) fn decode(path: &Path, bytes: &[u8]) -> Result<Image> {
     let exr_err = |e: ::exr::error::Error| Error::format(path, "OpenEXR data", e.to_string());
+    let meta = ::exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), false).map_err(exr_err)?;
+    for header in meta.headers.iter() {
+        let size = header.layer_size;
+        if size.width().checked_mul(size.height()).map_or(true, |n| n > MAX_PIXELS) {
+            return Err(Error::format(
+                path,
+                "header",
+                format!("data window {}×{} exceeds the limit of {MAX_PIXELS} pixels", size.width(), size.height()),
+            ));
+        }
+    }
     let image = x::read()
         .no_deep_data()
         .largest_resolution_level()

@@ -2,7 +2,7 @@
 //!
 //! | format | read | write |
 //! |---|---|---|
-//! | OpenEXR (`.exr`) | first layer; R, G, B (A ignored) or a single Y channel; half, float or uint → `f32` | float32 RGB, linear, ZIP-free default compression of the `exr` crate |
+//! | OpenEXR (`.exr`) | first layer; R, G, B (A ignored) or a single Y channel; half, float or uint → `f32` | float32 RGB, linear, lossless RLE compression (the `exr` crate's default) |
 //! | Radiance (`.hdr`, `.rgbe`, `.pic`) | RGBE, run-length encoded or flat | — |
 //! | PNG (`.png`) | 8- or 16-bit, grey or colour, alpha ignored; sRGB-decoded to linear | 8-bit RGB, sRGB-encoded, clamped to [0, 1], rounded |
 //! | JPEG (`.jpg`, `.jpeg`) | 8-bit, grey or colour; sRGB-decoded to linear | — |
@@ -330,6 +330,17 @@ mod tests {
                 assert!(err.to_string().contains(file.to_str().unwrap()), "{err}");
             }
         }
+        // An EXR whose data window claims 10⁶ × 10⁶ pixels: refused before any allocation.
+        let exr = dir.join("huge.exr");
+        write_image(&exr, &test_pattern(3, 2)).unwrap();
+        let mut bytes = std::fs::read(&exr).unwrap();
+        let at = bytes.windows(11).position(|w| w == b"dataWindow\0").unwrap() + 11 + 6 + 4;
+        bytes[at + 8..at + 12].copy_from_slice(&1_000_000i32.to_le_bytes());
+        bytes[at + 12..at + 16].copy_from_slice(&1_000_000i32.to_le_bytes());
+        std::fs::write(&exr, &bytes).unwrap();
+        let err = read_image(&exr).unwrap_err().to_string();
+        assert!(err.contains("huge.exr"), "{err}");
+        println!("hostile EXR header: {err}");
         // A truncated PNG of our own.
         let png = dir.join("t.png");
         write_image(&png, &test_pattern(40, 40)).unwrap();
