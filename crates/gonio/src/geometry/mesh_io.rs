@@ -392,7 +392,7 @@ impl PlyBody<'_> {
             })
             .sum();
         let needed = element.count.checked_mul(min_record.max(1));
-        if needed.map_or(true, |n| n > self.remaining()) {
+        if !matches!(needed, Some(n) if n <= self.remaining()) {
             return Err(self.error(format!(
                 "element `{}` declares {} records, more than the {} bytes left can hold",
                 element.name,

@@ -20,7 +20,7 @@ pub(super) fn decode(path: &Path, bytes: &[u8]) -> Result<Image> {
     let meta = ::exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), false).map_err(exr_err)?;
     for header in meta.headers.iter() {
         let size = header.layer_size;
-        if size.width().checked_mul(size.height()).map_or(true, |n| n > MAX_PIXELS) {
+        if !matches!(size.width().checked_mul(size.height()), Some(n) if n <= MAX_PIXELS) {
             return Err(Error::format(
                 path,
                 "header",

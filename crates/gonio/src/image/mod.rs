@@ -285,6 +285,24 @@ mod tests {
     }
 
     #[test]
+    fn reads_jpeg_colour_and_grey() {
+        let dir = scratch_dir("jpeg");
+        // Flat images survive JPEG compression nearly exactly: sRGB 128 → linear 0.2158.
+        let colour = ::image::RgbImage::from_pixel(16, 8, ::image::Rgb([128, 128, 128]));
+        let path = dir.join("flat.JPG");
+        colour.save_with_format(&path, ::image::ImageFormat::Jpeg).unwrap();
+        let grey = ::image::GrayImage::from_pixel(8, 8, ::image::Luma([255]));
+        let gpath = dir.join("white.jpeg");
+        grey.save_with_format(&gpath, ::image::ImageFormat::Jpeg).unwrap();
+        let img = read_image(&path).unwrap();
+        assert_eq!((img.width, img.height), (16, 8));
+        let want = srgb_to_linear(128.0 / 255.0);
+        assert!(img.data.iter().all(|v| (v - want).abs() < 0.01), "{:?}", img.get(0, 0));
+        let white = read_image(&gpath).unwrap();
+        assert!(white.data.iter().all(|v| (v - 1.0).abs() < 0.01));
+    }
+
+    #[test]
     fn reads_flat_radiance_hdr() {
         // A 2×1 flat (not run-length encoded) RGBE file: (128,64,32, e=129) = (1, 0.5, 0.25);
         // (128,128,128, e=128+2) = (2, 2, 2). Value = m · 2^(e − 136) (Radiance's RGBE: (m + 0.5)·2^(e−136)
