@@ -18,6 +18,8 @@
 pub mod bsdf;
 pub mod error;
 pub mod fresnel;
+pub mod geometry;
+pub mod image;
 pub mod math;
 pub mod props;
 pub mod sampling;
