@@ -18,6 +18,7 @@
 pub mod bsdf;
 pub mod error;
 pub mod fresnel;
+pub mod microfacet;
 pub mod math;
 pub mod props;
 pub mod sampling;
