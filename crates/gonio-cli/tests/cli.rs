@@ -62,3 +62,24 @@ fn nan_parameters_are_rejected() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("`reflectance`"));
 }
+
+/// Every built-in model at default and extreme parameters, at the project's standard (10⁶ samples per
+/// chi-square test, 10⁶ sweep queries): the same run as `gonio check --all`.
+#[test]
+fn check_all_passes_at_the_full_standard() {
+    let out = gonio(&["check", "--all", "--json"]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("valid JSON");
+    let reports = v.as_array().unwrap();
+    let failed: Vec<_> = reports.iter().filter(|r| r["passed"] != true).map(|r| r.to_string()).collect();
+    assert!(failed.is_empty(), "{failed:#?}");
+    assert_eq!(out.status.code(), Some(0));
+    assert!(reports.len() >= 20);
+    for r in reports {
+        let checks = r["checks"].as_array().unwrap();
+        for kind in ["chi2", "reciprocity", "albedo max", "white furnace", "NaN/Inf sweep", "sample weight/pdf"] {
+            assert!(checks.iter().any(|c| c["check"].as_str().unwrap().starts_with(kind)), "{kind} missing in {}", r["name"]);
+        }
+        let reciprocity = checks.iter().find(|c| c["check"] == "reciprocity").unwrap();
+        assert!(reciprocity["measured"].as_f64().unwrap() < 1e-5);
+    }
+}

@@ -176,3 +176,163 @@ fn phi_fraction(w: Vec3) -> f32 {
         f
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sampling::Pcg32;
+    use crate::verify::chi2::{chi2_plane, chi2_warp, Chi2Config};
+
+    /// The cone apertures under test: wide, a hemisphere, beyond a hemisphere, and a narrow cap.
+    const CONES: [f32; 4] = [0.5, 0.0, -0.5, 0.999];
+
+    /// 32 × 32 grid points (cell centres) and 10 000 random points of [0, 1)².
+    fn square_points() -> Vec<Vec2> {
+        let mut rng = Pcg32::new(5, 7);
+        let grid = (0..32 * 32).map(|i| Vec2::new((i % 32) as f32 + 0.5, (i / 32) as f32 + 0.5) / 32.0);
+        grid.chain((0..10_000).map(|_| rng.next_vec2())).collect()
+    }
+
+    /// Distance between two `u` on the square where the second coordinate is an azimuth fraction: 0 and 1
+    /// are the same φ, so the seam φ = 0 is compared modulo 1.
+    fn azimuth_distance(a: Vec2, b: Vec2) -> f32 {
+        let dy = (a.y - b.y).abs();
+        (a.x - b.x).abs().max(dy.min(1.0 - dy))
+    }
+
+    /// Round trip of a direction warp of the (z, φ) kind. At the poles (sin θ < 10⁻³, a set of measure
+    /// zero up to f32 rounding) φ is not recoverable and only u₀ is compared.
+    fn round_trip_z_phi(sample: impl Fn(Vec2) -> Vec3, invert: impl Fn(Vec3) -> Vec2, name: &str) {
+        for u in square_points() {
+            let w = sample(u);
+            let back = invert(w);
+            let sin_theta = (w.x * w.x + w.y * w.y).sqrt();
+            let err = if sin_theta < 1e-3 { (u.x - back.x).abs() } else { azimuth_distance(u, back) };
+            assert!(err < 1e-4, "{name}: u = {u} → {w} → {back}");
+        }
+    }
+
+    #[test]
+    fn disk_round_trip() {
+        for u in square_points() {
+            let p = sample_uniform_disk_concentric(u);
+            assert!(p.length() <= 1.0 + 1e-6);
+            let back = invert_uniform_disk_concentric(p);
+            assert!((back - u).abs().max_element() < 1e-4, "u = {u} → {p} → {back}");
+        }
+        // The centre and the wedge diagonals.
+        for u in [Vec2::splat(0.5), Vec2::new(0.9, 0.9), Vec2::new(0.1, 0.9), Vec2::new(0.1, 0.1), Vec2::new(0.9, 0.1)] {
+            let back = invert_uniform_disk_concentric(sample_uniform_disk_concentric(u));
+            assert!((back - u).abs().max_element() < 1e-5, "u = {u} → {back}");
+        }
+    }
+
+    #[test]
+    fn cosine_hemisphere_round_trip() {
+        for u in square_points() {
+            let w = sample_cosine_hemisphere(u);
+            assert!((w.length() - 1.0).abs() < 1e-5 && w.z >= 0.0);
+            let back = invert_cosine_hemisphere_sample(w);
+            assert!((back - u).abs().max_element() < 1e-4, "u = {u} → {w} → {back}");
+        }
+    }
+
+    #[test]
+    fn uniform_hemisphere_and_sphere_round_trip() {
+        round_trip_z_phi(sample_uniform_hemisphere, invert_uniform_hemisphere_sample, "hemisphere");
+        round_trip_z_phi(sample_uniform_sphere, invert_uniform_sphere_sample, "sphere");
+    }
+
+    #[test]
+    fn cone_round_trip() {
+        for cos_theta_max in CONES {
+            round_trip_z_phi(|u| sample_uniform_cone(u, cos_theta_max), |w| invert_uniform_cone_sample(w, cos_theta_max), "cone");
+            for u in square_points() {
+                assert!(sample_uniform_cone(u, cos_theta_max).z >= cos_theta_max);
+            }
+        }
+    }
+
+    /// ∫ pdf dω by the midpoint rule on a fine (cos θ, φ) grid; dω = d(cos θ) dφ. The cos θ steps of
+    /// 2·10⁻⁵ put every cone's rim used here on a step boundary.
+    fn sphere_integral(pdf: impl Fn(Vec3) -> f32) -> f64 {
+        let (nz, nphi) = (100_000, 16);
+        let (dz, dphi) = (2.0 / nz as f64, std::f64::consts::TAU / nphi as f64);
+        let mut sum = 0.0;
+        for i in 0..nz {
+            let z = -1.0 + (i as f64 + 0.5) * dz;
+            let r = (1.0 - z * z).sqrt();
+            for j in 0..nphi {
+                let phi = (j as f64 + 0.5) * dphi;
+                sum += f64::from(pdf(Vec3::new((r * phi.cos()) as f32, (r * phi.sin()) as f32, z as f32)));
+            }
+        }
+        sum * dz * dphi
+    }
+
+    #[test]
+    fn pdfs_integrate_to_one() {
+        let n = 2000;
+        let h = 2.0 / n as f64;
+        let disk: f64 = (0..n * n)
+            .map(|k| {
+                let p = Vec2::new((-1.0 + ((k % n) as f64 + 0.5) * h) as f32, (-1.0 + ((k / n) as f64 + 0.5) * h) as f32);
+                f64::from(uniform_disk_pdf(p))
+            })
+            .sum::<f64>()
+            * h
+            * h;
+        assert!((disk - 1.0).abs() < 1e-3, "disk: {disk}");
+        for (name, integral) in [
+            ("cosine hemisphere", sphere_integral(cosine_hemisphere_pdf)),
+            ("uniform hemisphere", sphere_integral(uniform_hemisphere_pdf)),
+            ("uniform sphere", sphere_integral(uniform_sphere_pdf)),
+        ] {
+            assert!((integral - 1.0).abs() < 1e-4, "{name}: {integral}");
+        }
+        for c in CONES {
+            let integral = sphere_integral(|w| uniform_cone_pdf(w, c));
+            assert!((integral - 1.0).abs() < 1e-3, "cone {c}: {integral}");
+        }
+    }
+
+    #[test]
+    fn disk_chi2() {
+        // The rim cuts grid cells, where the pdf jumps: many quadrature points per cell keep the
+        // expected counts accurate there.
+        let cfg = Chi2Config { integration_res: 24, ..Chi2Config::default() };
+        let r = chi2_plane(sample_uniform_disk_concentric, |p| f64::from(uniform_disk_pdf(p)), Vec2::NEG_ONE, Vec2::ONE, (50, 50), &cfg);
+        eprintln!("disk: {r}");
+        assert!(r.passed, "{r}");
+        // The naive polar map r = u₀ crowds the centre: the same test must catch it.
+        let naive = |u: Vec2| u.x * Vec2::new((2.0 * PI * u.y).cos(), (2.0 * PI * u.y).sin());
+        let r = chi2_plane(naive, |p| f64::from(uniform_disk_pdf(p)), Vec2::NEG_ONE, Vec2::ONE, (50, 50), &cfg);
+        assert!(!r.passed, "{r}");
+    }
+
+    #[test]
+    fn direction_warps_chi2() {
+        let cfg = Chi2Config { tests: 3, ..Chi2Config::default() };
+        for (name, r) in [
+            ("cosine hemisphere", chi2_warp(sample_cosine_hemisphere, |w| f64::from(cosine_hemisphere_pdf(w)), &cfg)),
+            ("uniform hemisphere", chi2_warp(sample_uniform_hemisphere, |w| f64::from(uniform_hemisphere_pdf(w)), &cfg)),
+            ("uniform sphere", chi2_warp(sample_uniform_sphere, |w| f64::from(uniform_sphere_pdf(w)), &cfg)),
+        ] {
+            eprintln!("{name}: {r}");
+            assert!(r.passed, "{name}: {r}");
+        }
+    }
+
+    #[test]
+    fn cone_chi2() {
+        for (k, c) in CONES.into_iter().enumerate() {
+            // The rim must be a cell edge: 40 rows of cos θ put 0.5, 0 and −0.5 on edges; the narrow cap
+            // needs rows of 10⁻⁴ (ten rows inside it).
+            let theta_res = if c == 0.999 { 20_000 } else { 40 };
+            let cfg = Chi2Config { theta_res, phi_res: 40, tests: CONES.len(), seed: k as u64, ..Chi2Config::default() };
+            let r = chi2_warp(|u| sample_uniform_cone(u, c), |w| f64::from(uniform_cone_pdf(w, c)), &cfg);
+            eprintln!("cone {c}: {r}");
+            assert!(r.passed, "cone {c}: {r}");
+        }
+    }
+}

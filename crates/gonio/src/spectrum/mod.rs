@@ -1,5 +1,6 @@
 //! Colour: linear RGB now ([`Rgb`]), named optical constants of metals and dielectrics ([`named`]).
 
+pub mod cie;
 pub mod named;
 pub mod rgb;
 

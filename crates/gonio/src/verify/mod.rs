@@ -16,6 +16,7 @@
 //! assert!(report.passed(), "{}", report.to_table());
 //! ```
 
+pub mod chi2;
 pub mod consistency;
 pub mod energy;
 pub mod reciprocity;
@@ -149,6 +150,13 @@ impl Report {
     }
 }
 
+/// A file-name-safe version of a report name (a JSON spec, a path).
+fn file_stem(name: &str) -> String {
+    let stem: String = name.chars().map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '_' { c } else { '_' }).collect();
+    let stem = stem.split('_').filter(|p| !p.is_empty()).collect::<Vec<_>>().join("_");
+    stem.chars().take(80).collect()
+}
+
 fn format_value(v: f64) -> String {
     if v == 0.0 {
         "0".into()
@@ -192,6 +200,36 @@ pub fn check<M: BsdfModel + Sync + ?Sized>(bsdf: &M, cfg: &CheckConfig) -> Repor
 pub fn check_named<M: BsdfModel + Sync + ?Sized>(bsdf: &M, name: &str, cfg: &CheckConfig) -> Report {
     let mut rows = Vec::new();
     let dirs = test_directions(bsdf);
+
+    // Chi-square of sample() against pdf() at every test direction, one Šidák family.
+    let chi2_cfg = chi2::Chi2Config {
+        samples: cfg.chi2_samples,
+        significance: cfg.significance,
+        tests: cfg.sidak_family.unwrap_or(dirs.len()).max(1),
+        seed: cfg.seed,
+        ..chi2::Chi2Config::default()
+    };
+    for (k, &wo) in dirs.iter().enumerate() {
+        let r = chi2::chi2_bsdf(bsdf, wo, &chi2_cfg);
+        let mut detail = r.message.clone();
+        if !r.passed {
+            if let Some(dir) = &cfg.histogram_dir {
+                let file = dir.join(format!("chi2-{}-{k}.txt", file_stem(name)));
+                let written = std::fs::create_dir_all(dir).and_then(|()| r.write_histograms(&file));
+                detail += &match written {
+                    Ok(()) => format!("; histograms in {}", file.display()),
+                    Err(e) => format!("; could not write histograms to {}: {e}", file.display()),
+                };
+            }
+        }
+        rows.push(CheckRow {
+            check: format!("chi2 cosθo={:+.2}", wo.z),
+            measured: r.p_value,
+            limit: format!("p > {:.2e}", r.alpha),
+            passed: r.passed,
+            detail,
+        });
+    }
 
     // Consistency of sample() with f() and pdf().
     let c = consistency::consistency(bsdf, &dirs, cfg.consistency_samples, cfg.seed);
@@ -249,4 +287,100 @@ pub fn check_named<M: BsdfModel + Sync + ?Sized>(bsdf: &M, name: &str, cfg: &Che
     });
 
     Report { name: name.to_string(), rows }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bsdf::BsdfSample;
+    use crate::sampling::warp::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
+    use crate::Rgb;
+
+    /// A deliberately broken model: f = gain/π with a cosine sampler, and optionally a pdf that lies.
+    struct Broken {
+        gain: f32,
+        skew: bool,
+        pdf_scale: f32,
+    }
+
+    impl BsdfModel for Broken {
+        fn flags(&self) -> BsdfFlags {
+            BsdfFlags::DIFFUSE_REFLECTION
+        }
+        fn f(&self, wo: Vec3, wi: Vec3) -> Rgb {
+            if wo.z <= 0.0 || wi.z <= 0.0 {
+                return Rgb::ZERO;
+            }
+            let skew = if self.skew { 0.5 + wi.z } else { 1.0 };
+            Rgb::splat(self.gain * skew * std::f32::consts::FRAC_1_PI)
+        }
+        fn sample(&self, wo: Vec3, _uc: f32, u: Vec2) -> Option<BsdfSample> {
+            if wo.z <= 0.0 {
+                return None;
+            }
+            let wi = sample_cosine_hemisphere(u);
+            BsdfSample::smooth(wi, self.f(wo, wi), self.pdf(wo, wi), BsdfFlags::DIFFUSE_REFLECTION, 1.0)
+        }
+        fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+            if wo.z <= 0.0 {
+                return 0.0;
+            }
+            // pdf_scale ≠ 1 makes pdf() disagree with the density sample() actually has.
+            let p = cosine_hemisphere_pdf(wi);
+            if self.pdf_scale == 1.0 {
+                p
+            } else {
+                p * (self.pdf_scale * wi.z + (1.0 - self.pdf_scale) * 0.5) * 2.0
+            }
+        }
+    }
+
+    fn failed_rows(report: &Report) -> Vec<String> {
+        report.rows.iter().filter(|r| !r.passed).map(|r| r.check.clone()).collect()
+    }
+
+    #[test]
+    fn an_honest_model_passes_everything() {
+        let r = check(&Broken { gain: 0.9, skew: false, pdf_scale: 1.0 }, &CheckConfig::quick());
+        assert!(r.passed(), "{}", r.to_table());
+    }
+
+    #[test]
+    fn energy_gain_is_detected() {
+        let r = check(&Broken { gain: 1.2, skew: false, pdf_scale: 1.0 }, &CheckConfig::quick());
+        assert_eq!(failed_rows(&r), ["albedo max (above)", "white furnace (above)"], "{}", r.to_table());
+        assert!((r.rows.iter().find(|x| x.check.starts_with("albedo")).unwrap().measured - 1.2).abs() < 1e-3);
+    }
+
+    #[test]
+    fn non_reciprocity_is_detected() {
+        let r = check(&Broken { gain: 0.5, skew: true, pdf_scale: 1.0 }, &CheckConfig::quick());
+        assert_eq!(failed_rows(&r), ["reciprocity"], "{}", r.to_table());
+    }
+
+    #[test]
+    fn a_lying_pdf_fails_chi2_and_writes_histograms() {
+        let dir = std::env::temp_dir().join(format!("gonio-verify-test-{}", std::process::id()));
+        let cfg = CheckConfig { histogram_dir: Some(dir.clone()), ..CheckConfig::quick() };
+        let r = check_named(&Broken { gain: 0.5, skew: false, pdf_scale: 0.7 }, "lying pdf", &cfg);
+        let failed = failed_rows(&r);
+        // sample() reports the lying pdf consistently, so only the chi-square test can see the lie.
+        assert!(!failed.is_empty() && failed.iter().all(|c| c.starts_with("chi2")), "{}", r.to_table());
+        let files: Vec<_> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().path()).collect();
+        assert!(!files.is_empty());
+        let text = std::fs::read_to_string(&files[0]).unwrap();
+        let numeric_rows = text.lines().filter(|l| !l.starts_with('#') && !l.trim().is_empty()).count();
+        assert_eq!(numeric_rows, 2 * chi2::Chi2Config::default().theta_res, "observed and expected matrices");
+        std::fs::remove_dir_all(dir).unwrap();
+    }
+
+    #[test]
+    fn report_renders_as_table_and_json() {
+        let r = check(&Broken { gain: 1.2, skew: false, pdf_scale: 1.0 }, &CheckConfig::quick());
+        let table = r.to_table();
+        assert!(table.contains("FAIL") && table.contains("pass"));
+        let json = r.to_json();
+        assert_eq!(json["passed"], false);
+        assert_eq!(json["checks"].as_array().unwrap().len(), r.rows.len());
+    }
 }
