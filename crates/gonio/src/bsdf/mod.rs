@@ -28,8 +28,10 @@ pub mod blend;
 pub mod conductor;
 pub mod dielectric;
 pub mod diffuse;
+pub mod rough_conductor;
 pub mod sum;
 pub mod thin_dielectric;
+pub mod torrance_sparrow;
 pub mod twosided;
 
 use crate::error::{Error, Result};
@@ -41,8 +43,10 @@ pub use blend::BlendBsdf;
 pub use conductor::Conductor;
 pub use dielectric::Dielectric;
 pub use diffuse::Diffuse;
+pub use rough_conductor::{MicrofacetConductor, RoughConductor};
 pub use sum::Sum;
 pub use thin_dielectric::ThinDielectric;
+pub use torrance_sparrow::TorranceSparrow;
 pub use twosided::TwoSided;
 
 /// What kind of scattering a model (or one sampled lobe) does. A small bit set.
@@ -242,6 +246,8 @@ macro_rules! bsdf_models {
 bsdf_models! {
     Diffuse(Diffuse) = "diffuse",
     Conductor(Conductor) = "conductor",
+    RoughConductor(RoughConductor) = "roughconductor",
+    TorranceSparrow(TorranceSparrow) = "torrance_sparrow",
     Dielectric(Dielectric) = "dielectric",
     ThinDielectric(ThinDielectric) = "thindielectric",
     Blend(BlendBsdf) = "blendbsdf",
