@@ -64,7 +64,9 @@ impl Conductor {
         let k = p.rgb_in("k", Rgb::ZERO, 0.0, f32::MAX)?;
         let specular_reflectance = p.reflectance("specular_reflectance", Rgb::ONE)?;
         let eta_k = match (material, has_index) {
-            (Some(_), true) => return Err(Error::spec(p.at(), format!("give either `material` or `eta`/`k` to `{}`, not both", p.plugin_type()))),
+            (Some(_), true) => {
+                return Err(Error::spec(p.at(), format!("give either `material` or `eta`/`k` to `{}`, not both", p.plugin_type())))
+            }
             (None, true) => {
                 if (0..3).any(|c| eta.0[c] + k.0[c] <= 0.0) {
                     return Err(Error::spec(p.at(), format!("`{}` needs eta + k > 0 in every channel", p.plugin_type())));

@@ -14,7 +14,8 @@
 //! f(ωo, ωi) = F(ωo·ωh) D(ωh) G1(ωo, ωh) G1(ωi, ωh) / (4 cos θo cos θi), ωh = (ωo + ωi)/|ωo + ωi|
 //! (Walter 2007 eq. 20 with the separable Smith G of eq. 23 — what Mitsuba 3 uses). Λ is exact for both
 //! distributions (gonio uses the erf form for Beckmann where Mitsuba uses Walter's rational approximation,
-//! eq. 27: they differ by up to 0.35 % in G1). One-sided: light from below is absorbed. The `material`,
+//! eq. 27: compared with Mitsuba 3 they differ by up to 0.6 % in f and 0.3 % in the visible-normal pdf,
+//! and agree to 1e-5 once that approximation is undone). One-sided: light from below is absorbed. The `material`,
 //! `eta`, `k` and `specular_reflectance` parameters are those of [`Conductor`].
 //!
 //! Sampling draws ωh from [`MicrofacetDistribution::sample_wm`] and reflects ωo about it;
@@ -90,7 +91,10 @@ impl MicrofacetConductor {
         };
         let (alpha_x, alpha_y) = read_roughness(p, rules)?;
         if kind == MicrofacetKind::Blinn && alpha_x != alpha_y {
-            return Err(Error::spec(p.at(), format!("`{plugin}`: `alpha_u` ≠ `alpha_v` needs distribution beckmann or ggx (Blinn is isotropic)")));
+            return Err(Error::spec(
+                p.at(),
+                format!("`{plugin}`: `alpha_u` ≠ `alpha_v` needs distribution beckmann or ggx (Blinn is isotropic)"),
+            ));
         }
         // Read `shadowing` only where it is a parameter, so that `finish` rejects it elsewhere.
         let shadowing = match rules.shadowing {
@@ -154,7 +158,7 @@ impl MicrofacetConductor {
         }
         let wm = self.distribution.sample_wm(wo, u, self.sample_visible);
         let wi = reflect(wo, wm).normalize();
-        if !(wi.z > 0.0) {
+        if wi.z.is_nan() || wi.z <= 0.0 {
             return None;
         }
         let s = BsdfSample::smooth(wi, self.eval(wo, wi), self.pdf_lobe(wo, wi), BsdfFlags::GLOSSY_REFLECTION, 1.0)?;
