@@ -21,6 +21,7 @@ pub mod fresnel;
 pub mod geometry;
 pub mod image;
 pub mod math;
+pub mod microfacet;
 pub mod props;
 pub mod sampling;
 pub mod spectrum;

@@ -32,8 +32,10 @@ pub mod diffuse;
 pub mod glossy_mix;
 pub mod oren_nayar;
 pub mod phong;
+pub mod rough_conductor;
 pub mod sum;
 pub mod thin_dielectric;
+pub mod torrance_sparrow;
 pub mod twosided;
 
 use crate::error::{Error, Result};
@@ -48,8 +50,10 @@ pub use dielectric::Dielectric;
 pub use diffuse::Diffuse;
 pub use oren_nayar::OrenNayar;
 pub use phong::Phong;
+pub use rough_conductor::{MicrofacetConductor, RoughConductor};
 pub use sum::Sum;
 pub use thin_dielectric::ThinDielectric;
+pub use torrance_sparrow::TorranceSparrow;
 pub use twosided::TwoSided;
 
 /// What kind of scattering a model (or one sampled lobe) does. A small bit set.
@@ -249,6 +253,8 @@ macro_rules! bsdf_models {
 bsdf_models! {
     Diffuse(Diffuse) = "diffuse",
     Conductor(Conductor) = "conductor",
+    RoughConductor(RoughConductor) = "roughconductor",
+    TorranceSparrow(TorranceSparrow) = "torrance_sparrow",
     Dielectric(Dielectric) = "dielectric",
     ThinDielectric(ThinDielectric) = "thindielectric",
     Blend(BlendBsdf) = "blendbsdf",
