@@ -19,11 +19,26 @@ pub enum Error {
         #[source]
         source: std::io::Error,
     },
+    /// A data file (image, mesh) that could be read but is malformed: truncated, an unsupported variant,
+    /// a count larger than the file, an index out of range. `at` says where in the file: "line 12" for
+    /// text, "byte 1234" for binary, or a record such as "face 17".
+    #[error("{}: {at}: {message}", path.display())]
+    Format { path: PathBuf, at: String, message: String },
 }
 
 impl Error {
     pub(crate) fn spec(at: impl Into<String>, message: impl Into<String>) -> Self {
         Error::Spec { at: at.into(), message: message.into() }
+    }
+}
+
+impl Error {
+    pub(crate) fn format(path: &std::path::Path, at: impl Into<String>, message: impl Into<String>) -> Self {
+        Error::Format { path: path.to_path_buf(), at: at.into(), message: message.into() }
+    }
+
+    pub(crate) fn io(path: &std::path::Path, source: std::io::Error) -> Self {
+        Error::Io { path: path.to_path_buf(), source }
     }
 }
 

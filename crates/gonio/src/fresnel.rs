@@ -34,14 +34,21 @@ pub struct Refraction {
 #[must_use]
 pub fn refract(wi: Vec3, eta: f32) -> Option<Refraction> {
     let (eta, n, cos_i) = if wi.z < 0.0 { (1.0 / eta, -Vec3::Z, -wi.z) } else { (eta, Vec3::Z, wi.z) };
-    let sin2_i = (1.0 - cos_i * cos_i).max(0.0);
-    let sin2_t = sin2_i / (eta * eta);
-    if sin2_t >= 1.0 {
+    let cos2_t = cos2_transmitted(cos_i, eta);
+    if cos2_t <= 0.0 {
         return None;
     }
-    let cos_t = (1.0 - sin2_t).sqrt();
+    let cos_t = cos2_t.sqrt();
     let wt = -wi / eta + (cos_i / eta - cos_t) * n;
     Some(Refraction { wt, eta })
+}
+
+/// cos²θₜ = 1 − (1 − cos²θᵢ)/η² written as (cos²θᵢ + η² − 1)/η², which keeps its precision when η ≈ 1
+/// and θᵢ is grazing (2026-11: the first form rounded to total internal reflection at η = 1 for
+/// |cos θᵢ| < 1.7e-4, found by the Mitsuba cross-check). ≤ 0 means total internal reflection.
+#[inline]
+fn cos2_transmitted(cos_i: f32, eta: f32) -> f32 {
+    cos_i.mul_add(cos_i, eta.mul_add(eta, -1.0)) / (eta * eta)
 }
 
 /// Fresnel reflectances (Rₛ, Rₚ) of s- and p-polarised light at a dielectric interface.
@@ -51,11 +58,15 @@ pub fn refract(wi: Vec3, eta: f32) -> Option<Refraction> {
 pub fn fresnel_dielectric_sp(cos_theta_i: f32, eta: f32) -> (f32, f32) {
     let (eta, cos_i) = if cos_theta_i < 0.0 { (1.0 / eta, -cos_theta_i) } else { (eta, cos_theta_i) };
     let cos_i = cos_i.min(1.0);
-    let sin2_t = (1.0 - cos_i * cos_i) / (eta * eta);
-    if sin2_t >= 1.0 {
+    if eta == 1.0 {
+        // No interface at all: nothing is reflected, even at grazing incidence.
+        return (0.0, 0.0);
+    }
+    let cos2_t = cos2_transmitted(cos_i, eta);
+    if cos2_t <= 0.0 {
         return (1.0, 1.0);
     }
-    let cos_t = (1.0 - sin2_t).max(0.0).sqrt();
+    let cos_t = cos2_t.sqrt();
     // Born & Wolf eq. 1.5.21 with n₁ = 1, n₂ = η.
     let rs = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
     let rp = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
@@ -97,15 +108,20 @@ impl Complex {
         let d = o.norm();
         Complex::new((self.re * o.re + self.im * o.im) / d, (self.im * o.re - self.re * o.im) / d)
     }
-    /// Principal square root.
+    /// Principal square root, free of cancellation: the larger part comes from sqrt((|z| + |re|)/2) and
+    /// the smaller from im / (2·larger). (2026-11: the textbook sqrt((|z| − re)/2) lost ~5 digits when
+    /// |im| ≪ re, found by the Mitsuba cross-check on silver.)
     fn sqrt(self) -> Complex {
         let r = self.norm().sqrt();
         if r == 0.0 {
             return Complex::new(0.0, 0.0);
         }
-        let re = (0.5 * (r + self.re)).max(0.0).sqrt();
-        let im = (0.5 * (r - self.re)).max(0.0).sqrt();
-        Complex::new(re, if self.im < 0.0 { -im } else { im })
+        let big = (0.5 * (r + self.re.abs())).sqrt();
+        if self.re >= 0.0 {
+            Complex::new(big, self.im / (2.0 * big))
+        } else {
+            Complex::new(self.im.abs() / (2.0 * big), big.copysign(self.im))
+        }
     }
 }
 
@@ -216,6 +232,38 @@ mod tests {
         assert!((f - 0.918_411).abs() < 1e-5, "F = {f}");
         // Grazing incidence reflects everything.
         assert!((fresnel_conductor(0.0, 0.2, 3.0) - 1.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn conductor_is_accurate_when_k_is_small_against_eta() {
+        // η = 40, k = 100 and silver-like η = 0.155, k = 4.83 at 70°: compare with an f64 evaluation.
+        fn exact(c: f64, eta: f64, k: f64) -> f64 {
+            // |rs|², |rp|² via the closed form of Born & Wolf for an absorbing medium (a², b² terms).
+            let s2 = 1.0 - c * c;
+            let t = eta * eta - k * k - s2;
+            let a2b2 = (t * t + 4.0 * eta * eta * k * k).sqrt();
+            let a = (0.5 * (a2b2 + t)).max(0.0).sqrt();
+            let rs = (a2b2 + c * c - 2.0 * a * c) / (a2b2 + c * c + 2.0 * a * c);
+            let rp = rs * (a2b2 * c * c + s2 * s2 - 2.0 * a * c * s2) / (a2b2 * c * c + s2 * s2 + 2.0 * a * c * s2);
+            0.5 * (rs + rp)
+        }
+        for (eta, k) in [(40.0f32, 100.0f32), (0.155, 4.83), (1.5, 1e-3), (0.2, 3.0)] {
+            for c in [1.0f32, 0.7, 0.34, 0.05] {
+                let got = fresnel_conductor(c, eta, k) as f64;
+                let want = exact(c as f64, eta as f64, k as f64);
+                assert!(((got - want) / want).abs() < 2e-6, "η={eta} k={k} cos={c}: {got} vs {want}");
+            }
+        }
+    }
+
+    #[test]
+    fn equal_indices_transmit_everything_even_at_grazing() {
+        for c in [1.0f32, 1e-3, 1.7e-4, 6.79e-5, -6.79e-5, -1e-6] {
+            assert_eq!(fresnel_dielectric(c, 1.0), 0.0);
+            let w = Vec3::new((1.0 - c * c).sqrt(), 0.0, c);
+            let r = refract(w, 1.0).expect("no total internal reflection at η = 1");
+            assert!((r.wt + w).length() < 1e-6);
+        }
     }
 
     #[test]

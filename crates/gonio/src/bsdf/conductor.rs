@@ -55,6 +55,8 @@ impl Conductor {
         Conductor { eta_k: None, specular_reflectance: Rgb::ONE }
     }
 
+    /// Read `material` or `eta`/`k`, and `specular_reflectance`. Rough conductors read their Fresnel term
+    /// through this too, so the parameters mean the same in every conductor plugin.
     pub fn from_props(p: &Props) -> Result<Self> {
         let material = p.string("material")?;
         let has_index = p.has("eta") || p.has("k");
@@ -62,10 +64,12 @@ impl Conductor {
         let k = p.rgb_in("k", Rgb::ZERO, 0.0, f32::MAX)?;
         let specular_reflectance = p.reflectance("specular_reflectance", Rgb::ONE)?;
         let eta_k = match (material, has_index) {
-            (Some(_), true) => return Err(Error::spec(p.at(), "give either `material` or `eta`/`k` to `conductor`, not both")),
+            (Some(_), true) => {
+                return Err(Error::spec(p.at(), format!("give either `material` or `eta`/`k` to `{}`, not both", p.plugin_type())))
+            }
             (None, true) => {
                 if (0..3).any(|c| eta.0[c] + k.0[c] <= 0.0) {
-                    return Err(Error::spec(p.at(), "`conductor` needs eta + k > 0 in every channel"));
+                    return Err(Error::spec(p.at(), format!("`{}` needs eta + k > 0 in every channel", p.plugin_type())));
                 }
                 Some((eta, k))
             }

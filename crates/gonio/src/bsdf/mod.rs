@@ -25,11 +25,17 @@
 //! ```
 
 pub mod blend;
+pub mod blinn_phong;
 pub mod conductor;
 pub mod dielectric;
 pub mod diffuse;
+pub mod glossy_mix;
+pub mod oren_nayar;
+pub mod phong;
+pub mod rough_conductor;
 pub mod sum;
 pub mod thin_dielectric;
+pub mod torrance_sparrow;
 pub mod twosided;
 
 use crate::error::{Error, Result};
@@ -38,11 +44,16 @@ use crate::props::Props;
 use crate::spectrum::Rgb;
 
 pub use blend::BlendBsdf;
+pub use blinn_phong::BlinnPhong;
 pub use conductor::Conductor;
 pub use dielectric::Dielectric;
 pub use diffuse::Diffuse;
+pub use oren_nayar::OrenNayar;
+pub use phong::Phong;
+pub use rough_conductor::{MicrofacetConductor, RoughConductor};
 pub use sum::Sum;
 pub use thin_dielectric::ThinDielectric;
+pub use torrance_sparrow::TorranceSparrow;
 pub use twosided::TwoSided;
 
 /// What kind of scattering a model (or one sampled lobe) does. A small bit set.
@@ -242,11 +253,16 @@ macro_rules! bsdf_models {
 bsdf_models! {
     Diffuse(Diffuse) = "diffuse",
     Conductor(Conductor) = "conductor",
+    RoughConductor(RoughConductor) = "roughconductor",
+    TorranceSparrow(TorranceSparrow) = "torrance_sparrow",
     Dielectric(Dielectric) = "dielectric",
     ThinDielectric(ThinDielectric) = "thindielectric",
     Blend(BlendBsdf) = "blendbsdf",
     Sum(Sum) = "sum",
     TwoSided(TwoSided) = "twosided",
+    Phong(Phong) = "phong",
+    BlinnPhong(BlinnPhong) = "blinn_phong",
+    OrenNayar(OrenNayar) = "oren_nayar",
 }
 
 impl Bsdf {

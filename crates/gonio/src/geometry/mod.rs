@@ -1,5 +1,5 @@
 //! Geometry: rays, bounding boxes, the shapes of Mitsuba's scene format (sphere, rectangle, cube, disk,
-//! triangle meshes), surface interactions and the bounding volume hierarchy over all primitives.
+//! triangle meshes, and the mesh file loaders in [`mesh_io`]), surface interactions and the bounding volume hierarchy over all primitives.
 
 pub mod bounds;
 pub mod builtin_meshes;
@@ -7,6 +7,7 @@ pub mod bvh;
 pub mod disk;
 pub mod interaction;
 pub mod mesh;
+pub mod mesh_io;
 pub mod ray;
 pub mod shape;
 pub mod sphere;

@@ -187,3 +187,47 @@ mod tests {
         assert_eq!(a.max_component(), 3.0);
     }
 }
+
+/// The sRGB transfer function (IEC 61966-2-1), encoded value in [0, 1] → linear value. The piecewise curve:
+/// `v / 12.92` for `v ≤ 0.04045`, else `((v + 0.055) / 1.055)^2.4`. Values outside [0, 1] follow the same
+/// formula (negative inputs stay on the linear segment).
+#[inline]
+#[must_use]
+pub fn srgb_to_linear(v: f32) -> f32 {
+    if v <= 0.040_45 {
+        v / 12.92
+    } else {
+        ((v + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// The inverse of [`srgb_to_linear`] (IEC 61966-2-1): `12.92 v` for `v ≤ 0.0031308`, else
+/// `1.055 v^(1/2.4) − 0.055`. No clamping: callers that quantise clamp first.
+#[inline]
+#[must_use]
+pub fn linear_to_srgb(v: f32) -> f32 {
+    if v <= 0.003_130_8 {
+        12.92 * v
+    } else {
+        1.055 * v.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+#[cfg(test)]
+mod srgb_tests {
+    use super::*;
+
+    #[test]
+    fn srgb_curve_round_trips_and_hits_known_points() {
+        for i in 0..=1000 {
+            let v = i as f32 / 1000.0;
+            assert!((linear_to_srgb(srgb_to_linear(v)) - v).abs() < 1e-5, "{v}");
+        }
+        assert_eq!(srgb_to_linear(0.0), 0.0);
+        assert!((srgb_to_linear(1.0) - 1.0).abs() < 1e-6);
+        // 50 % grey in sRGB is about 21.4 % linear.
+        assert!((srgb_to_linear(0.5) - 0.214_041).abs() < 1e-5);
+        // The two pieces meet (continuity at the breakpoint).
+        assert!((srgb_to_linear(0.040_45) - ((0.040_45f32 + 0.055) / 1.055).powf(2.4)).abs() < 1e-6);
+    }
+}

@@ -1,0 +1,90 @@
+//! OpenEXR through the pure-Rust `exr` crate: the first valid layer, largest resolution level, any flat
+//! channels. Channel names match on their last `.`-separated part, so `R` and `diffuse.R` both count; R, G
+//! and B make colour, a lone Y (luminance) is copied to all three, alpha and any other channel are ignored.
+
+use std::io::Cursor;
+use std::path::Path;
+
+use ::exr::prelude as x;
+use ::exr::prelude::{ReadChannels as _, ReadLayers as _, WritableImage as _};
+
+use super::Image;
+use crate::error::{Error, Result};
+
+/// More pixels than this in one layer is taken as a hostile or corrupt header: refused before the
+/// decoder allocates for it (2²⁸ pixels = a 16384² image, 3 GiB as f32 RGB).
+const MAX_PIXELS: usize = 1 << 28;
+
+pub(super) fn decode(path: &Path, bytes: &[u8]) -> Result<Image> {
+    let exr_err = |e: ::exr::error::Error| Error::format(path, "OpenEXR data", e.to_string());
+    let meta = ::exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), false).map_err(exr_err)?;
+    for header in meta.headers.iter() {
+        let size = header.layer_size;
+        if !matches!(size.width().checked_mul(size.height()), Some(n) if n <= MAX_PIXELS) {
+            return Err(Error::format(
+                path,
+                "header",
+                format!("data window {}×{} exceeds the limit of {MAX_PIXELS} pixels", size.width(), size.height()),
+            ));
+        }
+    }
+    let image = x::read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .first_valid_layer()
+        .all_attributes()
+        .non_parallel()
+        .from_buffered(Cursor::new(bytes))
+        .map_err(exr_err)?;
+    let layer = image.layer_data;
+    let (width, height) = (layer.size.width(), layer.size.height());
+    let pixels = width.checked_mul(height).ok_or_else(|| Error::format(path, "header", "image too large"))?;
+
+    let find = |wanted: &str| {
+        layer.channel_data.list.iter().find(|c| {
+            let name = c.name.to_string();
+            name.rsplit('.').next().is_some_and(|last| last.eq_ignore_ascii_case(wanted))
+        })
+    };
+    let planes: [&::exr::image::AnyChannel<x::FlatSamples>; 3] = match (find("R"), find("G"), find("B"), find("Y")) {
+        (Some(r), Some(g), Some(b), _) => [r, g, b],
+        (_, _, _, Some(y)) => [y, y, y],
+        _ => {
+            let names: Vec<String> = layer.channel_data.list.iter().map(|c| c.name.to_string()).collect();
+            return Err(Error::format(path, "channels", format!("expected R, G, B or Y channels, found [{}]", names.join(", "))));
+        }
+    };
+    for plane in planes {
+        if plane.sample_data.len() != pixels {
+            return Err(Error::format(
+                path,
+                format!("channel {}", plane.name),
+                format!(
+                    "expected {pixels} samples ({width}×{height}), found {} (subsampled channels are not supported)",
+                    plane.sample_data.len()
+                ),
+            ));
+        }
+    }
+
+    let mut img = Image { width, height, data: vec![0.0; 3 * pixels] };
+    for (c, plane) in planes.iter().enumerate() {
+        for (i, v) in plane.sample_data.values_as_f32().enumerate() {
+            img.data[3 * i + c] = v;
+        }
+    }
+    Ok(img)
+}
+
+pub(super) fn encode(path: &Path, img: &Image) -> Result<Vec<u8>> {
+    let width = img.width;
+    let channels = x::SpecificChannels::rgb(|p: x::Vec2<usize>| {
+        let i = 3 * (p.y() * width + p.x());
+        (img.data[i], img.data[i + 1], img.data[i + 2])
+    });
+    let image = x::Image::from_channels((img.width, img.height), channels);
+    let mut out = Cursor::new(Vec::new());
+    image.write().non_parallel().to_buffered(&mut out).map_err(|e| Error::format(path, "OpenEXR encoding", e.to_string()))?;
+    Ok(out.into_inner())
+}

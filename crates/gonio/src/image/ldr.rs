@@ -1,0 +1,56 @@
+//! PNG, JPEG and Radiance HDR through the `image` crate (decoders only for JPEG and HDR; PNG both ways).
+//! Integer samples are sRGB-decoded to linear; HDR samples are linear already.
+
+use std::io::Cursor;
+use std::path::Path;
+
+use ::image::{DynamicImage, ImageFormat};
+
+use super::{linear_to_srgb, srgb_to_linear, Format, Image};
+use crate::error::{Error, Result};
+
+pub(super) fn decode(path: &Path, bytes: &[u8], format: Format) -> Result<Image> {
+    let image_format = match format {
+        Format::Hdr => ImageFormat::Hdr,
+        Format::Png => ImageFormat::Png,
+        Format::Jpeg => ImageFormat::Jpeg,
+        Format::Exr => unreachable!("EXR is decoded by the exr module"),
+    };
+    let decoded = ::image::load_from_memory_with_format(bytes, image_format)
+        .map_err(|e| Error::format(path, format!("{image_format:?} data"), e.to_string()))?;
+    let (width, height) = (decoded.width() as usize, decoded.height() as usize);
+    let data: Vec<f32> = match decoded {
+        DynamicImage::ImageRgb32F(_) | DynamicImage::ImageRgba32F(_) => decoded.into_rgb32f().into_raw(),
+        DynamicImage::ImageLuma16(_) | DynamicImage::ImageLumaA16(_) | DynamicImage::ImageRgb16(_) | DynamicImage::ImageRgba16(_) => {
+            // A table would be 64 K entries; the curve is cheap enough per sample.
+            decoded.into_rgb16().into_raw().into_iter().map(|v| srgb_to_linear(f32::from(v) / 65535.0)).collect()
+        }
+        _ => {
+            let table: Vec<f32> = (0..=255u8).map(|v| srgb_to_linear(f32::from(v) / 255.0)).collect();
+            decoded.into_rgb8().into_raw().into_iter().map(|v| table[usize::from(v)]).collect()
+        }
+    };
+    if data.len() != 3 * width * height {
+        return Err(Error::format(path, "pixels", "decoder returned the wrong number of samples"));
+    }
+    Ok(Image { width, height, data })
+}
+
+pub(super) fn encode_png(path: &Path, img: &Image) -> Result<Vec<u8>> {
+    let too_large = || Error::format(path, "image", "too large for PNG (at most 2³²−1 pixels a side)");
+    let width = u32::try_from(img.width).map_err(|_| too_large())?;
+    let height = u32::try_from(img.height).map_err(|_| too_large())?;
+    let bytes: Vec<u8> = img
+        .data
+        .iter()
+        .map(|&v| {
+            // NaN maps to 0 (`clamp` keeps NaN, so treat it first).
+            let v = if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) };
+            (linear_to_srgb(v) * 255.0).round() as u8
+        })
+        .collect();
+    let buffer = ::image::RgbImage::from_raw(width, height, bytes).ok_or_else(too_large)?;
+    let mut out = Cursor::new(Vec::new());
+    buffer.write_to(&mut out, ImageFormat::Png).map_err(|e| Error::format(path, "PNG encoding", e.to_string()))?;
+    Ok(out.into_inner())
+}

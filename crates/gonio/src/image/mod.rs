@@ -1,0 +1,422 @@
+//! Images in and out: a linear-RGB float buffer ([`Image`]) and the files a renderer meets.
+//!
+//! | format | read | write |
+//! |---|---|---|
+//! | OpenEXR (`.exr`) | first layer; R, G, B (A ignored) or a single Y channel; half, float or uint → `f32` | float32 RGB, linear, lossless RLE compression (the `exr` crate's default) |
+//! | Radiance (`.hdr`, `.rgbe`, `.pic`) | RGBE, run-length encoded or flat | — |
+//! | PNG (`.png`) | 8- or 16-bit, grey or colour, alpha ignored; sRGB-decoded to linear | 8-bit RGB, sRGB-encoded, clamped to [0, 1], rounded |
+//! | JPEG (`.jpg`, `.jpeg`) | 8-bit, grey or colour; sRGB-decoded to linear | — |
+//!
+//! The format is taken from the file's magic bytes when they are recognised, else from the extension
+//! (case-insensitive). Integer images are taken to be sRGB-encoded, as Mitsuba 3 does for PNG and JPEG
+//! bitmaps that carry no other colour information.
+//!
+//! Writing is atomic: the file is encoded in memory first, written to a temporary file beside the target
+//! (`.name.tmp-<pid>`) and renamed over it, so a failure never leaves a half-written file, and an existing
+//! file at the target survives any error.
+//!
+//! ```
+//! use gonio::image::Image;
+//! use gonio::Rgb;
+//! let mut img = Image::new(2, 1);
+//! img.set(1, 0, Rgb::new(0.5, 0.25, 1.0));
+//! assert_eq!(img.get(1, 0), Rgb::new(0.5, 0.25, 1.0));
+//! ```
+
+mod exr;
+mod ldr;
+
+use std::path::{Path, PathBuf};
+
+use crate::error::{Error, Result};
+use crate::spectrum::Rgb;
+
+pub use crate::spectrum::rgb::{linear_to_srgb, srgb_to_linear};
+
+/// A linear RGB image: row-major, top row first, three `f32` per pixel.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Image {
+    pub width: usize,
+    pub height: usize,
+    /// `3 · width · height` floats: pixel (x, y) starts at `3 · (y · width + x)`.
+    pub data: Vec<f32>,
+}
+
+impl Image {
+    /// A black image.
+    #[must_use]
+    pub fn new(width: usize, height: usize) -> Self {
+        Image { width, height, data: vec![0.0; 3 * width * height] }
+    }
+
+    /// The pixel at column `x`, row `y` (row 0 at the top).
+    ///
+    /// # Panics
+    /// If `(x, y)` is outside the image.
+    #[inline]
+    #[must_use]
+    pub fn get(&self, x: usize, y: usize) -> Rgb {
+        debug_assert!(x < self.width && y < self.height, "pixel ({x}, {y}) outside {}×{}", self.width, self.height);
+        let i = 3 * (y * self.width + x);
+        Rgb([self.data[i], self.data[i + 1], self.data[i + 2]])
+    }
+
+    /// Sets the pixel at column `x`, row `y`.
+    ///
+    /// # Panics
+    /// If `(x, y)` is outside the image.
+    #[inline]
+    pub fn set(&mut self, x: usize, y: usize, value: Rgb) {
+        debug_assert!(x < self.width && y < self.height, "pixel ({x}, {y}) outside {}×{}", self.width, self.height);
+        let i = 3 * (y * self.width + x);
+        self.data[i..i + 3].copy_from_slice(&value.0);
+    }
+
+    /// The mean of all pixels (zero for an empty image); accumulated in `f64`.
+    #[must_use]
+    pub fn mean(&self) -> Rgb {
+        let n = (self.width * self.height).max(1) as f64;
+        let mut sum = [0.0f64; 3];
+        for px in self.data.chunks_exact(3) {
+            for c in 0..3 {
+                sum[c] += f64::from(px[c]);
+            }
+        }
+        Rgb([(sum[0] / n) as f32, (sum[1] / n) as f32, (sum[2] / n) as f32])
+    }
+
+    /// An error if `data` does not hold exactly `3 · width · height` floats.
+    fn check_shape(&self, path: &Path) -> Result<()> {
+        let expected = self.width.checked_mul(self.height).and_then(|n| n.checked_mul(3));
+        if expected != Some(self.data.len()) {
+            return Err(Error::format(
+                path,
+                "image",
+                format!("expected 3·{}·{} floats of pixel data, found {}; nothing was written", self.width, self.height, self.data.len()),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The file formats gonio reads and writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Format {
+    Exr,
+    Hdr,
+    Png,
+    Jpeg,
+}
+
+const READ_EXTENSIONS: &str = ".exr, .hdr (also .rgbe, .pic), .png, .jpg, .jpeg";
+const WRITE_EXTENSIONS: &str = ".exr, .png";
+
+fn format_from_extension(path: &Path) -> Option<Format> {
+    let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+    match ext.as_str() {
+        "exr" => Some(Format::Exr),
+        "hdr" | "rgbe" | "pic" => Some(Format::Hdr),
+        "png" => Some(Format::Png),
+        "jpg" | "jpeg" => Some(Format::Jpeg),
+        _ => None,
+    }
+}
+
+fn format_from_magic(bytes: &[u8]) -> Option<Format> {
+    if bytes.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
+        Some(Format::Exr)
+    } else if bytes.starts_with(b"#?RADIANCE") || bytes.starts_with(b"#?RGBE") {
+        Some(Format::Hdr)
+    } else if bytes.starts_with(&[0x89, b'P', b'N', b'G', 0x0d, 0x0a, 0x1a, 0x0a]) {
+        Some(Format::Png)
+    } else if bytes.starts_with(&[0xff, 0xd8, 0xff]) {
+        Some(Format::Jpeg)
+    } else {
+        None
+    }
+}
+
+/// Reads an image file into linear RGB. See the module docs for the formats.
+pub fn read_image(path: &Path) -> Result<Image> {
+    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let format = format_from_magic(&bytes)
+        .or_else(|| format_from_extension(path))
+        .ok_or_else(|| Error::format(path, "header", format!("not a recognised image file; accepted: {READ_EXTENSIONS}")))?;
+    let image = guard(path, || match format {
+        Format::Exr => exr::decode(path, &bytes),
+        Format::Hdr | Format::Png | Format::Jpeg => ldr::decode(path, &bytes, format),
+    })?;
+    if image.width == 0 || image.height == 0 {
+        return Err(Error::format(path, "header", "image has no pixels"));
+    }
+    debug_assert_eq!(image.data.len(), 3 * image.width * image.height);
+    Ok(image)
+}
+
+/// Writes `img` to `path`, atomically (see the module docs): `.exr` as float32 linear RGB, `.png` as
+/// 8-bit sRGB.
+pub fn write_image(path: &Path, img: &Image) -> Result<()> {
+    let format = format_from_extension(path)
+        .ok_or_else(|| Error::format(path, "file name", format!("cannot write this extension; accepted: {WRITE_EXTENSIONS}")))?;
+    img.check_shape(path)?;
+    if img.width == 0 || img.height == 0 {
+        return Err(Error::format(path, "image", "cannot write an image with no pixels"));
+    }
+    let bytes = guard(path, || match format {
+        Format::Exr => exr::encode(path, img),
+        Format::Png => ldr::encode_png(path, img),
+        Format::Hdr | Format::Jpeg => {
+            Err(Error::format(path, "file name", format!("cannot write this extension; accepted: {WRITE_EXTENSIONS}")))
+        }
+    })?;
+    write_atomically(path, &bytes)
+}
+
+/// Runs a third-party decoder or encoder, turning a panic inside it into an error that names the file:
+/// user data must never bring the process down (STYLE.md rule 6).
+fn guard<T>(path: &Path, op: impl FnOnce() -> Result<T>) -> Result<T> {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(op))
+        .unwrap_or_else(|_| Err(Error::format(path, "file", "the decoder failed on malformed data")))
+}
+
+/// The temporary file beside `path`: `.name.tmp-<pid>` in the same directory, so the rename stays on one
+/// file system.
+fn temporary_path(path: &Path) -> PathBuf {
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    path.with_file_name(format!(".{name}.tmp-{}", std::process::id()))
+}
+
+/// Writes `bytes` to a temporary file beside `path`, flushes it and renames it over `path`. On any error
+/// the temporary is removed and `path` is untouched.
+fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
+    use std::io::Write;
+    let tmp = temporary_path(path);
+    let result = (|| -> std::io::Result<()> {
+        let mut file = std::fs::File::create(&tmp)?;
+        file.write_all(bytes)?;
+        file.sync_all()?;
+        drop(file);
+        std::fs::rename(&tmp, path)
+    })();
+    result.map_err(|e| {
+        // The temporary may not exist (creation failed); nothing more to do then.
+        let _ = std::fs::remove_file(&tmp);
+        Error::io(path, e)
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const DATA: &str = "/work/shared/data";
+
+    fn scratch_dir(tag: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("gonio-image-{tag}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    fn test_pattern(width: usize, height: usize) -> Image {
+        let mut img = Image::new(width, height);
+        for y in 0..height {
+            for x in 0..width {
+                let v = Rgb::new(x as f32 / width as f32, y as f32 / height as f32, 0.3 + 0.01 * (x * y) as f32);
+                img.set(x, y, v);
+            }
+        }
+        img
+    }
+
+    fn assert_plausible(img: &Image, width: usize, height: usize, name: &str) -> Rgb {
+        assert_eq!((img.width, img.height), (width, height), "{name}");
+        assert_eq!(img.data.len(), 3 * width * height);
+        assert!(img.data.iter().all(|v| v.is_finite() && *v >= 0.0), "{name}: non-finite or negative pixel");
+        let mean = img.mean();
+        println!("{name}: {}×{}, mean {mean}", img.width, img.height);
+        assert!(mean.luminance() > 1e-4 && mean.luminance() < 1e3, "{name}: implausible mean {mean}");
+        mean
+    }
+
+    #[test]
+    fn exr_round_trip_is_exact() {
+        let dir = scratch_dir("exr");
+        let mut img = test_pattern(7, 5);
+        img.set(3, 2, Rgb::new(1e-7, 12345.678, 0.0));
+        let path = dir.join("pattern.EXR");
+        write_image(&path, &img).unwrap();
+        let back = read_image(&path).unwrap();
+        assert_eq!(back, img);
+        assert!(std::fs::read_dir(&dir).unwrap().count() == 1, "temporary left behind");
+    }
+
+    #[test]
+    fn png_round_trip_within_one_step() {
+        let dir = scratch_dir("png");
+        let img = test_pattern(9, 4);
+        let path = dir.join("pattern.png");
+        write_image(&path, &img).unwrap();
+        let back = read_image(&path).unwrap();
+        assert_eq!((back.width, back.height), (9, 4));
+        for (a, b) in img.data.iter().zip(&back.data) {
+            let (sa, sb) = (linear_to_srgb(a.clamp(0.0, 1.0)), linear_to_srgb(*b));
+            assert!((sa - sb).abs() <= 0.5 / 255.0 + 1e-6, "{a} → {b}");
+        }
+    }
+
+    #[test]
+    fn png_write_clamps_and_reads_grey() {
+        let dir = scratch_dir("clamp");
+        let mut img = Image::new(2, 1);
+        img.set(0, 0, Rgb::new(-1.0, 2.0, f32::NAN));
+        img.set(1, 0, Rgb::splat(0.5));
+        let path = dir.join("c.png");
+        write_image(&path, &img).unwrap();
+        let back = read_image(&path).unwrap();
+        assert_eq!(back.get(0, 0), Rgb::new(0.0, 1.0, 0.0));
+        // A grey 16-bit PNG with alpha, written by the `image` crate directly.
+        let grey = ::image::ImageBuffer::<::image::LumaA<u16>, _>::from_raw(2, 1, vec![0u16, 65535, 65535, 0]).unwrap();
+        let gpath = dir.join("grey.png");
+        grey.save(&gpath).unwrap();
+        let g = read_image(&gpath).unwrap();
+        assert_eq!(g.get(0, 0), Rgb::ZERO);
+        assert_eq!(g.get(1, 0), Rgb::ONE);
+    }
+
+    #[test]
+    fn reads_jpeg_colour_and_grey() {
+        let dir = scratch_dir("jpeg");
+        // Flat images survive JPEG compression nearly exactly: sRGB 128 → linear 0.2158.
+        let colour = ::image::RgbImage::from_pixel(16, 8, ::image::Rgb([128, 128, 128]));
+        let path = dir.join("flat.JPG");
+        colour.save_with_format(&path, ::image::ImageFormat::Jpeg).unwrap();
+        let grey = ::image::GrayImage::from_pixel(8, 8, ::image::Luma([255]));
+        let gpath = dir.join("white.jpeg");
+        grey.save_with_format(&gpath, ::image::ImageFormat::Jpeg).unwrap();
+        let img = read_image(&path).unwrap();
+        assert_eq!((img.width, img.height), (16, 8));
+        let want = srgb_to_linear(128.0 / 255.0);
+        assert!(img.data.iter().all(|v| (v - want).abs() < 0.01), "{:?}", img.get(0, 0));
+        let white = read_image(&gpath).unwrap();
+        assert!(white.data.iter().all(|v| (v - 1.0).abs() < 0.01));
+    }
+
+    #[test]
+    fn reads_flat_radiance_hdr() {
+        // A 2×1 flat (not run-length encoded) RGBE file: (128,64,32, e=129) = (1, 0.5, 0.25);
+        // (128,128,128, e=128+2) = (2, 2, 2). Value = m · 2^(e − 136) (Radiance's RGBE: (m + 0.5)·2^(e−136)
+        // in some readers; both give within 1 %).
+        let dir = scratch_dir("hdr");
+        let mut bytes = b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 1 +X 2\n".to_vec();
+        bytes.extend_from_slice(&[128, 64, 32, 129, 128, 128, 128, 130]);
+        let path = dir.join("flat.hdr");
+        std::fs::write(&path, &bytes).unwrap();
+        let img = read_image(&path).unwrap();
+        assert_eq!((img.width, img.height), (2, 1));
+        let (a, b) = (img.get(0, 0), img.get(1, 0));
+        for (got, want) in [(a.r(), 1.0), (a.g(), 0.5), (a.b(), 0.25), (b.r(), 2.0), (b.b(), 2.0)] {
+            assert!((got - want).abs() < 0.01 * want, "{got} vs {want}");
+        }
+    }
+
+    #[test]
+    fn reads_real_environment_maps() {
+        let museum = read_image(Path::new(&format!("{DATA}/envmaps/museum.exr"))).unwrap();
+        assert_plausible(&museum, 512, 256, "museum.exr");
+        let venice = read_image(Path::new(&format!("{DATA}/envmaps/venice_sunset_1k.hdr"))).unwrap();
+        assert_plausible(&venice, 1024, 512, "venice_sunset_1k.hdr");
+    }
+
+    #[test]
+    fn reads_mitsuba_reference_exr() {
+        let path = format!("{DATA}/mitsuba/tests/scenes/bsdf_spheres/refs/test_arealight_ref_rgb.exr");
+        let img = read_image(Path::new(&path)).unwrap();
+        assert_plausible(&img, 48, 48, "test_arealight_ref_rgb.exr");
+    }
+
+    #[test]
+    fn truncated_files_are_errors_naming_the_file() {
+        let dir = scratch_dir("trunc");
+        for name in ["envmaps/museum.exr", "envmaps/venice_sunset_1k.hdr"] {
+            let src = std::fs::read(format!("{DATA}/{name}")).unwrap();
+            let file = Path::new(name).file_name().unwrap();
+            let path = dir.join(file);
+            for len in [0, 3, 100, src.len() / 2] {
+                std::fs::write(&path, &src[..len]).unwrap();
+                let err = read_image(&path).expect_err("truncated file accepted");
+                assert!(err.to_string().contains(file.to_str().unwrap()), "{err}");
+            }
+        }
+        // An EXR whose data window claims 10⁶ × 10⁶ pixels: refused before any allocation.
+        let exr = dir.join("huge.exr");
+        write_image(&exr, &test_pattern(3, 2)).unwrap();
+        let mut bytes = std::fs::read(&exr).unwrap();
+        let at = bytes.windows(11).position(|w| w == b"dataWindow\0").unwrap() + 11 + 6 + 4;
+        bytes[at + 8..at + 12].copy_from_slice(&1_000_000i32.to_le_bytes());
+        bytes[at + 12..at + 16].copy_from_slice(&1_000_000i32.to_le_bytes());
+        std::fs::write(&exr, &bytes).unwrap();
+        let err = read_image(&exr).unwrap_err().to_string();
+        assert!(err.contains("huge.exr"), "{err}");
+        println!("hostile EXR header: {err}");
+        // A truncated PNG of our own.
+        let png = dir.join("t.png");
+        write_image(&png, &test_pattern(40, 40)).unwrap();
+        let bytes = std::fs::read(&png).unwrap();
+        std::fs::write(&png, &bytes[..100.min(bytes.len() - 1)]).unwrap();
+        assert!(read_image(&png).unwrap_err().to_string().contains("t.png"));
+        // Unknown content and extension.
+        let txt = dir.join("notes.txt");
+        std::fs::write(&txt, "hello").unwrap();
+        assert!(read_image(&txt).unwrap_err().to_string().contains(".exr"));
+        assert!(matches!(read_image(&dir.join("missing.exr")), Err(Error::Io { .. })));
+    }
+
+    #[test]
+    fn writing_into_a_missing_directory_leaves_nothing() {
+        let dir = scratch_dir("missing");
+        let path = dir.join("no/such/dir/out.exr");
+        assert!(matches!(write_image(&path, &test_pattern(2, 2)), Err(Error::Io { .. })));
+        assert!(!dir.join("no").exists());
+    }
+
+    #[test]
+    fn a_failed_write_keeps_the_old_file() {
+        let dir = scratch_dir("keep");
+        let path = dir.join("keep.png");
+        write_image(&path, &test_pattern(4, 4)).unwrap();
+        let before = std::fs::read(&path).unwrap();
+        let mut bad = test_pattern(4, 4);
+        bad.data.pop();
+        let err = write_image(&path, &bad).unwrap_err();
+        assert!(err.to_string().contains("keep.png"), "{err}");
+        assert_eq!(std::fs::read(&path).unwrap(), before);
+        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1, "temporary left behind");
+        // Unknown extension: an error listing the accepted ones.
+        let err = write_image(&dir.join("x.tiff"), &test_pattern(1, 1)).unwrap_err();
+        assert!(err.to_string().contains(".exr, .png"), "{err}");
+    }
+
+    #[test]
+    fn a_read_only_directory_is_an_error_and_leaves_nothing() {
+        let dir = scratch_dir("ro");
+        let ro = dir.join("ro");
+        std::fs::create_dir(&ro).unwrap();
+        let mut perms = std::fs::metadata(&ro).unwrap().permissions();
+        perms.set_readonly(true);
+        std::fs::set_permissions(&ro, perms.clone()).unwrap();
+        let result = write_image(&ro.join("out.png"), &test_pattern(2, 2));
+        #[allow(clippy::permissions_set_readonly_false)]
+        perms.set_readonly(false);
+        let listing: Vec<_> = std::fs::read_dir(&ro).unwrap().collect();
+        std::fs::set_permissions(&ro, perms).unwrap();
+        // Root ignores directory permissions; then the write succeeds, which is also correct.
+        match result {
+            Err(e) => {
+                assert!(e.to_string().contains("out.png"));
+                assert!(listing.is_empty(), "left behind: {listing:?}");
+            }
+            Ok(()) => assert_eq!(listing.len(), 1),
+        }
+    }
+}
