@@ -21,6 +21,8 @@ enum Command {
     Check(cmd::check::Args),
     /// Print the directional albedo ∫ f cos dωi of a BSDF against θo.
     Albedo(cmd::albedo::Args),
+    /// Render a Mitsuba 3 XML scene to an EXR or PNG image.
+    Render(cmd::render::Args),
 }
 
 fn main() -> ExitCode {
@@ -28,6 +30,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Check(args) => cmd::check::run(args),
         Command::Albedo(args) => cmd::albedo::run(args),
+        Command::Render(args) => cmd::render::run(args),
     };
     match result {
         Ok(code) => code,

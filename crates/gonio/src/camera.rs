@@ -2,8 +2,9 @@
 //!
 //! | parameter   | type      | default  | meaning                                                       |
 //! |-------------|-----------|----------|---------------------------------------------------------------|
-//! | `fov`       | float     | 39.5978  | field of view in degrees along `fov_axis` (Mitsuba's default is a 50 mm lens on 36 mm film along x) |
+//! | `fov`       | float     | —        | field of view in degrees along `fov_axis`                     |
 //! | `fov_axis`  | string    | `x`      | `x`, `y`, `smaller`, `larger` or `diagonal`                   |
+//! | `focal_length` | string | `50mm`   | instead of `fov`: a lens on 35 mm film (36 × 24 mm), giving the diagonal field of view 2 atan(√(36² + 24²) / 2f) — Mitsuba's default when neither is given |
 //! | `to_world`  | transform | identity | camera → world                                                |
 //! | `near_clip` | float     | 0.01     | rays start at this depth                                      |
 //! | `far_clip`  | float     | 10000    | and end at this one                                           |
@@ -56,8 +57,19 @@ impl PerspectiveCamera {
         if p.plugin_type() != "perspective" {
             return Err(Error::spec(p.at(), format!("unsupported sensor `{}` (gonio has: perspective)", p.plugin_type())));
         }
-        let fov = p.float_in("fov", 39.597_755, 1e-3, 179.999)?;
-        let axis = p.string("fov_axis")?.unwrap_or_else(|| "x".into());
+        let (fov, axis) = if p.has("fov") {
+            if p.has("focal_length") {
+                return Err(Error::spec(p.at_param("focal_length"), "give `fov` or `focal_length`, not both"));
+            }
+            (p.float_in("fov", 45.0, 1e-3, 179.999)?, p.string("fov_axis")?.unwrap_or_else(|| "x".into()))
+        } else {
+            let raw = p.string("focal_length")?.unwrap_or_else(|| "50mm".into());
+            let f: f32 = raw.trim().trim_end_matches("mm").trim().parse().ok().filter(|f: &f32| *f > 0.0).ok_or_else(|| {
+                Error::spec(p.at_param("focal_length"), format!("`focal_length` must be a length like \"50mm\", got \"{raw}\""))
+            })?;
+            let _ = p.string("fov_axis")?;
+            ((36.0f32.hypot(24.0) / (2.0 * f)).atan().to_degrees() * 2.0, "diagonal".to_string())
+        };
         let near = p.float_positive("near_clip", 1e-2)?;
         let far = p.float_positive("far_clip", 1e4)?;
         if far <= near {
@@ -92,5 +104,25 @@ mod tests {
         let top = cam.ray(Vec2::new(0.5, 0.0));
         assert!(top.d.y > 0.0 && (top.d.y - 0.5 * -top.d.z).abs() < 1e-5, "{:?}", top.d);
         assert!(PerspectiveCamera::new(look, 90.0, "z", 2, 1, 1e-2, 1e4, "t").is_err());
+    }
+
+    /// Horizontal fields of view Mitsuba 3.5 reports (`x_fov`) for these sensors.
+    #[test]
+    fn fields_of_view_match_mitsuba() {
+        let x_fov = |xml: &str, w: u32, h: u32| {
+            let p = Props::from_json(xml).unwrap();
+            let c = PerspectiveCamera::from_props(&p, w, h).unwrap();
+            2.0 * c.tan_half_x.atan().to_degrees()
+        };
+        for (xml, w, h, want) in [
+            (r#"{"type": "perspective"}"#, 48, 48, 34.022_057),
+            (r#"{"type": "perspective"}"#, 64, 32, 42.311_714),
+            (r#"{"type": "perspective"}"#, 32, 64, 21.902_138),
+            (r#"{"type": "perspective", "fov": 30, "fov_axis": "diagonal"}"#, 64, 32, 26.954_737),
+            (r#"{"type": "perspective", "fov": 30, "fov_axis": "smaller"}"#, 64, 32, 56.373_57),
+        ] {
+            let got = x_fov(xml, w, h);
+            assert!((got - want).abs() < 1e-3, "{xml} {w}×{h}: {got} vs {want}");
+        }
     }
 }

@@ -133,7 +133,7 @@ fn loader_errors_name_file_line_and_element() {
         ("<scene version=\"3.0.0\">\n<shape type=\"sphere\"><ref id=\"nope\"/></shape></scene>", "bad.xml:2:22: <ref id=\"nope\">"),
         ("<scene version=\"3.0.0\">\n<integrator type=\"path\"><integer name=\"max_depth\" value=\"$d\"/></integrator></scene>", "bad.xml:2:25: `$d` is not defined"),
         ("<scene version=\"3.0.0\">\n<emitter type=\"envmapp\"/></scene>", "bad.xml:2:1: unsupported emitter `envmapp`"),
-        ("<scene version=\"3.0.0\">\n<shape type=\"sphere\"><bsdf type=\"diffuse\">\n<texture name=\"reflectance\" type=\"bitmap\"/></bsdf></shape></scene>", "bad.xml:3:1: unsupported texture `bitmap`"),
+        ("<scene version=\"3.0.0\">\n<shape type=\"sphere\"><bsdf type=\"diffuse\">\n<texture name=\"reflectance\" type=\"gradient\"/></bsdf></shape></scene>", "bad.xml:3:1: unsupported texture `gradient`"),
         ("<scene>\n</scene>", "bad.xml:1:1: <scene> needs a version"),
     ];
     for (xml, want) in cases {

@@ -1,2 +1,3 @@
 pub mod albedo;
 pub mod check;
+pub mod render;

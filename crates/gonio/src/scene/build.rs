@@ -99,7 +99,7 @@ fn shape_from_props(p: &Props) -> Result<Shape> {
             let face_normals = p.bool("face_normals", false)?;
             // Mitsuba's OBJ loader flips v (v ↦ 1 − v) by default; mesh_io returns the file's values.
             let flip_tex = if kind == "obj" { p.bool("flip_tex_coords", true)? } else { false };
-            let data = super::mesh_files::load(kind, std::path::Path::new(&filename), at)?;
+            let data = super::mesh_files::load(kind, std::path::Path::new(&filename), p.at_param("filename"))?;
             let uvs = data.uvs.map(|uv| uv.into_iter().map(|t| if flip_tex { glam::Vec2::new(t.x, 1.0 - t.y) } else { t }).collect());
             Shape::Mesh(Mesh::from_file_data(data.positions, data.normals, uvs, data.indices, &to_world, face_normals, flip, &format!("{at} ({filename})"))?)
         }

@@ -1,10 +1,12 @@
 //! Textures: colours that vary over a surface, evaluated at a hit's uv. Materials evaluate them into a
 //! plain [`crate::bsdf::Bsdf`] (see [`crate::scene::material`]).
 //!
-//! Plugins: `checkerboard` ([`checkerboard`]); `bitmap` arrives with image I/O.
+//! Plugins: `checkerboard` ([`checkerboard`]) and `bitmap` ([`bitmap`]).
 
+pub mod bitmap;
 pub mod checkerboard;
 
+pub use bitmap::Bitmap;
 pub use checkerboard::Checkerboard;
 
 use crate::error::{Error, Result};
@@ -16,6 +18,7 @@ use glam::Vec2;
 #[derive(Clone, Debug, PartialEq)]
 pub enum Texture {
     Checkerboard(Checkerboard),
+    Bitmap(Bitmap),
 }
 
 impl Texture {
@@ -23,7 +26,8 @@ impl Texture {
     pub fn from_props(p: &Props) -> Result<Texture> {
         let t = match p.plugin_type() {
             "checkerboard" => Texture::Checkerboard(Checkerboard::from_props(p)?),
-            other => return Err(Error::spec(p.at(), format!("unsupported texture `{other}` (gonio has: checkerboard)"))),
+            "bitmap" => Texture::Bitmap(Bitmap::from_props(p)?),
+            other => return Err(Error::spec(p.at(), format!("unsupported texture `{other}` (gonio has: checkerboard, bitmap)"))),
         };
         p.finish()?;
         Ok(t)
@@ -35,6 +39,7 @@ impl Texture {
     pub fn eval(&self, uv: Vec2) -> Rgb {
         match self {
             Texture::Checkerboard(c) => c.eval(uv),
+            Texture::Bitmap(b) => b.eval(uv),
         }
     }
 }

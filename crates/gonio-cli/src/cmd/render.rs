@@ -1,0 +1,120 @@
+//! `gonio render SCENE.xml`: render a Mitsuba 3 XML scene with gonio's path tracer.
+//!
+//! The image goes to `-o FILE` (`.exr`: float32 linear RGB; `.png`: 8-bit sRGB), by default next to the
+//! scene with the extension replaced by `.exr` (as Mitsuba's `mitsuba scene.xml` does). Ctrl-C stops the
+//! render after the current pass; the image so far is written (every pixel with the same number of
+//! samples, reported) and the exit code is 130.
+
+use gonio::image::{write_image, Image};
+use gonio::render::render;
+use gonio::scene::Scene;
+use gonio::Error;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// A scene in Mitsuba 3's XML format.
+    scene: PathBuf,
+    /// Output image (.exr or .png); default: the scene's name with .exr, next to the scene.
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// Samples per pixel (overrides the scene's sampler).
+    #[arg(long)]
+    spp: Option<u32>,
+    /// Set a scene parameter, as Mitsuba's -D: overrides <default name="NAME" value="…"/>.
+    #[arg(short = 'D', value_name = "NAME=VALUE")]
+    define: Vec<String>,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Random seed (overrides the sampler's `seed`).
+    #[arg(long)]
+    seed: Option<u64>,
+    /// No progress bar or summary.
+    #[arg(short, long)]
+    quiet: bool,
+}
+
+fn arg_error(message: String) -> Error {
+    Error::Spec { at: "command line".into(), message }
+}
+
+pub fn run(args: Args) -> Result<ExitCode, Error> {
+    let overrides = args
+        .define
+        .iter()
+        .map(|d| match d.split_once('=') {
+            Some((k, v)) if !k.is_empty() => Ok((k.to_string(), v.to_string())),
+            _ => Err(arg_error(format!("-D expects NAME=VALUE, got `{d}`"))),
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let output = args.output.clone().unwrap_or_else(|| args.scene.with_extension("exr"));
+    let load_start = std::time::Instant::now();
+    let scene = Scene::load(&args.scene, &overrides)?;
+    for w in &scene.warnings {
+        eprintln!("gonio: warning: {w}");
+    }
+    let spp = args.spp.unwrap_or(scene.sampler.sample_count);
+    if spp == 0 {
+        return Err(arg_error("--spp must be at least 1".into()));
+    }
+    let seed = args.seed.unwrap_or(scene.sampler.seed);
+    let mut pool = rayon::ThreadPoolBuilder::new();
+    if let Some(n) = args.threads {
+        pool = pool.num_threads(n);
+    }
+    let pool = pool.build().map_err(|e| arg_error(format!("--threads: {e}")))?;
+
+    let cancel = Arc::new(AtomicBool::new(false));
+    {
+        let cancel = cancel.clone();
+        // A second Ctrl-C exits at once.
+        let _ = ctrlc::set_handler(move || {
+            if cancel.swap(true, Ordering::SeqCst) {
+                std::process::exit(130);
+            }
+        });
+    }
+    let (w, h) = (scene.film.width, scene.film.height);
+    let total = u64::from(w) * u64::from(h) * u64::from(spp);
+    let bar = if args.quiet || !std::io::stderr().is_terminal() {
+        ProgressBar::hidden()
+    } else {
+        let b = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
+        b.set_style(
+            ProgressStyle::with_template("{bar:40} {percent:>3}%  {human_pos}/{human_len} samples  {per_sec}  ETA {eta}")
+                .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        );
+        b
+    };
+    let load_seconds = load_start.elapsed().as_secs_f64();
+    let out = pool.install(|| render(&scene, spp, seed, &cancel, &|done| bar.set_position(done)));
+    bar.finish_and_clear();
+
+    let image = Image { width: out.width as usize, height: out.height as usize, data: out.data };
+    write_image(&output, &image)?;
+    if out.nonfinite > 0 {
+        eprintln!("gonio: warning: dropped {} non-finite samples (counted as black)", out.nonfinite);
+    }
+    if !args.quiet {
+        let rate = f64::from(out.spp_done) * f64::from(w) * f64::from(h) / out.seconds.max(1e-9);
+        eprintln!(
+            "gonio: {w}×{h}, {} spp, {} primitives: loaded in {load_seconds:.2} s, rendered in {:.2} s ({:.2} Msamples/s) → {}",
+            out.spp_done,
+            scene.primitive_count(),
+            out.seconds,
+            rate / 1e6,
+            output.display()
+        );
+    }
+    if out.cancelled {
+        eprintln!("gonio: interrupted: wrote {} of {} spp to {}", out.spp_done, out.spp_requested, output.display());
+        return Ok(ExitCode::from(130));
+    }
+    Ok(ExitCode::SUCCESS)
+}
