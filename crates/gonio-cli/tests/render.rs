@@ -48,7 +48,7 @@ fn bad_scenes_exit_two_with_one_line() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
     assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
-    assert!(stderr.contains("bad.xml:11:1") && stderr.contains("`radius`"), "{stderr}");
+    assert!(stderr.contains("bad.xml:10:1") && stderr.contains("`radius`"), "{stderr}");
     let out = gonio(&["render", scene.to_str().unwrap(), "-D", "nonsense"]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("NAME=VALUE"));
