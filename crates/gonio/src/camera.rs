@@ -106,7 +106,7 @@ mod tests {
         assert!(PerspectiveCamera::new(look, 90.0, "z", 2, 1, 1e-2, 1e4, "t").is_err());
     }
 
-    /// Horizontal fields of view Mitsuba 3.5 reports (`x_fov`) for these sensors.
+    /// Horizontal fields of view Mitsuba 3.9.1 reports (`x_fov`) for these sensors.
     #[test]
     fn fields_of_view_match_mitsuba() {
         let x_fov = |xml: &str, w: u32, h: u32| {

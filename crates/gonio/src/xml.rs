@@ -113,7 +113,7 @@ pub fn parse_vector(node: roxmltree::Node, env: &XmlEnv, source: &str, default: 
 /// Inside an `<emitter>` the spectrum is radiance: [`spectrum_to_rgb`] (no illuminant). Elsewhere it is a
 /// reflectance, which Mitsuba weights by D65 so that a flat spectrum stays grey; gonio approximates that by
 /// dividing each channel by the response to the equal-energy white (exact for flat spectra: a flat 0.78
-/// over 400–700 nm gives (0.777, 0.781, 0.775) here and (0.776, 0.780, 0.776) in Mitsuba 3.5; 2026-11,
+/// over 400–700 nm gives (0.777, 0.781, 0.775) here and (0.776, 0.780, 0.776) in Mitsuba 3.9.1; 2026-11,
 /// until a D65 table lands in `spectrum`).
 pub fn parse_spectrum(node: roxmltree::Node, env: &XmlEnv, source: &str, within_emitter: bool) -> Result<Rgb> {
     let reduce = |w: &[f64], v: &[f64]| {
@@ -262,11 +262,11 @@ mod tests {
         assert!(env.substitute("$nope", "f.xml:3:4").unwrap_err().to_string().starts_with("f.xml:3:4: `$nope` is not defined"));
         let doc = roxmltree::Document::parse("<spectrum name=\"r\" value=\"400:0.78, 500:0.78, 600:0.78, 700:0.78\"/>").unwrap();
         let c = parse_spectrum(first(&doc), &env, "s.xml", false).unwrap();
-        // Mitsuba 3.5 (scalar_rgb) loads this reflectance as (0.776367, 0.77981, 0.776029).
+        // Mitsuba 3.9.1 (scalar_rgb) loads this reflectance as (0.776367, 0.77981, 0.776029).
         assert!((c.r() - 0.776).abs() < 2e-3 && (c.g() - 0.780).abs() < 2e-3 && (c.b() - 0.776).abs() < 2e-3, "{c}");
         let doc = roxmltree::Document::parse("<spectrum name=\"radiance\" value=\"400:0, 500:8, 600:15.6, 700:18.4\"/>").unwrap();
         let c = parse_spectrum(first(&doc), &env, "s.xml", true).unwrap();
-        // Mitsuba 3.5 loads this area-light radiance as (20.7108, 10.8546, 2.77115).
+        // Mitsuba 3.9.1 loads this area-light radiance as (20.7108, 10.8546, 2.77115).
         assert!((c.r() / 20.7108 - 1.0).abs() < 2e-3 && (c.g() / 10.8546 - 1.0).abs() < 2e-3 && (c.b() / 2.77115 - 1.0).abs() < 5e-3, "{c}");
     }
 }

@@ -151,7 +151,7 @@ fn defaults_and_overrides_substitute() {
     assert_eq!((s.sampler.sample_count, s.film.width), (7, 8));
 }
 
-/// Orientation of `lookat` against Mitsuba: the same scene rendered by Mitsuba 3.5 (scalar_rgb, 16 spp)
+/// Orientation of `lookat` against Mitsuba: the same scene rendered by Mitsuba 3.9.1 (scalar_rgb, 16 spp)
 /// puts the red sphere (world +x) at pixel centroid (23.9, 12.0) and the green one (world +y, −x) at
 /// (12.0, 4.5) of a 32×24 image, with mean (0.957, 0.898, 0.870). Recorded with
 /// `tests/mitsuba_compare.py` (which needs the `mitsuba` Python package).
