@@ -1,5 +1,5 @@
 # gonio — the only entry points a newcomer needs.
-#   make demo   build, then prove every model's physics with `gonio check --all`
+#   make demo   build, render scenes/demo.xml to out/demo.png, then prove every model's physics with `gonio check --all`
 #   make test   build, then run the Rust tests and the Python tests (incl. the Mitsuba 3 cross-checks)
 
 PYTHON ?= python3
@@ -33,8 +33,11 @@ python: venv
 	$(VPY) -c "import gonio; print('gonio', gonio.__version__, 'for Python installed in $(VENV):', ', '.join(gonio.plugins()))"
 
 demo: build
+	@mkdir -p out
+	./target/release/gonio render scenes/demo.xml -o out/demo.png --spp 64
+	@echo "demo: rendered scenes/demo.xml (paper, rough gold, glass, Oren-Nayar moon, aluminium) to out/demo.png"
 	./target/release/gonio check --all
-	@echo "demo: gonio check --all ran the verification harness (chi-square of sample against pdf, sample weights, reciprocity, energy conservation, NaN/Inf sweep) on every example model of every plugin; exit status 0 means every check passed."
+	@echo "demo: gonio check --all ran the verification harness (chi-square of sample against pdf, sample weights, reciprocity, energy conservation, NaN/Inf sweep) on every example model; exit status 0 means every check passed."
 
 test: build
 	$(CARGO) test --release -p gonio -p gonio-cli
