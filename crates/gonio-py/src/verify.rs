@@ -127,7 +127,9 @@ fn py_chi2(
 ) -> PyResult<PyChi2Result> {
     let wo = single_direction(wo, "wo")?;
     let samples = at_least_one("samples", samples)?;
-    require(theta_res >= 2 && theta_res % 2 == 0, || format!("`theta_res` must be even and at least 2 (the horizon is a cell edge), got {theta_res}"))?;
+    require(theta_res >= 2 && theta_res % 2 == 0, || {
+        format!("`theta_res` must be even and at least 2 (the horizon is a cell edge), got {theta_res}")
+    })?;
     let theta_res = at_least_one("theta_res", theta_res)?;
     let phi_res = at_least_one("phi_res", phi_res)?;
     require(significance > 0.0 && significance < 1.0, || format!("`significance` must be in (0, 1), got {significance}"))?;
@@ -178,7 +180,10 @@ impl PyReciprocityResult {
             Some((wo, wi)) => format!("wo={}, wi={}", wo.bind(py).str()?, wi.bind(py).str()?),
             None => "None".into(),
         };
-        Ok(format!("<gonio.verify.ReciprocityResult max_rel_error={:.3e} over {} pairs, worst at {worst}>", self.max_rel_error, self.compared))
+        Ok(format!(
+            "<gonio.verify.ReciprocityResult max_rel_error={:.3e} over {} pairs, worst at {worst}>",
+            self.max_rel_error, self.compared
+        ))
     }
 }
 
@@ -260,7 +265,8 @@ fn py_energy(py: Python<'_>, bsdf: &PyBsdf, angles: i64, samples: i64, seed: i64
         (curve, furnace)
     })?;
     // The same reduction as `gonio check`: the largest channel, first occurrence on ties.
-    let (mu, worst) = curve.iter().map(|(mu, a)| (*mu, a.max_component())).fold((0.0, f32::MIN), |acc, x| if x.1 > acc.1 { x } else { acc });
+    let (mu, worst) =
+        curve.iter().map(|(mu, a)| (*mu, a.max_component())).fold((0.0, f32::MIN), |acc, x| if x.1 > acc.1 { x } else { acc });
     Ok(PyEnergyResult {
         side,
         cos_theta_o: PyArray1::from_vec(py, curve.iter().map(|(mu, _)| f64::from(*mu)).collect()).into_any().unbind(),
@@ -387,7 +393,13 @@ impl PyReport {
         self.report
             .rows
             .iter()
-            .map(|r| PyCheckRow { check: r.check.clone(), measured: r.measured, limit: r.limit.clone(), passed: r.passed, detail: r.detail.clone() })
+            .map(|r| PyCheckRow {
+                check: r.check.clone(),
+                measured: r.measured,
+                limit: r.limit.clone(),
+                passed: r.passed,
+                detail: r.detail.clone(),
+            })
             .collect()
     }
 

@@ -225,3 +225,19 @@ def test_negative_counts_and_non_models_are_rejected(diffuse):
         verify.reciprocity(diffuse, seed=-1)
     with pytest.raises(TypeError):
         verify.check(DIFFUSE)
+
+
+def test_the_gil_is_released(diffuse):
+    """Another Python thread keeps running while a check computes."""
+    import threading
+    import time
+
+    done = threading.Event()
+    worker = threading.Thread(target=lambda: (verify.chi2(diffuse, WO, samples=2_000_000), done.set()))
+    ticks = 0
+    worker.start()
+    while not done.is_set():
+        ticks += 1
+        time.sleep(0.001)
+    worker.join()
+    assert ticks >= 10
