@@ -175,7 +175,8 @@ def test_check_fails_energy_of_a_phong_violation():
 
 @pytest.mark.parametrize("spec", [DIFFUSE, PHONG_GAIN, '{"type": "dielectric", "int_ior": 1.5}'])
 def test_check_matches_the_cli(spec):
-    """The same spec and seed give the same report as `gonio check --json`, figure for figure."""
+    """The same spec and seed give the same report as `gonio check --json`, figure for figure, and the same
+    table as `gonio check`."""
     if not CLI.exists():
         pytest.skip(f"{CLI} not built (cargo build --release -p gonio-cli, or set GONIO_CLI)")
     seed = 11
@@ -184,8 +185,11 @@ def test_check_matches_the_cli(spec):
     out = subprocess.run(args, capture_output=True, text=True, timeout=600)
     assert out.returncode in (0, 1), out.stderr
     cli = json.loads(out.stdout)
-    py = verify.check(gonio.load_bsdf(spec), samples=100_000, sweep=20_000, seed=seed).to_dict()
-    assert py == cli
+    report = verify.check(gonio.load_bsdf(spec), samples=100_000, sweep=20_000, seed=seed)
+    assert report.to_dict() == cli
+    # And str(report) is the table the CLI prints without --json.
+    table = subprocess.run([a for a in args if a != "--json"], capture_output=True, text=True, timeout=600)
+    assert table.stdout.startswith(str(report)) and table.stdout[len(str(report)):].endswith("BSDFs passed every check\n")
 
 
 # --- bad arguments -----------------------------------------------------------------------------------
