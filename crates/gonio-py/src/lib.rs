@@ -19,6 +19,8 @@ use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
+mod verify;
+
 create_exception!(
     gonio,
     SpecError,
@@ -35,7 +37,7 @@ fn spec_error(e: gonio::Error) -> PyErr {
 }
 
 /// Run `work` without the GIL, turning a panic (a gonio bug) into `RuntimeError`.
-fn run_released<T: Send>(py: Python<'_>, work: impl FnOnce() -> T + Send) -> PyResult<T> {
+pub(crate) fn run_released<T: Send>(py: Python<'_>, work: impl FnOnce() -> T + Send) -> PyResult<T> {
     py.allow_threads(|| catch_unwind(AssertUnwindSafe(work))).map_err(|payload| {
         let what = payload
             .downcast_ref::<&str>()
@@ -48,10 +50,10 @@ fn run_released<T: Send>(py: Python<'_>, work: impl FnOnce() -> T + Send) -> PyR
 
 /// An array argument read into f64 rows of `width` numbers: `rows.len() == n * width`, `batched` false
 /// for a single row given without the leading axis (shape `(width,)`, or `()` when `width == 1`).
-struct Rows {
+pub(crate) struct Rows {
     values: Vec<f64>,
-    n: usize,
-    batched: bool,
+    pub(crate) n: usize,
+    pub(crate) batched: bool,
 }
 
 /// Read `obj` (any array-like; float32 and float64 arrays are read without conversion) as rows of
@@ -104,7 +106,7 @@ fn broadcast(args: &[(&str, &Rows)]) -> PyResult<(usize, bool)> {
 }
 
 /// Directions as `Vec3`s, checked: finite, and unit length unless `normalize` (then non-zero).
-fn read_directions(obj: &Bound<'_, PyAny>, name: &str, normalize: bool) -> PyResult<(Rows, Vec<Vec3>)> {
+pub(crate) fn read_directions(obj: &Bound<'_, PyAny>, name: &str, normalize: bool) -> PyResult<(Rows, Vec<Vec3>)> {
     let rows = read_rows(obj, name, 3)?;
     let mut dirs = Vec::with_capacity(rows.n);
     for (i, w) in rows.values.chunks_exact(3).enumerate() {
@@ -172,10 +174,10 @@ fn column<'py, T: numpy::Element>(py: Python<'py>, values: Vec<T>, batched: bool
 /// given in the local shading frame, normal = +z. `f` excludes the cosine (Mitsuba's `eval` is
 /// `f · |cos θi|`).
 #[pyclass(module = "gonio._gonio", name = "Bsdf", frozen)]
-struct PyBsdf {
-    bsdf: Bsdf,
+pub(crate) struct PyBsdf {
+    pub(crate) bsdf: Bsdf,
     /// The description it was built from, for `__repr__`.
-    spec: String,
+    pub(crate) spec: String,
 }
 
 #[pymethods]
@@ -395,6 +397,7 @@ fn _gonio(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(from_xml, m)?)?;
     m.add_function(wrap_pyfunction!(plugins, m)?)?;
     m.add_function(wrap_pyfunction!(examples, m)?)?;
+    verify::register(m)?;
     for (name, bit) in [
         ("FLAG_REFLECTION", BsdfFlags::REFLECTION),
         ("FLAG_TRANSMISSION", BsdfFlags::TRANSMISSION),

@@ -246,3 +246,77 @@ def test_docstring_examples():
 def test_spec_error_is_public():
     assert gonio.SpecError.__module__ == "gonio"
     assert issubclass(gonio.SpecError, ValueError)
+
+
+# --- torrance_sparrow (no Mitsuba equivalent: smoke tests of the API) ----------------------------------
+
+TS_ETA, TS_K = [0.2, 0.9, 1.1], [3.9, 2.4, 1.8]
+
+
+@pytest.mark.parametrize(
+    "spec",
+    [
+        {"type": "torrance_sparrow"},
+        {"type": "torrance_sparrow", "exponent": 100, "eta": TS_ETA, "k": TS_K},
+        {"type": "torrance_sparrow", "distribution": "beckmann", "alpha": 0.3, "shadowing": "smith"},
+        {"type": "torrance_sparrow", "distribution": "ggx", "alpha_u": 0.1, "alpha_v": 0.4,
+         "shadowing": "smith_correlated", "sample_visible": False},
+        {"type": "torrance_sparrow", "distribution": "ggx", "alpha": 0.5, "shadowing": "none"},
+    ],
+)
+def test_torrance_sparrow_api(spec):
+    b = gonio.load_bsdf(spec)
+    assert b.plugin == "torrance_sparrow" and b.flags == gonio.BsdfFlags.REFLECTION | gonio.BsdfFlags.GLOSSY
+    wo, wi = unit(500), unit(500)
+    f, pdf = b.f(wo, wi), b.pdf(wo, wi)
+    assert f.shape == (500, 3) and f.dtype == np.float32 and pdf.shape == (500,)
+    assert np.isfinite(f).all() and (f >= 0).all() and np.isfinite(pdf).all() and (pdf >= 0).all()
+    # One-sided: nothing from below.
+    assert (b.f(-wo, wi) == 0).all() and (b.pdf(-wo, wi) == 0).all()
+    s = b.sample(wo, RNG.random(500), RNG.random((500, 2)))
+    v = s.valid
+    assert v.sum() > 250 and (s.wi[v, 2] > 0).all()
+    np.testing.assert_allclose(s.pdf[v], b.pdf(wo[v], s.wi[v]), rtol=1e-5)
+    np.testing.assert_allclose(s.weight[v], b.f(wo[v], s.wi[v]) * s.wi[v, 2:3] / s.pdf[v, None], rtol=1e-4)
+    # Reciprocity of f.
+    np.testing.assert_allclose(b.f(wo, wi), b.f(wi, wo), rtol=1e-5, atol=1e-12)
+
+
+def test_torrance_sparrow_mirror_configuration():
+    """At normal incidence in the mirror configuration G = 1 and D = (e + 2)/(2π): f = F(1)·(e + 2)/(8π)."""
+    e = 100
+    b = gonio.load_bsdf({"type": "torrance_sparrow", "exponent": e})  # material none: F = 1
+    np.testing.assert_allclose(b.f([0, 0, 1], [0, 0, 1]), (e + 2) / (8 * np.pi), rtol=1e-5)
+
+
+def test_torrance_sparrow_with_smith_is_roughconductor():
+    common = {"alpha_u": 0.1, "alpha_v": 0.4, "eta": TS_ETA, "k": TS_K}
+    for distribution in ("beckmann", "ggx"):
+        ts = gonio.load_bsdf({"type": "torrance_sparrow", "distribution": distribution, "shadowing": "smith", **common})
+        rc = gonio.load_bsdf({"type": "roughconductor", "distribution": distribution, **common})
+        wo, wi = unit(300), unit(300)
+        np.testing.assert_array_equal(ts.f(wo, wi), rc.f(wo, wi))
+        np.testing.assert_array_equal(ts.pdf(wo, wi), rc.pdf(wo, wi))
+
+
+def test_torrance_sparrow_without_shadowing_gains_energy_at_grazing_angles():
+    """`shadowing = none` is the documented teaching switch: its albedo exceeds 1 near the horizon."""
+    spec = {"type": "torrance_sparrow", "distribution": "beckmann", "alpha": 0.5}
+    grazing = [np.sqrt(1 - 0.05**2), 0, 0.05]
+    with_g = gonio.load_bsdf({**spec, "shadowing": "vcavity"}).albedo(grazing, samples=100_000)
+    without = gonio.load_bsdf({**spec, "shadowing": "none"}).albedo(grazing, samples=100_000)
+    assert (with_g <= 1.001).all() and (without > 1.01).all()
+
+
+@pytest.mark.parametrize(
+    "spec, where",
+    [
+        ({"type": "torrance_sparrow", "shadowing": "walter"}, "shadowing"),
+        ({"type": "torrance_sparrow", "distribution": "phong"}, "distribution"),
+        ({"type": "torrance_sparrow", "alpha": 0.0}, "alpha"),
+        ({"type": "torrance_sparrow", "exponent": -1}, "exponent"),
+    ],
+)
+def test_torrance_sparrow_bad_parameters(spec, where):
+    with pytest.raises(gonio.SpecError, match=where):
+        gonio.load_bsdf(spec)

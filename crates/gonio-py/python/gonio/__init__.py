@@ -29,7 +29,7 @@ import enum
 import json
 from typing import Any, Mapping, Union
 
-from . import _gonio
+from . import _gonio, verify
 from ._gonio import Bsdf, BsdfSample, SpecError, examples, plugins
 
 __version__: str = _gonio.__version__
@@ -43,6 +43,7 @@ __all__ = [
     "examples",
     "load_bsdf",
     "plugins",
+    "verify",
 ]
 
 

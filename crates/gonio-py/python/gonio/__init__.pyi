@@ -6,6 +6,8 @@ from typing import Any, Mapping, Tuple, Union
 import numpy as np
 import numpy.typing as npt
 
+from . import verify as verify
+
 __version__: str
 
 ArrayLike = npt.ArrayLike
