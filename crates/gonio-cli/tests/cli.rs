@@ -69,7 +69,7 @@ fn nan_parameters_are_rejected() {
 fn check_all_passes_at_the_full_standard() {
     let out = gonio(&["check", "--all", "--json"]);
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("valid JSON");
-    let reports = v.as_array().unwrap();
+    let reports = v["examples"].as_array().unwrap();
     let failed: Vec<_> = reports.iter().filter(|r| r["passed"] != true).map(|r| r.to_string()).collect();
     assert!(failed.is_empty(), "{failed:#?}");
     assert_eq!(out.status.code(), Some(0));
@@ -81,5 +81,15 @@ fn check_all_passes_at_the_full_standard() {
         }
         let reciprocity = checks.iter().find(|c| c["check"] == "reciprocity").unwrap();
         assert!(reciprocity["measured"].as_f64().unwrap() < 1e-5);
+    }
+    // Every non-physical model kept for teaching fails the row it is known to break, and only that.
+    let violations = v["violations"].as_array().unwrap();
+    assert!(violations.len() >= 5, "{violations:#?}");
+    for r in violations {
+        assert_eq!(r["detected"], true, "{r}");
+        assert_eq!(r["passed"], false, "{r}");
+        let kind = r["expected_violation"].as_str().unwrap();
+        let checks = r["checks"].as_array().unwrap();
+        assert!(checks.iter().any(|c| c["check"].as_str().unwrap().starts_with(kind) && c["passed"] == false), "{r}");
     }
 }

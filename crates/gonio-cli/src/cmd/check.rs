@@ -1,7 +1,7 @@
 //! `gonio check BSDF` and `gonio check --all`.
 
 use crate::spec::load_bsdf;
-use gonio::verify::{check_named, test_directions, CheckConfig, Report};
+use gonio::verify::{check_named, expect_violation, test_directions, CheckConfig, Report};
 use gonio::{Bsdf, Error};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -33,12 +33,19 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> Result<ExitCode, Error> {
+    let load = |s: &'static str| Bsdf::from_json(s).map(|b| (s.to_string(), b));
     let models: Vec<(String, Bsdf)> = if args.all {
-        Bsdf::examples().into_iter().map(|s| Bsdf::from_json(s).map(|b| (s.to_string(), b))).collect::<Result<_, _>>()?
+        Bsdf::examples().into_iter().map(load).collect::<Result<_, _>>()?
     } else {
         let arg = args.bsdf.expect("clap requires BSDF unless --all");
         let bsdf = load_bsdf(&arg)?;
         vec![(arg, bsdf)]
+    };
+    // With --all, the non-physical models kept for teaching must fail the row they are known to break.
+    let violations: Vec<(String, Bsdf, &'static str)> = if args.all {
+        Bsdf::violations().into_iter().map(|(s, kind)| load(s).map(|(name, b)| (name, b, kind))).collect::<Result<_, _>>()?
+    } else {
+        Vec::new()
     };
     let mut cfg = CheckConfig {
         chi2_samples: args.samples,
@@ -48,7 +55,9 @@ pub fn run(args: Args) -> Result<ExitCode, Error> {
         ..CheckConfig::default()
     };
     // One family for the whole run: the Šidák correction covers every chi-square test of every model.
-    cfg.sidak_family = Some(models.iter().map(|(_, b)| test_directions(b).len()).sum());
+    cfg.sidak_family = Some(
+        models.iter().map(|(_, b)| test_directions(b)).chain(violations.iter().map(|(_, b, _)| test_directions(b))).map(|d| d.len()).sum(),
+    );
 
     let reports: Vec<Report> = models
         .iter()
@@ -61,12 +70,49 @@ pub fn run(args: Args) -> Result<ExitCode, Error> {
         })
         .collect();
     let failed = reports.iter().filter(|r| !r.passed()).count();
+
+    if !violations.is_empty() && !args.json {
+        println!("\nexpected violations (non-physical models kept for teaching)");
+    }
+    let detections: Vec<(Report, &str, Result<(), String>)> = violations
+        .iter()
+        .map(|(name, bsdf, kind)| {
+            let report = check_named(bsdf, name, &cfg);
+            let detected = expect_violation(&report, kind);
+            if !args.json {
+                print!("{}", report.to_table());
+                match &detected {
+                    Ok(()) => println!("  `{kind}`: violation detected"),
+                    Err(e) => println!("  `{kind}`: NOT DETECTED ({})", e.lines().next().unwrap_or_default()),
+                }
+            }
+            (report, *kind, detected)
+        })
+        .collect();
+    let missed = detections.iter().filter(|d| d.2.is_err()).count();
+
     if args.json {
         let all: Vec<_> = reports.iter().map(Report::to_json).collect();
-        let value = if args.all { serde_json::Value::Array(all) } else { all.into_iter().next().unwrap_or_default() };
+        let value = if args.all {
+            let violations: Vec<_> = detections
+                .iter()
+                .map(|(report, kind, detected)| {
+                    let mut v = report.to_json();
+                    v["expected_violation"] = serde_json::json!(kind);
+                    v["detected"] = serde_json::json!(detected.is_ok());
+                    v
+                })
+                .collect();
+            serde_json::json!({ "examples": all, "violations": violations })
+        } else {
+            all.into_iter().next().unwrap_or_default()
+        };
         println!("{}", serde_json::to_string_pretty(&value).unwrap_or_default());
     } else {
         println!("{} of {} BSDFs passed every check", reports.len() - failed, reports.len());
+        if !detections.is_empty() {
+            println!("{} of {} expected violations detected", detections.len() - missed, detections.len());
+        }
     }
-    Ok(if failed == 0 { ExitCode::SUCCESS } else { ExitCode::from(1) })
+    Ok(if failed == 0 && missed == 0 { ExitCode::SUCCESS } else { ExitCode::from(1) })
 }

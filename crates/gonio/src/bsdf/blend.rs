@@ -29,12 +29,6 @@ pub struct BlendBsdf {
 }
 
 impl BlendBsdf {
-    pub const EXAMPLES: &'static [&'static str] = &[
-        r#"{"type": "blendbsdf", "a": {"type": "diffuse"}, "b": {"type": "conductor", "material": "Au"}}"#,
-        r#"{"type": "blendbsdf", "weight": 0.9, "a": {"type": "diffuse", "reflectance": 1}, "b": {"type": "dielectric"}}"#,
-        r#"{"type": "blendbsdf", "weight": 0.0, "a": {"type": "diffuse"}, "b": {"type": "thindielectric"}}"#,
-    ];
-
     /// (1 − weight)·first + weight·second.
     #[must_use]
     pub fn new(first: Bsdf, second: Bsdf, weight: f32) -> Self {
@@ -49,6 +43,14 @@ impl BlendBsdf {
         };
         Ok(BlendBsdf::new(Bsdf::from_props(first)?, Bsdf::from_props(second)?, weight))
     }
+}
+
+impl crate::bsdf::Examples for BlendBsdf {
+    const EXAMPLES: &'static [&'static str] = &[
+        r#"{"type": "blendbsdf", "a": {"type": "diffuse"}, "b": {"type": "conductor", "material": "Au"}}"#,
+        r#"{"type": "blendbsdf", "weight": 0.9, "a": {"type": "diffuse", "reflectance": 1}, "b": {"type": "dielectric"}}"#,
+        r#"{"type": "blendbsdf", "weight": 0.0, "a": {"type": "diffuse"}, "b": {"type": "thindielectric"}}"#,
+    ];
 }
 
 impl BsdfModel for BlendBsdf {
@@ -68,6 +70,8 @@ impl BsdfModel for BlendBsdf {
 
 #[cfg(test)]
 mod tests {
+    #[allow(unused_imports)]
+    use crate::bsdf::Examples;
     use super::*;
 
     #[test]

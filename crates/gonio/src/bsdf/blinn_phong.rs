@@ -99,23 +99,6 @@ impl GlossyLobe for BlinnPhongLobe {
 pub type BlinnPhong = DiffuseGlossy<BlinnPhongLobe>;
 
 impl DiffuseGlossy<BlinnPhongLobe> {
-    /// Specs that `gonio check --all` must pass.
-    pub const EXAMPLES: &'static [&'static str] = &[
-        r#"{"type": "blinn_phong"}"#,
-        r#"{"type": "blinn_phong", "diffuse_reflectance": 0.0, "specular_reflectance": 0.9, "exponent": 8}"#,
-        r#"{"type": "blinn_phong", "diffuse_reflectance": [0.6, 0.3, 0.1], "specular_reflectance": 0.3, "exponent": 80}"#,
-        r#"{"type": "blinn_phong", "diffuse_reflectance": 0.2, "specular_reflectance": 0.25, "exponent": 1, "normalization": "none"}"#,
-    ];
-
-    /// Specs that break physics on purpose, with the check row that must catch them.
-    pub const VIOLATIONS: &'static [(&'static str, &'static str)] = &[
-        (
-            r#"{"type": "blinn_phong", "diffuse_reflectance": 0.5, "specular_reflectance": 0.5, "exponent": 1, "normalization": "none"}"#,
-            "albedo max",
-        ),
-        (r#"{"type": "blinn_phong", "diffuse_reflectance": 0.0, "specular_reflectance": 1.0, "exponent": 8}"#, "albedo max"),
-    ];
-
     /// The Blinn–Phong model with the given reflectances and lobe.
     #[must_use]
     pub fn blinn_phong(kd: Rgb, ks: Rgb, exponent: f32, normalization: Normalization) -> Self {
@@ -133,8 +116,30 @@ impl DiffuseGlossy<BlinnPhongLobe> {
     }
 }
 
+impl crate::bsdf::Examples for DiffuseGlossy<BlinnPhongLobe> {
+    /// Specs that `gonio check --all` must pass.
+    const EXAMPLES: &'static [&'static str] = &[
+        r#"{"type": "blinn_phong"}"#,
+        r#"{"type": "blinn_phong", "diffuse_reflectance": 0.0, "specular_reflectance": 0.9, "exponent": 8}"#,
+        r#"{"type": "blinn_phong", "diffuse_reflectance": [0.6, 0.3, 0.1], "specular_reflectance": 0.3, "exponent": 80}"#,
+        r#"{"type": "blinn_phong", "exponent": 1000}"#,
+        r#"{"type": "blinn_phong", "diffuse_reflectance": 0.2, "specular_reflectance": 0.25, "exponent": 1, "normalization": "none"}"#,
+    ];
+
+    /// Specs that break physics on purpose, with the check row that must catch them.
+    const VIOLATIONS: &'static [(&'static str, &'static str)] = &[
+        (
+            r#"{"type": "blinn_phong", "diffuse_reflectance": 0.5, "specular_reflectance": 0.5, "exponent": 1, "normalization": "none"}"#,
+            "albedo max",
+        ),
+        (r#"{"type": "blinn_phong", "diffuse_reflectance": 0.0, "specular_reflectance": 1.0, "exponent": 8}"#, "albedo max"),
+    ];
+}
+
 #[cfg(test)]
 mod tests {
+    #[allow(unused_imports)]
+    use crate::bsdf::Examples;
     use super::super::glossy_mix::testing::{assert_passes, assert_violation_detected, hemisphere_integral};
     use super::*;
     use crate::bsdf::BsdfModel;

@@ -36,13 +36,6 @@ pub struct Conductor {
 }
 
 impl Conductor {
-    pub const EXAMPLES: &'static [&'static str] = &[
-        r#"{"type": "conductor"}"#,
-        r#"{"type": "conductor", "material": "Au"}"#,
-        r#"{"type": "conductor", "material": "Cu", "specular_reflectance": [0.2, 0.5, 1.0]}"#,
-        r#"{"type": "conductor", "eta": [0.001, 1, 40], "k": [0, 0.001, 100]}"#,
-    ];
-
     /// A conductor with complex index `eta + i k`.
     #[must_use]
     pub fn new(eta: Rgb, k: Rgb) -> Self {
@@ -91,6 +84,15 @@ impl Conductor {
         };
         fresnel * self.specular_reflectance
     }
+}
+
+impl crate::bsdf::Examples for Conductor {
+    const EXAMPLES: &'static [&'static str] = &[
+        r#"{"type": "conductor"}"#,
+        r#"{"type": "conductor", "material": "Au"}"#,
+        r#"{"type": "conductor", "material": "Cu", "specular_reflectance": [0.2, 0.5, 1.0]}"#,
+        r#"{"type": "conductor", "eta": [0.001, 1, 40], "k": [0, 0.001, 100]}"#,
+    ];
 }
 
 impl BsdfModel for Conductor {

@@ -45,15 +45,6 @@ pub struct Dielectric {
 }
 
 impl Dielectric {
-    pub const EXAMPLES: &'static [&'static str] = &[
-        r#"{"type": "dielectric"}"#,
-        r#"{"type": "dielectric", "int_ior": "diamond"}"#,
-        r#"{"type": "dielectric", "int_ior": 1.0, "ext_ior": 1.5}"#,
-        r#"{"type": "dielectric", "int_ior": 1.01}"#,
-        r#"{"type": "dielectric", "int_ior": 1.5, "fresnel": false}"#,
-        r#"{"type": "dielectric", "specular_transmittance": [0.2, 0.7, 0.9]}"#,
-    ];
-
     #[must_use]
     pub fn new(eta: f32) -> Self {
         Dielectric { eta, specular_reflectance: Rgb::ONE, specular_transmittance: Rgb::ONE, fresnel: true }
@@ -110,6 +101,17 @@ fn ior(p: &Props, name: &'static str, default: f32) -> Result<f32> {
     }
 }
 
+impl crate::bsdf::Examples for Dielectric {
+    const EXAMPLES: &'static [&'static str] = &[
+        r#"{"type": "dielectric"}"#,
+        r#"{"type": "dielectric", "int_ior": "diamond"}"#,
+        r#"{"type": "dielectric", "int_ior": 1.0, "ext_ior": 1.5}"#,
+        r#"{"type": "dielectric", "int_ior": 1.01}"#,
+        r#"{"type": "dielectric", "int_ior": 1.5, "fresnel": false}"#,
+        r#"{"type": "dielectric", "specular_transmittance": [0.2, 0.7, 0.9]}"#,
+    ];
+}
+
 impl BsdfModel for Dielectric {
     fn flags(&self) -> BsdfFlags {
         BsdfFlags::DELTA_REFLECTION | BsdfFlags::DELTA_TRANSMISSION
@@ -143,6 +145,8 @@ impl BsdfModel for Dielectric {
 
 #[cfg(test)]
 mod tests {
+    #[allow(unused_imports)]
+    use crate::bsdf::Examples;
     use super::*;
     use crate::fresnel::fresnel_dielectric;
 

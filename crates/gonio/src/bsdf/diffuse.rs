@@ -30,12 +30,6 @@ pub struct Diffuse {
 }
 
 impl Diffuse {
-    pub const EXAMPLES: &'static [&'static str] = &[
-        r#"{"type": "diffuse"}"#,
-        r#"{"type": "diffuse", "reflectance": [1, 1, 1]}"#,
-        r#"{"type": "diffuse", "reflectance": [0.9, 0.05, 0.0]}"#,
-    ];
-
     #[must_use]
     pub fn new(reflectance: Rgb) -> Self {
         Diffuse { reflectance }
@@ -44,6 +38,14 @@ impl Diffuse {
     pub fn from_props(p: &Props) -> Result<Self> {
         Ok(Diffuse::new(p.reflectance("reflectance", Rgb::splat(0.5))?))
     }
+}
+
+impl crate::bsdf::Examples for Diffuse {
+    const EXAMPLES: &'static [&'static str] = &[
+        r#"{"type": "diffuse"}"#,
+        r#"{"type": "diffuse", "reflectance": [1, 1, 1]}"#,
+        r#"{"type": "diffuse", "reflectance": [0.9, 0.05, 0.0]}"#,
+    ];
 }
 
 impl BsdfModel for Diffuse {

@@ -190,6 +190,15 @@ pub trait BsdfModel {
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32;
 }
 
+/// The specs every model is checked with by `cargo test` and `gonio check --all`: examples (defaults and
+/// extreme parameters) that must pass every check, and violations — non-physical forms kept for
+/// teaching — each with the kind of check row that must catch it (e.g. "reciprocity", "albedo max"; see
+/// [`crate::verify::expect_violation`]).
+pub trait Examples {
+    const EXAMPLES: &'static [&'static str];
+    const VIOLATIONS: &'static [(&'static str, &'static str)] = &[];
+}
+
 /// Declares the closed set of models: the enum, its `BsdfModel` forwarding, `From` conversions and the
 /// plugin-name table. Adding a model is one line here.
 macro_rules! bsdf_models {
@@ -243,7 +252,16 @@ macro_rules! bsdf_models {
             #[must_use]
             pub fn examples() -> Vec<&'static str> {
                 let mut all = Vec::new();
-                $( all.extend_from_slice(<$ty>::EXAMPLES); )*
+                $( all.extend_from_slice(<$ty as Examples>::EXAMPLES); )*
+                all
+            }
+
+            /// Non-physical specs per plugin with the check row that must fail for each, used by
+            /// `gonio check --all`.
+            #[must_use]
+            pub fn violations() -> Vec<(&'static str, &'static str)> {
+                let mut all = Vec::new();
+                $( all.extend_from_slice(<$ty as Examples>::VIOLATIONS); )*
                 all
             }
         }

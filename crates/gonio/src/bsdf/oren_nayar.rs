@@ -23,7 +23,7 @@
 //! The qualitative model conserves energy for ρ ≤ 1: by quadrature its albedo at ρ = 1 is 0.87 (σ = 20°,
 //! normal incidence) rising to 0.99 at grazing view, and lower for rougher surfaces. The full model does
 //! not: its inter-reflection term is an approximation, and at ρ = 1, σ = 20° the albedo reaches 1.04 at
-//! grazing view (the example in [`OrenNayar::VIOLATIONS`]). Its direct term also goes *negative* for
+//! grazing view (the example in its `VIOLATIONS`, see [`crate::bsdf::Examples`]). Its direct term also goes *negative* for
 //! rough surfaces (σ ≳ 45°) when both directions are near grazing with opposite azimuths (C₂'s
 //! −(2β/π)³ correction is smaller than the growth of tan β); f is clamped at 0 there. Both tan β and
 //! tan((α+β)/2) diverge as both directions reach the horizon (f·cos θi stays bounded); their cosines are
@@ -86,20 +86,6 @@ impl Geometry {
 }
 
 impl OrenNayar {
-    /// Specs that `gonio check --all` must pass.
-    pub const EXAMPLES: &'static [&'static str] = &[
-        r#"{"type": "oren_nayar"}"#,
-        r#"{"type": "oren_nayar", "reflectance": 1.0, "sigma": 0}"#,
-        r#"{"type": "oren_nayar", "reflectance": [1.0, 0.5, 0.1], "sigma": 90}"#,
-        r#"{"type": "oren_nayar", "reflectance": 0.8, "sigma": 30, "full": true}"#,
-        r#"{"type": "oren_nayar", "reflectance": 0.05, "sigma": 80, "full": true}"#,
-    ];
-
-    /// Specs that break physics, with the check row that must catch them: the full model's
-    /// inter-reflection approximation gains energy at grazing view for ρ = 1.
-    pub const VIOLATIONS: &'static [(&'static str, &'static str)] =
-        &[(r#"{"type": "oren_nayar", "reflectance": 1.0, "sigma": 20, "full": true}"#, "albedo max")];
-
     /// The model with albedo `reflectance` and slope-angle deviation `sigma` in radians.
     #[must_use]
     pub fn new(reflectance: Rgb, sigma: f32, full: bool) -> Self {
@@ -139,6 +125,22 @@ impl OrenNayar {
     }
 }
 
+impl crate::bsdf::Examples for OrenNayar {
+    /// Specs that `gonio check --all` must pass.
+    const EXAMPLES: &'static [&'static str] = &[
+        r#"{"type": "oren_nayar"}"#,
+        r#"{"type": "oren_nayar", "reflectance": 1.0, "sigma": 0}"#,
+        r#"{"type": "oren_nayar", "reflectance": [1.0, 0.5, 0.1], "sigma": 90}"#,
+        r#"{"type": "oren_nayar", "reflectance": 0.8, "sigma": 30, "full": true}"#,
+        r#"{"type": "oren_nayar", "reflectance": 0.05, "sigma": 80, "full": true}"#,
+    ];
+
+    /// Specs that break physics, with the check row that must catch them: the full model's
+    /// inter-reflection approximation gains energy at grazing view for ρ = 1.
+    const VIOLATIONS: &'static [(&'static str, &'static str)] =
+        &[(r#"{"type": "oren_nayar", "reflectance": 1.0, "sigma": 20, "full": true}"#, "albedo max")];
+}
+
 impl BsdfModel for OrenNayar {
     fn flags(&self) -> BsdfFlags {
         BsdfFlags::DIFFUSE_REFLECTION
@@ -174,6 +176,8 @@ impl BsdfModel for OrenNayar {
 
 #[cfg(test)]
 mod tests {
+    #[allow(unused_imports)]
+    use crate::bsdf::Examples;
     use super::super::glossy_mix::testing::{assert_passes, assert_violation_detected, hemisphere_integral};
     use super::*;
     use crate::bsdf::Diffuse;

@@ -113,26 +113,6 @@ impl GlossyLobe for PhongLobe {
 pub type Phong = DiffuseGlossy<PhongLobe>;
 
 impl DiffuseGlossy<PhongLobe> {
-    /// Specs that `gonio check --all` must pass.
-    pub const EXAMPLES: &'static [&'static str] = &[
-        r#"{"type": "phong"}"#,
-        r#"{"type": "phong", "diffuse_reflectance": 0.05, "specular_reflectance": 0.9, "exponent": 1}"#,
-        r#"{"type": "phong", "diffuse_reflectance": [0.6, 0.3, 0.1], "specular_reflectance": 0.3, "exponent": 60}"#,
-        r#"{"type": "phong", "diffuse_reflectance": 0.3, "specular_reflectance": 0.6, "exponent": 0}"#,
-    ];
-
-    /// Specs that break physics on purpose, with the check row that must catch them.
-    pub const VIOLATIONS: &'static [(&'static str, &'static str)] = &[
-        (
-            r#"{"type": "phong", "diffuse_reflectance": 0.5, "specular_reflectance": 0.5, "exponent": 1, "normalization": "none"}"#,
-            "albedo max",
-        ),
-        (
-            r#"{"type": "phong", "diffuse_reflectance": 0.2, "specular_reflectance": 0.6, "exponent": 20, "form": "original"}"#,
-            "reciprocity",
-        ),
-    ];
-
     /// The Phong model with the given reflectances and lobe.
     #[must_use]
     pub fn phong(kd: Rgb, ks: Rgb, exponent: f32, normalization: Normalization, form: PhongForm) -> Self {
@@ -152,8 +132,34 @@ impl DiffuseGlossy<PhongLobe> {
     }
 }
 
+impl crate::bsdf::Examples for DiffuseGlossy<PhongLobe> {
+    /// Specs that `gonio check --all` must pass.
+    const EXAMPLES: &'static [&'static str] = &[
+        r#"{"type": "phong"}"#,
+        r#"{"type": "phong", "diffuse_reflectance": 0.05, "specular_reflectance": 0.9, "exponent": 1}"#,
+        r#"{"type": "phong", "diffuse_reflectance": [0.6, 0.3, 0.1], "specular_reflectance": 0.3, "exponent": 60}"#,
+        r#"{"type": "phong", "diffuse_reflectance": 0.3, "specular_reflectance": 0.6, "exponent": 0}"#,
+        r#"{"type": "phong", "exponent": 500}"#,
+        r#"{"type": "phong", "exponent": 2000}"#,
+    ];
+
+    /// Specs that break physics on purpose, with the check row that must catch them.
+    const VIOLATIONS: &'static [(&'static str, &'static str)] = &[
+        (
+            r#"{"type": "phong", "diffuse_reflectance": 0.5, "specular_reflectance": 0.5, "exponent": 1, "normalization": "none"}"#,
+            "albedo max",
+        ),
+        (
+            r#"{"type": "phong", "diffuse_reflectance": 0.2, "specular_reflectance": 0.6, "exponent": 20, "form": "original"}"#,
+            "reciprocity",
+        ),
+    ];
+}
+
 #[cfg(test)]
 mod tests {
+    #[allow(unused_imports)]
+    use crate::bsdf::Examples;
     use super::super::glossy_mix::testing::{assert_passes, assert_violation_detected, hemisphere_integral};
     use super::*;
     use crate::bsdf::BsdfModel;

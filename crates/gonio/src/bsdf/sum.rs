@@ -35,12 +35,6 @@ pub struct Sum {
 }
 
 impl Sum {
-    pub const EXAMPLES: &'static [&'static str] = &[
-        r#"{"type": "sum", "weights": [0.7, 0.3], "base": {"type": "diffuse", "reflectance": 1.0}, "coat": {"type": "conductor"}}"#,
-        r#"{"type": "sum", "weights": [0.5, 0.5], "a": {"type": "diffuse"}, "b": {"type": "dielectric"}}"#,
-        r#"{"type": "sum", "weights": [1, 0], "a": {"type": "diffuse"}, "b": {"type": "conductor", "material": "Au"}}"#,
-    ];
-
     /// A sum of `components` with `weights` (non-negative, not all zero, as many as components).
     ///
     /// # Panics
@@ -99,6 +93,14 @@ impl Sum {
     }
 }
 
+impl crate::bsdf::Examples for Sum {
+    const EXAMPLES: &'static [&'static str] = &[
+        r#"{"type": "sum", "weights": [0.7, 0.3], "base": {"type": "diffuse", "reflectance": 1.0}, "coat": {"type": "conductor"}}"#,
+        r#"{"type": "sum", "weights": [0.5, 0.5], "a": {"type": "diffuse"}, "b": {"type": "dielectric"}}"#,
+        r#"{"type": "sum", "weights": [1, 0], "a": {"type": "diffuse"}, "b": {"type": "conductor", "material": "Au"}}"#,
+    ];
+}
+
 impl BsdfModel for Sum {
     fn flags(&self) -> BsdfFlags {
         self.components.iter().zip(&self.weights).filter(|(_, w)| **w > 0.0).fold(BsdfFlags::NONE, |acc, (c, _)| acc | c.flags())
@@ -126,6 +128,8 @@ impl BsdfModel for Sum {
 
 #[cfg(test)]
 mod tests {
+    #[allow(unused_imports)]
+    use crate::bsdf::Examples;
     use super::*;
 
     #[test]

@@ -43,12 +43,6 @@ pub struct ThinDielectric {
 }
 
 impl ThinDielectric {
-    pub const EXAMPLES: &'static [&'static str] = &[
-        r#"{"type": "thindielectric"}"#,
-        r#"{"type": "thindielectric", "int_ior": 2.4, "specular_reflectance": [1, 0.5, 0.2]}"#,
-        r#"{"type": "thindielectric", "int_ior": 1.0, "ext_ior": 1.0}"#,
-    ];
-
     pub fn from_props(p: &Props) -> Result<Self> {
         Ok(ThinDielectric {
             eta: relative_ior(p)?,
@@ -64,6 +58,14 @@ impl ThinDielectric {
         // Grazing light (R = 1) is reflected entirely: 2·1/(1+1) = 1, no special case needed.
         2.0 * r / (1.0 + r)
     }
+}
+
+impl crate::bsdf::Examples for ThinDielectric {
+    const EXAMPLES: &'static [&'static str] = &[
+        r#"{"type": "thindielectric"}"#,
+        r#"{"type": "thindielectric", "int_ior": 2.4, "specular_reflectance": [1, 0.5, 0.2]}"#,
+        r#"{"type": "thindielectric", "int_ior": 1.0, "ext_ior": 1.0}"#,
+    ];
 }
 
 impl BsdfModel for ThinDielectric {
@@ -95,6 +97,8 @@ impl BsdfModel for ThinDielectric {
 
 #[cfg(test)]
 mod tests {
+    #[allow(unused_imports)]
+    use crate::bsdf::Examples;
     use super::*;
 
     #[test]

@@ -33,11 +33,6 @@ fn flip(w: Vec3) -> Vec3 {
 }
 
 impl TwoSided {
-    pub const EXAMPLES: &'static [&'static str] = &[
-        r#"{"type": "twosided", "a": {"type": "diffuse"}}"#,
-        r#"{"type": "twosided", "a": {"type": "diffuse", "reflectance": 1}, "b": {"type": "conductor", "material": "Ag"}}"#,
-    ];
-
     /// `front` on the +z side, `back` (mirrored) on the −z side.
     #[must_use]
     pub fn new(front: Bsdf, back: Bsdf) -> Self {
@@ -71,6 +66,13 @@ impl TwoSided {
     }
 }
 
+impl crate::bsdf::Examples for TwoSided {
+    const EXAMPLES: &'static [&'static str] = &[
+        r#"{"type": "twosided", "a": {"type": "diffuse"}}"#,
+        r#"{"type": "twosided", "a": {"type": "diffuse", "reflectance": 1}, "b": {"type": "conductor", "material": "Ag"}}"#,
+    ];
+}
+
 impl BsdfModel for TwoSided {
     fn flags(&self) -> BsdfFlags {
         self.front.flags() | self.back.flags()
@@ -100,6 +102,8 @@ impl BsdfModel for TwoSided {
 
 #[cfg(test)]
 mod tests {
+    #[allow(unused_imports)]
+    use crate::bsdf::Examples;
     use super::*;
 
     #[test]

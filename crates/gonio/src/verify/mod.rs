@@ -289,6 +289,22 @@ pub fn check_named<M: BsdfModel + Sync + ?Sized>(bsdf: &M, name: &str, cfg: &Che
     Report { name: name.to_string(), rows }
 }
 
+/// Whether `report` shows the violation `row_kind` a non-physical model is kept to teach: some row whose
+/// check starts with `row_kind` (e.g. "reciprocity", "albedo max") fails, and every other row passes.
+/// For "albedo max" the white-furnace rows belong to the same energy violation and may fail with it.
+/// `Err` says what went wrong.
+pub fn expect_violation(report: &Report, row_kind: &str) -> Result<(), String> {
+    let related = |check: &str| check.starts_with(row_kind) || (row_kind == "albedo max" && check.starts_with("white furnace"));
+    if !report.rows.iter().any(|r| r.check.starts_with(row_kind) && !r.passed) {
+        return Err(format!("expected a `{row_kind}` violation:\n{}", report.to_table()));
+    }
+    let others: Vec<&str> = report.rows.iter().filter(|r| !related(&r.check) && !r.passed).map(|r| r.check.as_str()).collect();
+    if !others.is_empty() {
+        return Err(format!("only `{row_kind}` may fail, but so did {}:\n{}", others.join(", "), report.to_table()));
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -372,6 +388,17 @@ mod tests {
         let numeric_rows = text.lines().filter(|l| !l.starts_with('#') && !l.trim().is_empty()).count();
         assert_eq!(numeric_rows, 2 * chi2::Chi2Config::default().theta_res, "observed and expected matrices");
         std::fs::remove_dir_all(dir).unwrap();
+    }
+
+    #[test]
+    fn expected_violations_are_recognised() {
+        let gain = check(&Broken { gain: 1.2, skew: false, pdf_scale: 1.0 }, &CheckConfig::quick());
+        assert_eq!(expect_violation(&gain, "albedo max"), Ok(()));
+        assert!(expect_violation(&gain, "reciprocity").is_err());
+        let skew = check(&Broken { gain: 0.5, skew: true, pdf_scale: 1.0 }, &CheckConfig::quick());
+        assert_eq!(expect_violation(&skew, "reciprocity"), Ok(()));
+        let honest = check(&Broken { gain: 0.9, skew: false, pdf_scale: 1.0 }, &CheckConfig::quick());
+        assert!(expect_violation(&honest, "reciprocity").unwrap_err().contains("expected a `reciprocity` violation"));
     }
 
     #[test]
