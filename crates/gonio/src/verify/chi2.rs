@@ -380,7 +380,7 @@ fn pearson(bins: &[Bin]) -> f64 {
 /// Gauss–Legendre nodes and weights on [−1, 1]: the n roots of Pₙ by Newton's method from the
 /// Tricomi-style initial guess cos(π (i + 3/4) / (n + 1/2)), weights 2 / ((1 − x²) Pₙ′(x)²)
 /// (Abramowitz & Stegun 25.4.29).
-fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
+pub(crate) fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
     let n = n.max(1);
     let mut nodes = vec![0.0; n];
     let mut weights = vec![0.0; n];
