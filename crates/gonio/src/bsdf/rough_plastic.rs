@@ -31,6 +31,11 @@
 //! The glossy lobe with probability P = (1 − T(cos θo)) w / ((1 − T) w + T (1 − w)), w = s̄/(d̄ + s̄),
 //! else a cosine-weighted direction; pdf = P · pdf(ωm)/(4 ωo·ωm) + (1 − P) cos θi / π.
 //!
+//! # Compared with Mitsuba 3 (3.9.1, 400 random pairs, 2026-11)
+//! GGX: pdf within 3e-3, f within 1 % (α = 0.3) and 0.14 % (α = 1): a constant factor in the diffuse
+//! term, from Mitsuba's R̄ᵢ = 2·mean of Rᵢ(μ)μ over its 64 table points (including both ends) rather than
+//! an integral; Beckmann adds the G1 approximation (1.6 %).
+//!
 //! ```
 //! use gonio::bsdf::{Bsdf, BsdfModel};
 //! use gonio::math::{Vec2, Vec3};
