@@ -43,7 +43,11 @@ fn renders_exr_next_to_the_scene_and_png_on_request() {
 fn bad_scenes_exit_two_with_one_line() {
     let dir = temp_dir("bad");
     let scene = dir.join("bad.xml");
-    std::fs::write(&scene, SCENE.replace("<shape type=\"sphere\"/>", "<shape type=\"sphere\">\n<float name=\"radius\" value=\"-1\"/></shape>")).unwrap();
+    std::fs::write(
+        &scene,
+        SCENE.replace("<shape type=\"sphere\"/>", "<shape type=\"sphere\">\n<float name=\"radius\" value=\"-1\"/></shape>"),
+    )
+    .unwrap();
     let out = gonio(&["render", scene.to_str().unwrap(), "--quiet"]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{stderr}");

@@ -36,8 +36,20 @@ impl PerspectiveCamera {
         let aspect = width as f32 / height as f32;
         let t = (fov_deg.to_radians() * 0.5).tan();
         let axis = match axis {
-            "smaller" => if aspect > 1.0 { "y" } else { "x" },
-            "larger" => if aspect > 1.0 { "x" } else { "y" },
+            "smaller" => {
+                if aspect > 1.0 {
+                    "y"
+                } else {
+                    "x"
+                }
+            }
+            "larger" => {
+                if aspect > 1.0 {
+                    "x"
+                } else {
+                    "y"
+                }
+            }
             other => other,
         };
         let (tan_half_x, tan_half_y) = match axis {

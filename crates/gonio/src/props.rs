@@ -152,8 +152,15 @@ impl Props {
         let c = match &e.value {
             Value::Number(v) => [*v; 3],
             Value::List(l) if l.len() == 3 => [l[0], l[1], l[2]],
-            Value::Nested(t) if t.class == "texture" => return Err(Error::spec(&e.at, format!(
-                "textures are not yet supported: parameter `{name}` of `{}` is a `{}` texture; give a colour", self.plugin, t.plugin))),
+            Value::Nested(t) if t.class == "texture" => {
+                return Err(Error::spec(
+                    &e.at,
+                    format!(
+                        "textures are not yet supported: parameter `{name}` of `{}` is a `{}` texture; give a colour",
+                        self.plugin, t.plugin
+                    ),
+                ))
+            }
             _ => return Err(self.wrong(e, "a colour (a number or three numbers)")),
         };
         if c.iter().any(|v| !(*v >= lo as f64 && *v <= hi as f64)) {
@@ -432,7 +439,10 @@ impl Props {
             }
             if ctag == "ref" {
                 let id = env.required(child, "id", source)?;
-                let target = env.refs.get(&id).ok_or_else(|| Error::spec(&cat, format!("<ref id=\"{id}\">: no plugin with this id was declared before")))?;
+                let target = env
+                    .refs
+                    .get(&id)
+                    .ok_or_else(|| Error::spec(&cat, format!("<ref id=\"{id}\">: no plugin with this id was declared before")))?;
                 let key = name.unwrap_or_else(&mut auto_name);
                 props.set(&key, Value::Nested(target.clone()), &cat);
                 continue;
@@ -443,10 +453,15 @@ impl Props {
                 "transform" => Value::Transform(parse_transform(child, env, source)?),
                 "spectrum" => {
                     let c = parse_spectrum(child, env, source, tag == "emitter")?;
-                    if c.r() == c.g() && c.g() == c.b() { Value::Number(f64::from(c.r())) } else { Value::List(c.to_f64().to_vec()) }
+                    if c.r() == c.g() && c.g() == c.b() {
+                        Value::Number(f64::from(c.r()))
+                    } else {
+                        Value::List(c.to_f64().to_vec())
+                    }
                 }
                 "float" | "integer" | "boolean" | "string" | "rgb" => {
-                    let raw = env.attr(child, "value", source)?
+                    let raw = env
+                        .attr(child, "value", source)?
                         .ok_or_else(|| Error::spec(&cat, format!("<{ctag} name=\"{name}\"> needs a value attribute")))?;
                     let bad = |what: &str| Error::spec(&cat, format!("<{ctag} name=\"{name}\">: expected {what}, got \"{raw}\""));
                     match ctag {
@@ -477,7 +492,8 @@ impl Props {
 }
 
 /// Elements that describe a plugin (and may nest).
-const PLUGIN_TAGS: &[&str] = &["bsdf", "emitter", "texture", "shape", "sensor", "film", "sampler", "rfilter", "integrator", "medium", "phase", "volume"];
+const PLUGIN_TAGS: &[&str] =
+    &["bsdf", "emitter", "texture", "shape", "sensor", "film", "sampler", "rfilter", "integrator", "medium", "phase", "volume"];
 
 /// A parameter given as a number or a name (e.g. an index of refraction).
 #[derive(Clone, Debug, PartialEq)]

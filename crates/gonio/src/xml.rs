@@ -57,9 +57,8 @@ impl XmlEnv {
 
     /// A required attribute with parameters substituted.
     pub fn required(&self, node: roxmltree::Node, name: &str, source: &str) -> Result<String> {
-        self.attr(node, name, source)?.ok_or_else(|| {
-            Error::spec(xml_at(source, node), format!("<{}> needs a `{name}` attribute", node.tag_name().name()))
-        })
+        self.attr(node, name, source)?
+            .ok_or_else(|| Error::spec(xml_at(source, node), format!("<{}> needs a `{name}` attribute", node.tag_name().name())))
     }
 
     /// A file name resolved against the search paths (an absolute name is taken as is).
@@ -99,9 +98,10 @@ pub fn parse_vector(node: roxmltree::Node, env: &XmlEnv, source: &str, default: 
     let mut out = Vec3::splat(default);
     for (i, axis) in ["x", "y", "z"].iter().enumerate() {
         if let Some(v) = env.attr(node, axis, source)? {
-            out[i] = v.trim().parse::<f32>().map_err(|_| {
-                Error::spec(&at, format!("<{}>: attribute `{axis}` must be a number, got \"{v}\"", node.tag_name().name()))
-            })?;
+            out[i] = v
+                .trim()
+                .parse::<f32>()
+                .map_err(|_| Error::spec(&at, format!("<{}>: attribute `{axis}` must be a number, got \"{v}\"", node.tag_name().name())))?;
         }
     }
     Ok(out)
@@ -147,7 +147,10 @@ pub fn parse_spectrum(node: roxmltree::Node, env: &XmlEnv, source: &str, within_
             return Err(Error::spec(at, format!("<spectrum>: expected \"wavelength:value\", got \"{pair}\"")));
         };
         if wavelengths.last().is_some_and(|&prev| l <= prev) {
-            return Err(Error::spec(at, format!("<spectrum>: wavelengths must increase, {l} follows {}", wavelengths.last().unwrap_or(&0.0))));
+            return Err(Error::spec(
+                at,
+                format!("<spectrum>: wavelengths must increase, {l} follows {}", wavelengths.last().unwrap_or(&0.0)),
+            ));
         }
         wavelengths.push(l);
         values.push(v);
@@ -196,7 +199,8 @@ pub fn parse_transform(node: roxmltree::Node, env: &XmlEnv, source: &str) -> Res
                 };
                 let (origin, target) = (vec("origin")?, vec("target")?);
                 let up = if op.attribute("up").is_some() { vec("up")? } else { Vec3::Y };
-                Transform::look_at(origin, target, up).ok_or_else(|| bad("origin equals target, or `up` is parallel to the view direction"))?
+                Transform::look_at(origin, target, up)
+                    .ok_or_else(|| bad("origin equals target, or `up` is parallel to the view direction"))?
             }
             _ => return Err(bad("unknown transform operation (expected translate, rotate, scale, matrix or lookat)")),
         };
@@ -267,6 +271,9 @@ mod tests {
         let doc = roxmltree::Document::parse("<spectrum name=\"radiance\" value=\"400:0, 500:8, 600:15.6, 700:18.4\"/>").unwrap();
         let c = parse_spectrum(first(&doc), &env, "s.xml", true).unwrap();
         // Mitsuba 3.9.1 loads this area-light radiance as (20.7108, 10.8546, 2.77115).
-        assert!((c.r() / 20.7108 - 1.0).abs() < 2e-3 && (c.g() / 10.8546 - 1.0).abs() < 2e-3 && (c.b() / 2.77115 - 1.0).abs() < 5e-3, "{c}");
+        assert!(
+            (c.r() / 20.7108 - 1.0).abs() < 2e-3 && (c.g() / 10.8546 - 1.0).abs() < 2e-3 && (c.b() / 2.77115 - 1.0).abs() < 5e-3,
+            "{c}"
+        );
     }
 }

@@ -70,9 +70,9 @@ impl BsdfModel for BlendBsdf {
 
 #[cfg(test)]
 mod tests {
+    use super::*;
     #[allow(unused_imports)]
     use crate::bsdf::Examples;
-    use super::*;
 
     #[test]
     fn weight_follows_mitsuba_zero_is_first_one_is_second() {

@@ -74,7 +74,12 @@ impl Dielectric {
 /// Read `int_ior` / `ext_ior` (numbers > 0 or names from Mitsuba's table) and return their ratio.
 /// Shared by every model with a dielectric interface.
 pub(crate) fn relative_ior(p: &Props) -> Result<f32> {
-    let int_ior = ior(p, "int_ior", 1.5046)?;
+    relative_ior_with_default(p, 1.5046)
+}
+
+/// [`relative_ior`] with another default for `int_ior` (the plastics default to polypropylene, 1.49).
+pub(crate) fn relative_ior_with_default(p: &Props, int_default: f32) -> Result<f32> {
+    let int_ior = ior(p, "int_ior", int_default)?;
     let ext_ior = ior(p, "ext_ior", 1.000_277)?;
     Ok(int_ior / ext_ior)
 }
@@ -145,9 +150,9 @@ impl BsdfModel for Dielectric {
 
 #[cfg(test)]
 mod tests {
+    use super::*;
     #[allow(unused_imports)]
     use crate::bsdf::Examples;
-    use super::*;
     use crate::fresnel::fresnel_dielectric;
 
     fn glass() -> Dielectric {

@@ -32,7 +32,10 @@ pub mod diffuse;
 pub mod glossy_mix;
 pub mod oren_nayar;
 pub mod phong;
+pub mod plastic;
 pub mod rough_conductor;
+pub mod rough_dielectric;
+pub mod rough_plastic;
 pub mod sum;
 pub mod thin_dielectric;
 pub mod torrance_sparrow;
@@ -50,7 +53,10 @@ pub use dielectric::Dielectric;
 pub use diffuse::Diffuse;
 pub use oren_nayar::OrenNayar;
 pub use phong::Phong;
+pub use plastic::Plastic;
 pub use rough_conductor::{MicrofacetConductor, RoughConductor};
+pub use rough_dielectric::RoughDielectric;
+pub use rough_plastic::RoughPlastic;
 pub use sum::Sum;
 pub use thin_dielectric::ThinDielectric;
 pub use torrance_sparrow::TorranceSparrow;
@@ -274,6 +280,9 @@ bsdf_models! {
     RoughConductor(RoughConductor) = "roughconductor",
     TorranceSparrow(TorranceSparrow) = "torrance_sparrow",
     Dielectric(Dielectric) = "dielectric",
+    RoughDielectric(RoughDielectric) = "roughdielectric",
+    Plastic(Plastic) = "plastic",
+    RoughPlastic(RoughPlastic) = "roughplastic",
     ThinDielectric(ThinDielectric) = "thindielectric",
     Blend(BlendBsdf) = "blendbsdf",
     Sum(Sum) = "sum",

@@ -176,11 +176,11 @@ impl BsdfModel for OrenNayar {
 
 #[cfg(test)]
 mod tests {
-    #[allow(unused_imports)]
-    use crate::bsdf::Examples;
     use super::super::glossy_mix::testing::{assert_passes, assert_violation_detected, hemisphere_integral};
     use super::*;
     use crate::bsdf::Diffuse;
+    #[allow(unused_imports)]
+    use crate::bsdf::Examples;
     use crate::sampling::warp::sample_uniform_hemisphere;
     use crate::verify::energy::direction;
     use crate::verify::reciprocity::reciprocity;

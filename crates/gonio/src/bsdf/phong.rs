@@ -158,11 +158,11 @@ impl crate::bsdf::Examples for DiffuseGlossy<PhongLobe> {
 
 #[cfg(test)]
 mod tests {
-    #[allow(unused_imports)]
-    use crate::bsdf::Examples;
     use super::super::glossy_mix::testing::{assert_passes, assert_violation_detected, hemisphere_integral};
     use super::*;
     use crate::bsdf::BsdfModel;
+    #[allow(unused_imports)]
+    use crate::bsdf::Examples;
     use crate::verify::reciprocity::reciprocity;
 
     fn lobe_only(n: f32, normalization: Normalization, form: PhongForm) -> Phong {

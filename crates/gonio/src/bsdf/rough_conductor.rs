@@ -82,20 +82,7 @@ impl MicrofacetConductor {
 
     pub(crate) fn from_props(p: &Props, rules: &MicrofacetParams) -> Result<Self> {
         let plugin = p.plugin_type().to_string();
-        let kind = match p.string("distribution")? {
-            None => rules.default_kind,
-            Some(name) => MicrofacetKind::parse(&name).filter(|k| rules.kinds.contains(k)).ok_or_else(|| {
-                let names: Vec<&str> = rules.kinds.iter().map(|k| k.name()).collect();
-                Error::spec(p.at(), format!("parameter `distribution` of `{plugin}` must be one of {}, got `{name}`", names.join(", ")))
-            })?,
-        };
-        let (alpha_x, alpha_y) = read_roughness(p, rules)?;
-        if kind == MicrofacetKind::Blinn && alpha_x != alpha_y {
-            return Err(Error::spec(
-                p.at(),
-                format!("`{plugin}`: `alpha_u` ≠ `alpha_v` needs distribution beckmann or ggx (Blinn is isotropic)"),
-            ));
-        }
+        let distribution = read_distribution(p, rules)?;
         // Read `shadowing` only where it is a parameter, so that `finish` rejects it elsewhere.
         let shadowing = match rules.shadowing {
             None => Shadowing::Smith,
@@ -109,7 +96,7 @@ impl MicrofacetConductor {
         };
         let sample_visible = p.bool("sample_visible", true)?;
         let fresnel = Conductor::from_props(p)?;
-        Ok(MicrofacetConductor::new(MicrofacetDistribution::new(kind, alpha_x, alpha_y), shadowing, sample_visible, fresnel))
+        Ok(MicrofacetConductor::new(distribution, shadowing, sample_visible, fresnel))
     }
 
     /// f = F(ωo·ωh) D(ωh) G(ωo, ωi, ωh) / (4 cos θo cos θi) for both directions above the surface.
@@ -166,6 +153,27 @@ impl MicrofacetConductor {
         // carries no measurable energy (2026-11: seen at u = 0 with normal incidence in the NaN sweep).
         s.weight.is_finite().then_some(s)
     }
+}
+
+/// `distribution` (one of `rules.kinds`) and its roughness (see [`read_roughness`]). Shared by every
+/// microfacet plugin (`roughconductor`, `torrance_sparrow`, `roughdielectric`, `roughplastic`).
+pub(crate) fn read_distribution(p: &Props, rules: &MicrofacetParams) -> Result<MicrofacetDistribution> {
+    let plugin = p.plugin_type();
+    let kind = match p.string("distribution")? {
+        None => rules.default_kind,
+        Some(name) => MicrofacetKind::parse(&name).filter(|k| rules.kinds.contains(k)).ok_or_else(|| {
+            let names: Vec<&str> = rules.kinds.iter().map(|k| k.name()).collect();
+            Error::spec(p.at(), format!("parameter `distribution` of `{plugin}` must be one of {}, got `{name}`", names.join(", ")))
+        })?,
+    };
+    let (alpha_x, alpha_y) = read_roughness(p, rules)?;
+    if kind == MicrofacetKind::Blinn && alpha_x != alpha_y {
+        return Err(Error::spec(
+            p.at(),
+            format!("`{plugin}`: `alpha_u` ≠ `alpha_v` needs distribution beckmann or ggx (Blinn is isotropic)"),
+        ));
+    }
+    Ok(MicrofacetDistribution::new(kind, alpha_x, alpha_y))
 }
 
 /// `alpha`, or `alpha_u`/`alpha_v`, or (when allowed) the Blinn `exponent`; at most one of the three forms.
@@ -308,10 +316,10 @@ pub(crate) fn narrow_lobes_report(specs: &[&str]) {
 
 #[cfg(test)]
 mod tests {
-    #[allow(unused_imports)]
-    use crate::bsdf::Examples;
     use super::*;
     use crate::bsdf::Bsdf;
+    #[allow(unused_imports)]
+    use crate::bsdf::Examples;
     use crate::fresnel::fresnel_conductor;
     use crate::verify::{check_named, energy, CheckConfig};
 

@@ -128,9 +128,9 @@ impl BsdfModel for Sum {
 
 #[cfg(test)]
 mod tests {
+    use super::*;
     #[allow(unused_imports)]
     use crate::bsdf::Examples;
-    use super::*;
 
     #[test]
     fn mixture_of_smooth_and_delta_lobes() {

@@ -97,9 +97,9 @@ impl BsdfModel for ThinDielectric {
 
 #[cfg(test)]
 mod tests {
+    use super::*;
     #[allow(unused_imports)]
     use crate::bsdf::Examples;
-    use super::*;
 
     #[test]
     fn slab_reflectance_is_the_sum_of_the_interreflection_series() {

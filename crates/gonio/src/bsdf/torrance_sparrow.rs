@@ -110,10 +110,10 @@ impl BsdfModel for TorranceSparrow {
 
 #[cfg(test)]
 mod tests {
-    #[allow(unused_imports)]
-    use crate::bsdf::Examples;
     use super::*;
     use crate::bsdf::Bsdf;
+    #[allow(unused_imports)]
+    use crate::bsdf::Examples;
     use crate::verify::{check_named, energy, CheckConfig};
 
     #[test]

@@ -102,9 +102,9 @@ impl BsdfModel for TwoSided {
 
 #[cfg(test)]
 mod tests {
+    use super::*;
     #[allow(unused_imports)]
     use crate::bsdf::Examples;
-    use super::*;
 
     #[test]
     fn back_side_mirrors_the_front_or_uses_its_own_model() {

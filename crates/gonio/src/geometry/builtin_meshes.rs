@@ -39,12 +39,12 @@ pub fn cube(to_world: &Transform, flip_normals: bool, at: &str) -> Result<Mesh> 
     let (x, y, z) = (Vec3::X * 2.0, Vec3::Y * 2.0, Vec3::Z * 2.0);
     let m = Vec3::splat(-1.0);
     let quads = [
-        (Vec3::new(-1.0, -1.0, 1.0), x, y),  // +z
-        (m, y, x),                           // −z
-        (Vec3::new(1.0, -1.0, -1.0), y, z),  // +x
-        (m, z, y),                           // −x
-        (Vec3::new(-1.0, 1.0, -1.0), z, x),  // +y
-        (m, x, z),                           // −y
+        (Vec3::new(-1.0, -1.0, 1.0), x, y), // +z
+        (m, y, x),                          // −z
+        (Vec3::new(1.0, -1.0, -1.0), y, z), // +x
+        (m, z, y),                          // −x
+        (Vec3::new(-1.0, 1.0, -1.0), z, x), // +y
+        (m, x, z),                          // −y
     ];
     quads_to_mesh(&quads, to_world, flip_normals, at)
 }

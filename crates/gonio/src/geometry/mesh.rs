@@ -87,7 +87,9 @@ impl Mesh {
             }
         };
         let uvs = match uvs {
-            Some(uv) if uv.len() != n => return Err(Error::spec(at, format!("mesh has {} texture coordinates for {n} vertices", uv.len()))),
+            Some(uv) if uv.len() != n => {
+                return Err(Error::spec(at, format!("mesh has {} texture coordinates for {n} vertices", uv.len())))
+            }
             other => other,
         };
         let tri_areas: Vec<f32> = indices
@@ -249,7 +251,13 @@ mod tests {
 
     #[test]
     fn smooth_normals_of_a_tent_bisect_its_faces() {
-        let p = vec![Vec3::new(-1.0, 0.0, 0.0), Vec3::new(0.0, 0.0, 1.0), Vec3::new(0.0, 1.0, 1.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(1.0, 1.0, 0.0)];
+        let p = vec![
+            Vec3::new(-1.0, 0.0, 0.0),
+            Vec3::new(0.0, 0.0, 1.0),
+            Vec3::new(0.0, 1.0, 1.0),
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::new(1.0, 1.0, 0.0),
+        ];
         let idx = vec![[0, 1, 2], [1, 3, 4], [1, 4, 2]];
         let m = Mesh::from_file_data(p, None, None, idx, &Transform::IDENTITY, false, false, "t").unwrap();
         let n = m.normals.as_ref().unwrap()[1];

@@ -5,5 +5,5 @@ pub mod spherical;
 pub mod transform;
 
 pub use frame::Frame;
-pub use transform::Transform;
 pub use glam::{DVec3, Vec2, Vec3};
+pub use transform::Transform;

@@ -88,7 +88,10 @@ fn shape_from_props(p: &Props) -> Result<Shape> {
             let center = p.vector("center")?.unwrap_or(Vec3::ZERO);
             let radius = p.float_positive("radius", 1.0)?;
             Shape::Sphere(Sphere::new(center, radius, to_world, flip).ok_or_else(|| {
-                Error::spec(p.at_param("to_world"), "a sphere's `to_world` must scale uniformly (rotate, translate and scale by one factor)")
+                Error::spec(
+                    p.at_param("to_world"),
+                    "a sphere's `to_world` must scale uniformly (rotate, translate and scale by one factor)",
+                )
             })?)
         }
         "rectangle" => Shape::Mesh(rectangle(&to_world, flip, at)?),
@@ -101,7 +104,16 @@ fn shape_from_props(p: &Props) -> Result<Shape> {
             let flip_tex = if kind == "obj" { p.bool("flip_tex_coords", true)? } else { false };
             let data = super::mesh_files::load(kind, std::path::Path::new(&filename), p.at_param("filename"))?;
             let uvs = data.uvs.map(|uv| uv.into_iter().map(|t| if flip_tex { glam::Vec2::new(t.x, 1.0 - t.y) } else { t }).collect());
-            Shape::Mesh(Mesh::from_file_data(data.positions, data.normals, uvs, data.indices, &to_world, face_normals, flip, &format!("{at} ({filename})"))?)
+            Shape::Mesh(Mesh::from_file_data(
+                data.positions,
+                data.normals,
+                uvs,
+                data.indices,
+                &to_world,
+                face_normals,
+                flip,
+                &format!("{at} ({filename})"),
+            )?)
         }
         other => return Err(Error::spec(at, format!("unsupported shape `{other}` (gonio has: {SHAPES})"))),
     })

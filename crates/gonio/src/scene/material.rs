@@ -19,7 +19,10 @@ pub enum Material {
     /// parameter paths. Rebuilt at every hit from a copy of the template (`Props` tracks which parameters
     /// were read, so it is not `Sync`: the template sits behind a mutex held only for the copy). A slow,
     /// general path; models gain direct texture support as they need it, like `TexturedDiffuse`.
-    Textured { template: Mutex<Props>, textures: Vec<(Vec<String>, Texture)> },
+    Textured {
+        template: Mutex<Props>,
+        textures: Vec<(Vec<String>, Texture)>,
+    },
 }
 
 impl Material {

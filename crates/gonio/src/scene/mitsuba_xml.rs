@@ -92,7 +92,8 @@ impl Loader {
         if !root.has_tag_name("scene") {
             return Err(Error::spec(at, format!("expected a <scene> root element, found <{}>", root.tag_name().name())));
         }
-        let version = root.attribute("version").ok_or_else(|| Error::spec(&at, "<scene> needs a version attribute (e.g. version=\"3.0.0\")"))?;
+        let version =
+            root.attribute("version").ok_or_else(|| Error::spec(&at, "<scene> needs a version attribute (e.g. version=\"3.0.0\")"))?;
         if !version.split('.').next().is_some_and(|major| matches!(major, "0" | "2" | "3")) {
             return Err(Error::spec(&at, format!("unsupported scene version \"{version}\" (gonio reads Mitsuba 2 and 3 scenes)")));
         }

@@ -14,8 +14,8 @@ use crate::error::Result;
 use crate::film::FilmSpec;
 use crate::geometry::mesh::intersect_triangle;
 use crate::geometry::{Bvh, PrimHit, Ray, Shape, SurfaceInteraction};
-use glam::Vec3;
 use crate::light::Light;
+use glam::Vec3;
 use std::path::Path;
 
 /// Which integrator renders the scene.

@@ -61,20 +61,27 @@ impl Bitmap {
         let at = p.at_param("filename").to_string();
         let filename = p.string("filename")?.ok_or_else(|| Error::spec(p.at(), "`bitmap` needs a `filename`"))?;
         let mut image = read_image(Path::new(&filename))?;
-        let is_ldr = matches!(Path::new(&filename).extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref(), Some("png" | "jpg" | "jpeg"));
+        let is_ldr = matches!(
+            Path::new(&filename).extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref(),
+            Some("png" | "jpg" | "jpeg")
+        );
         if p.bool("raw", false)? && is_ldr {
             image.data.iter_mut().for_each(|v| *v = linear_to_srgb(*v));
         }
         let bilinear = match p.string("filter_type")?.as_deref() {
             None | Some("bilinear") => true,
             Some("nearest") => false,
-            Some(other) => return Err(Error::spec(p.at_param("filter_type"), format!("`filter_type` must be bilinear or nearest, got `{other}`"))),
+            Some(other) => {
+                return Err(Error::spec(p.at_param("filter_type"), format!("`filter_type` must be bilinear or nearest, got `{other}`")))
+            }
         };
         let wrap = match p.string("wrap_mode")?.as_deref() {
             None | Some("repeat") => Wrap::Repeat,
             Some("mirror") => Wrap::Mirror,
             Some("clamp") => Wrap::Clamp,
-            Some(other) => return Err(Error::spec(p.at_param("wrap_mode"), format!("`wrap_mode` must be repeat, mirror or clamp, got `{other}`"))),
+            Some(other) => {
+                return Err(Error::spec(p.at_param("wrap_mode"), format!("`wrap_mode` must be repeat, mirror or clamp, got `{other}`")))
+            }
         };
         if image.width == 0 || image.height == 0 {
             return Err(Error::spec(at, format!("`{filename}` has no pixels")));
@@ -123,7 +130,8 @@ mod tests {
     fn lookups_hit_texel_centres() {
         let mut data = vec![0.0; 3 * 4];
         data[3] = 1.0; // texel (1, 0) red
-        let b = Bitmap { image: Arc::new(Image { width: 2, height: 2, data }), bilinear: true, wrap: Wrap::Clamp, to_uv: Transform::IDENTITY };
+        let b =
+            Bitmap { image: Arc::new(Image { width: 2, height: 2, data }), bilinear: true, wrap: Wrap::Clamp, to_uv: Transform::IDENTITY };
         assert_eq!(b.eval(Vec2::new(0.75, 0.25)).r(), 1.0);
         assert!((b.eval(Vec2::new(0.5, 0.25)).r() - 0.5).abs() < 1e-6);
         assert_eq!(b.eval(Vec2::new(0.75, 0.75)).r(), 0.0);

@@ -398,7 +398,7 @@ fn pearson(bins: &[Bin]) -> f64 {
 /// Gauss–Legendre nodes and weights on [−1, 1]: the n roots of Pₙ by Newton's method from the
 /// Tricomi-style initial guess cos(π (i + 3/4) / (n + 1/2)), weights 2 / ((1 − x²) Pₙ′(x)²)
 /// (Abramowitz & Stegun 25.4.29).
-fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
+pub(crate) fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
     let n = n.max(1);
     let mut nodes = vec![0.0; n];
     let mut weights = vec![0.0; n];
@@ -570,7 +570,12 @@ impl Quadrature<'_> {
             let inside: Vec<(f64, f64)> = guide
                 .iter()
                 .copied()
-                .filter(|&(u, v)| (u >= qa[0] || qa[0] == a[0]) && (u < qa[1] || qa[1] == a[1]) && (v >= qb[0] || qb[0] == b[0]) && (v < qb[1] || qb[1] == b[1]))
+                .filter(|&(u, v)| {
+                    (u >= qa[0] || qa[0] == a[0])
+                        && (u < qa[1] || qa[1] == a[1])
+                        && (v >= qb[0] || qb[0] == b[0])
+                        && (v < qb[1] || qb[1] == b[1])
+                })
                 .collect();
             let part = self.integrate(qa, qb, depth + 1, &inside);
             total.value += part.value;
@@ -601,7 +606,14 @@ impl Grid {
 
     /// ∫ density over each cell, in `f64`, cells in parallel: adaptively (see the module docs), then
     /// again along the samples of cells whose observed count contradicts the first answer.
-    fn integrate(&self, density: &(dyn Fn(f64, f64) -> f64 + Sync), n: usize, tally: &Tally, samples: usize, names: [&str; 2]) -> CellIntegrals {
+    fn integrate(
+        &self,
+        density: &(dyn Fn(f64, f64) -> f64 + Sync),
+        n: usize,
+        tally: &Tally,
+        samples: usize,
+        names: [&str; 2],
+    ) -> CellIntegrals {
         let n = n.max(1);
         let quad = Quadrature { density, low: Rule::new(n), high: Rule::new(2 * n), samples: samples.max(1) as f64 };
         let mut cells: Vec<CellIntegral> = (0..self.len())
@@ -634,7 +646,8 @@ impl Grid {
         let guided: Vec<(usize, CellIntegral)> = suspect
             .par_iter()
             .map(|&(_, k)| {
-                let guide: Vec<(f64, f64)> = tally.points.iter().filter(|p| p.0 as usize == k).map(|p| (p.1, p.2)).take(GUIDE_POINTS).collect();
+                let guide: Vec<(f64, f64)> =
+                    tally.points.iter().filter(|p| p.0 as usize == k).map(|p| (p.1, p.2)).take(GUIDE_POINTS).collect();
                 let (a, b) = self.bounds(k);
                 (k, quad.integrate(a, b, 0, &guide))
             })
@@ -1269,11 +1282,15 @@ mod tests {
         // A lobe of exponent 3·10⁴ sampled around 60° but claimed around 61°.
         let tilt = |deg: f32| {
             let (s, c) = (deg.to_radians().sin(), deg.to_radians().cos());
-            (move |w: Vec3| Vec3::new(c * w.x + s * w.z, w.y, -s * w.x + c * w.z), move |w: Vec3| Vec3::new(c * w.x - s * w.z, w.y, s * w.x + c * w.z))
+            (
+                move |w: Vec3| Vec3::new(c * w.x + s * w.z, w.y, -s * w.x + c * w.z),
+                move |w: Vec3| Vec3::new(c * w.x - s * w.z, w.y, s * w.x + c * w.z),
+            )
         };
         let ((rotate, _), (_, unrotate)) = (tilt(60.0), tilt(61.0));
         let n = 3e4f32;
-        let r = chi2_warp(|u| rotate(sample_power_cosine_hemisphere(u, n)), |w| f64::from(power_cosine_hemisphere_pdf(unrotate(w), n)), &cfg);
+        let r =
+            chi2_warp(|u| rotate(sample_power_cosine_hemisphere(u, n)), |w| f64::from(power_cosine_hemisphere_pdf(unrotate(w), n)), &cfg);
         eprintln!("power cosine n = 3e4 sampled at 60°, pdf at 61°: {r}");
         assert!(!r.passed, "{r}");
     }
