@@ -15,6 +15,9 @@
 //! assert!(a.r() > a.b());
 //! ```
 
+// `!(x > 0.0)` is the deliberate NaN-rejecting form: it is true for NaN, where `x <= 0.0` is not.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 pub mod bsdf;
 pub mod camera;
 pub mod error;

@@ -156,9 +156,6 @@ impl<L: GlossyLobe> BsdfModel for DiffuseGlossy<L> {
 /// Test helpers shared by the models built on [`DiffuseGlossy`].
 #[cfg(test)]
 pub(super) mod testing {
-    use crate::bsdf::Bsdf;
-    use crate::verify::{check_named, CheckConfig, Report};
-
     /// ∫ g(ω) dω over the upper hemisphere by the midpoint rule in (θ, φ), in f64.
     pub fn hemisphere_integral(steps: usize, g: impl Fn(crate::math::Vec3) -> f64) -> f64 {
         let (dt, dp) = (std::f64::consts::FRAC_PI_2 / steps as f64, 2.0 * std::f64::consts::PI / (4 * steps) as f64);
@@ -172,24 +169,5 @@ pub(super) mod testing {
             }
         }
         sum
-    }
-
-    /// Runs the standard check on `spec` and asserts that it passes.
-    pub fn assert_passes(spec: &str) -> Report {
-        let b = Bsdf::from_json(spec).unwrap();
-        let report = check_named(&b, spec, &CheckConfig::default());
-        assert!(report.passed(), "{}", report.to_table());
-        report
-    }
-
-    /// Runs the standard check on `spec` and asserts that the violation `kind` is detected
-    /// ([`crate::verify::expect_violation`]).
-    pub fn assert_violation_detected(spec: &str, kind: &str) -> Report {
-        let b = Bsdf::from_json(spec).unwrap();
-        let report = check_named(&b, spec, &CheckConfig::default());
-        if let Err(e) = crate::verify::expect_violation(&report, kind) {
-            panic!("{spec}: {e}");
-        }
-        report
     }
 }

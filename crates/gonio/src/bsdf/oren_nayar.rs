@@ -176,7 +176,7 @@ impl BsdfModel for OrenNayar {
 
 #[cfg(test)]
 mod tests {
-    use super::super::glossy_mix::testing::{assert_passes, assert_violation_detected, hemisphere_integral};
+    use super::super::glossy_mix::testing::hemisphere_integral;
     use super::*;
     use crate::bsdf::Diffuse;
     #[allow(unused_imports)]
@@ -254,20 +254,5 @@ mod tests {
         let wi = direction(1e-3, std::f32::consts::PI);
         let f = on.f(wo, wi);
         assert!(f.min_component() >= 0.0 && f.is_finite(), "{f}");
-    }
-
-    #[test]
-    fn examples_pass_every_check() {
-        for spec in OrenNayar::EXAMPLES {
-            assert_passes(spec);
-        }
-    }
-
-    #[test]
-    fn violations_are_detected() {
-        for (spec, kind) in OrenNayar::VIOLATIONS {
-            let report = assert_violation_detected(spec, kind);
-            println!("{}", report.to_table());
-        }
     }
 }

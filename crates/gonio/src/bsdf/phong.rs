@@ -158,7 +158,7 @@ impl crate::bsdf::Examples for DiffuseGlossy<PhongLobe> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::glossy_mix::testing::{assert_passes, assert_violation_detected, hemisphere_integral};
+    use super::super::glossy_mix::testing::hemisphere_integral;
     use super::*;
     use crate::bsdf::BsdfModel;
     #[allow(unused_imports)]
@@ -259,21 +259,6 @@ mod tests {
             };
             let r = chi2_bsdf(b, direction(*mu, 0.3), &cfg);
             assert!(r.passed, "case {k}: {r}");
-        }
-    }
-
-    #[test]
-    fn examples_pass_every_check() {
-        for spec in Phong::EXAMPLES {
-            assert_passes(spec);
-        }
-    }
-
-    #[test]
-    fn violations_are_detected() {
-        for (spec, kind) in Phong::VIOLATIONS {
-            let report = assert_violation_detected(spec, kind);
-            println!("{}", report.to_table());
         }
     }
 }

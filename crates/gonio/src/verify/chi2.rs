@@ -1299,7 +1299,7 @@ mod tests {
     fn adaptive_quadrature_integrates_a_peak_between_the_nodes() {
         // A Gaussian bump of σ = 10⁻³ placed between the nodes of both rules on the unit square: the
         // rules see nothing at depth 0; guided by a point at the peak the integral is found.
-        let (x0, y0, sigma) = (0.3137, 0.7071, 1e-3);
+        let (x0, y0, sigma) = (0.3137, std::f64::consts::FRAC_1_SQRT_2, 1e-3);
         let density = move |x: f64, y: f64| {
             let r2 = (x - x0) * (x - x0) + (y - y0) * (y - y0);
             (-0.5 * r2 / (sigma * sigma)).exp() / (2.0 * PI * sigma * sigma)
