@@ -88,9 +88,14 @@ fn to_json(obj: &Bound<'_, PyAny>, at: &str) -> PyResult<serde_json::Value> {
     if obj.is_none() {
         return Err(SceneError::new_err(format!("{at}: None is not a parameter value")));
     }
-    let source = if obj.hasattr("matrix")? { obj.getattr("matrix")? } else { obj.clone() };
-    let np = obj.py().import("numpy")?;
-    let array = np.getattr("asarray")?.call1((&source, "float64")).map_err(|_| {
+    let asarray = obj.py().import("numpy")?.getattr("asarray")?;
+    let array = match asarray.call1((obj, "float64")) {
+        Ok(a) => Ok(a),
+        // A transform object is not an array itself; its matrix is.
+        Err(_) if obj.hasattr("matrix")? => asarray.call1((obj.getattr("matrix")?, "float64")),
+        Err(e) => Err(e),
+    }
+    .map_err(|_| {
         SceneError::new_err(format!(
             "{at}: a value of type `{}` is not a number, string, list, dict, array or transform",
             obj.get_type().name().map(|n| n.to_string()).unwrap_or_default()
@@ -356,9 +361,9 @@ fn load_dict(py: Python<'_>, scene: &Bound<'_, PyAny>) -> PyResult<PyScene> {
 /// array for a sensor's `to_world` — the matrix of Mitsuba's `<lookat>` (and of
 /// `ScalarTransform4f().look_at(...)`), computed exactly as gonio's XML loader does.
 #[pyfunction]
-#[pyo3(signature = (origin, target, up = (0.0, 1.0, 0.0)))]
-fn look_at<'py>(py: Python<'py>, origin: [f32; 3], target: [f32; 3], up: (f32, f32, f32)) -> PyResult<Bound<'py, PyAny>> {
-    let t = Transform::look_at(Vec3::from(origin), Vec3::from(target), Vec3::new(up.0, up.1, up.2))
+#[pyo3(signature = (origin, target, up = [0.0, 1.0, 0.0]))]
+fn look_at<'py>(py: Python<'py>, origin: [f32; 3], target: [f32; 3], up: [f32; 3]) -> PyResult<Bound<'py, PyAny>> {
+    let t = Transform::look_at(Vec3::from(origin), Vec3::from(target), Vec3::from(up))
         .ok_or_else(|| PyValueError::new_err("look_at: origin equals target, or `up` is parallel to the view direction"))?;
     let rows: Vec<f64> = t.matrix.transpose().to_cols_array().iter().map(|&v| f64::from(v)).collect();
     Ok(PyArray1::from_vec(py, rows).reshape([4, 4])?.into_any())
