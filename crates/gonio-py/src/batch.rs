@@ -3,6 +3,7 @@
 //! in parallel over chunks of rows on rayon's threads, and results are written straight into freshly
 //! allocated numpy arrays. Everything in the loop runs without the GIL.
 
+use gonio::math::Vec3;
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -104,6 +105,40 @@ impl Column<'_> {
     pub(crate) fn row3(&self, i: usize) -> [f64; 3] {
         [self.get(i, 0), self.get(i, 1), self.get(i, 2)]
     }
+
+    /// Rows `rows` as directions (see [`crate::to_direction`]) into `out` (cleared first); false when
+    /// any is not acceptable. One tight loop per storage type, without per-row dispatch, so that the
+    /// check of a million rows costs about what reading them does.
+    pub(crate) fn directions(&self, rows: std::ops::Range<usize>, normalize: bool, out: &mut Vec<Vec3>) -> bool {
+        out.clear();
+        if normalize || self.single {
+            // Rare or cheap: the general path.
+            for i in rows {
+                match crate::to_direction(self.row3(i), normalize) {
+                    Some(w) => out.push(w),
+                    None => return false,
+                }
+            }
+            return true;
+        }
+        let mut ok = true;
+        match self.data {
+            Slice::F32(s) => {
+                for w in s[3 * rows.start..3 * rows.end].chunks_exact(3) {
+                    let (x, y, z) = (f64::from(w[0]), f64::from(w[1]), f64::from(w[2]));
+                    ok &= crate::is_unit(x, y, z);
+                    out.push(Vec3::new(w[0], w[1], w[2]));
+                }
+            }
+            Slice::F64(s) => {
+                for w in s[3 * rows.start..3 * rows.end].chunks_exact(3) {
+                    ok &= crate::is_unit(w[0], w[1], w[2]);
+                    out.push(Vec3::new(w[0] as f32, w[1] as f32, w[2] as f32));
+                }
+            }
+        }
+        ok
+    }
 }
 
 /// The common row count of several arguments (1-row arguments broadcast), and whether any was batched.
@@ -126,14 +161,14 @@ pub(crate) fn broadcast(args: &[&Arg<'_>]) -> PyResult<(usize, bool)> {
     Ok((n, batched))
 }
 
-/// Run `row(i)` for every `i < n`, in parallel over chunks when there are many; true when every row
-/// succeeded. A chunk stops at its first failing row (the caller then finds and reports the first one).
-pub(crate) fn for_rows(n: usize, row: impl Fn(usize) -> bool + Sync) -> bool {
-    let chunk = |c: usize| (c * CHUNK..n.min((c + 1) * CHUNK)).all(&row);
+/// Run `chunk(rows)` over consecutive ranges of rows covering `0..n`, in parallel when there are many;
+/// true when every chunk succeeded (the caller then finds and reports the first failing row).
+pub(crate) fn for_chunks(n: usize, chunk: impl Fn(std::ops::Range<usize>) -> bool + Sync) -> bool {
+    let range = |c: usize| c * CHUNK..n.min((c + 1) * CHUNK);
     if n <= CHUNK {
-        chunk(0)
+        chunk(0..n)
     } else {
-        (0..n.div_ceil(CHUNK)).into_par_iter().all(chunk)
+        (0..n.div_ceil(CHUNK)).into_par_iter().all(|c| chunk(range(c)))
     }
 }
 

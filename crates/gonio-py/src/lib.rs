@@ -9,7 +9,7 @@
 //! bad arrays raise `ValueError` naming the offending row. A panic inside gonio (a bug) is caught and
 //! raised as `RuntimeError` rather than unwinding into the interpreter.
 
-use batch::{broadcast, finish, for_rows, output, Arg};
+use batch::{broadcast, finish, for_chunks, output, Arg};
 use gonio::bsdf::{Bsdf, BsdfFlags, BsdfModel, BsdfSample, PLUGINS};
 use gonio::math::{Vec2, Vec3};
 use gonio::Rgb;
@@ -63,18 +63,28 @@ fn to_direction(w: [f64; 3], normalize: bool) -> Option<Vec3> {
     if !w.iter().all(|v| v.is_finite()) {
         return None;
     }
-    let len = (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]).sqrt();
     if normalize {
+        let len = (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]).sqrt();
         // len ≥ 0 here; it is infinite when the squares overflow f64.
         if len == 0.0 || !len.is_finite() {
             return None;
         }
         Some(Vec3::new((w[0] / len) as f32, (w[1] / len) as f32, (w[2] / len) as f32))
-    } else if (len - 1.0).abs() > UNIT_TOLERANCE {
-        None
-    } else {
+    } else if is_unit(w[0], w[1], w[2]) {
         Some(Vec3::new(w[0] as f32, w[1] as f32, w[2] as f32))
+    } else {
+        None
     }
+}
+
+/// |(x, y, z)| within [`UNIT_TOLERANCE`] of 1, compared on the squared length (no square root); false for
+/// NaN or infinite components, whose squared length is NaN or infinite.
+#[inline]
+pub(crate) fn is_unit(x: f64, y: f64, z: f64) -> bool {
+    const LO: f64 = (1.0 - UNIT_TOLERANCE) * (1.0 - UNIT_TOLERANCE);
+    const HI: f64 = (1.0 + UNIT_TOLERANCE) * (1.0 + UNIT_TOLERANCE);
+    let l2 = x * x + y * y + z * z;
+    (LO..=HI).contains(&l2)
 }
 
 /// Why `to_direction` rejected `w`, given as row `i` of argument `name`.
@@ -151,11 +161,16 @@ impl PyBsdf {
         let (out, ptr) = output::<f32>(py, 3 * n);
         let (co, ci, bsdf) = (ao.column(), ai.column(), &self.bsdf);
         let ok = run_released(py, || {
-            for_rows(n, |i| {
-                let (Some(wo), Some(wi)) = (to_direction(co.row3(i), normalize), to_direction(ci.row3(i), normalize)) else { return false };
-                let c = bsdf.f(wo, wi);
-                // SAFETY: row i is written by this task only; 3i + 2 < 3n.
-                unsafe { (0..3).for_each(|k| ptr.write(3 * i + k, c.0[k])) };
+            for_chunks(n, |rows| {
+                let (mut wo, mut wi) = (Vec::with_capacity(rows.len()), Vec::with_capacity(rows.len()));
+                if !(co.directions(rows.clone(), normalize, &mut wo) && ci.directions(rows.clone(), normalize, &mut wi)) {
+                    return false;
+                }
+                for (j, i) in rows.enumerate() {
+                    let c = bsdf.f(wo[j], wi[j]);
+                    // SAFETY: row i is written by this task only; 3i + 2 < 3n.
+                    unsafe { (0..3).for_each(|k| ptr.write(3 * i + k, c.0[k])) };
+                }
                 true
             })
         })?;
@@ -174,10 +189,15 @@ impl PyBsdf {
         let (out, ptr) = output::<f32>(py, n);
         let (co, ci, bsdf) = (ao.column(), ai.column(), &self.bsdf);
         let ok = run_released(py, || {
-            for_rows(n, |i| {
-                let (Some(wo), Some(wi)) = (to_direction(co.row3(i), normalize), to_direction(ci.row3(i), normalize)) else { return false };
-                // SAFETY: index i is written by this task only.
-                unsafe { ptr.write(i, bsdf.pdf(wo, wi)) };
+            for_chunks(n, |rows| {
+                let (mut wo, mut wi) = (Vec::with_capacity(rows.len()), Vec::with_capacity(rows.len()));
+                if !(co.directions(rows.clone(), normalize, &mut wo) && ci.directions(rows.clone(), normalize, &mut wi)) {
+                    return false;
+                }
+                for (j, i) in rows.enumerate() {
+                    // SAFETY: index i is written by this task only.
+                    unsafe { ptr.write(i, bsdf.pdf(wo[j], wi[j])) };
+                }
                 true
             })
         })?;
@@ -210,31 +230,36 @@ impl PyBsdf {
         let (valid_out, valid_ptr) = output::<bool>(py, n);
         let (co, cuc, cu, bsdf) = (ao.column(), auc.column(), au.column(), &self.bsdf);
         let in_unit = |v: f64| (0.0..=1.0).contains(&v);
+        let sample_row = |wo: Vec3, i: usize| {
+            let (uc, u0, u1) = (cuc.get(i, 0), cu.get(i, 0), cu.get(i, 1));
+            if !(in_unit(uc) && in_unit(u0) && in_unit(u1)) {
+                return false;
+            }
+            let s = bsdf.sample(wo, uc as f32, Vec2::new(u0 as f32, u1 as f32));
+            let valid = s.is_some();
+            let s = s.unwrap_or(BsdfSample { wi: Vec3::ZERO, f: Rgb::ZERO, pdf: 0.0, weight: Rgb::ZERO, flags: BsdfFlags::NONE, eta: 0.0 });
+            // SAFETY: row i is written by this task only; every index is below the array's length.
+            unsafe {
+                let wi = s.wi.to_array();
+                for k in 0..3 {
+                    wi_ptr.write(3 * i + k, wi[k]);
+                    f_ptr.write(3 * i + k, s.f.0[k]);
+                    weight_ptr.write(3 * i + k, s.weight.0[k]);
+                }
+                pdf_ptr.write(i, s.pdf);
+                flags_ptr.write(i, s.flags.0);
+                eta_ptr.write(i, s.eta);
+                valid_ptr.write(i, valid);
+            }
+            true
+        };
         let ok = run_released(py, || {
-            for_rows(n, |i| {
-                let Some(wo) = to_direction(co.row3(i), normalize) else { return false };
-                let (uc, u0, u1) = (cuc.get(i, 0), cu.get(i, 0), cu.get(i, 1));
-                if !(in_unit(uc) && in_unit(u0) && in_unit(u1)) {
+            for_chunks(n, |rows| {
+                let mut wo = Vec::with_capacity(rows.len());
+                if !co.directions(rows.clone(), normalize, &mut wo) {
                     return false;
                 }
-                let s = bsdf.sample(wo, uc as f32, Vec2::new(u0 as f32, u1 as f32));
-                let valid = s.is_some();
-                let s =
-                    s.unwrap_or(BsdfSample { wi: Vec3::ZERO, f: Rgb::ZERO, pdf: 0.0, weight: Rgb::ZERO, flags: BsdfFlags::NONE, eta: 0.0 });
-                // SAFETY: row i is written by this task only; every index is below the array's length.
-                unsafe {
-                    let wi = s.wi.to_array();
-                    for k in 0..3 {
-                        wi_ptr.write(3 * i + k, wi[k]);
-                        f_ptr.write(3 * i + k, s.f.0[k]);
-                        weight_ptr.write(3 * i + k, s.weight.0[k]);
-                    }
-                    pdf_ptr.write(i, s.pdf);
-                    flags_ptr.write(i, s.flags.0);
-                    eta_ptr.write(i, s.eta);
-                    valid_ptr.write(i, valid);
-                }
-                true
+                rows.enumerate().all(|(j, i)| sample_row(wo[j], i))
             })
         })?;
         if !ok {
