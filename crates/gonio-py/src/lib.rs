@@ -240,9 +240,8 @@ impl PyBsdf {
             let s = s.unwrap_or(BsdfSample { wi: Vec3::ZERO, f: Rgb::ZERO, pdf: 0.0, weight: Rgb::ZERO, flags: BsdfFlags::NONE, eta: 0.0 });
             // SAFETY: row i is written by this task only; every index is below the array's length.
             unsafe {
-                let wi = s.wi.to_array();
-                for k in 0..3 {
-                    wi_ptr.write(3 * i + k, wi[k]);
+                for (k, wi) in s.wi.to_array().into_iter().enumerate() {
+                    wi_ptr.write(3 * i + k, wi);
                     f_ptr.write(3 * i + k, s.f.0[k]);
                     weight_ptr.write(3 * i + k, s.weight.0[k]);
                 }
