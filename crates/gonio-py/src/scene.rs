@@ -190,40 +190,38 @@ impl PyScene {
                 })
                 .map_err(|e| PyOSError::new_err(format!("cannot start the render thread: {e}")))?
         };
-        let finish_bar = |py: Python<'_>| -> PyResult<()> {
-            if let Some(b) = &bar {
-                b.call_method1("close", (done.load(Ordering::Relaxed),))?;
-            }
-            let _ = py;
-            Ok(())
-        };
+        // Wait for the worker, redrawing the bar and running Python's signal handlers. Any error here
+        // (Ctrl-C from `check_signals`, or raised inside the bar's Python code) cancels the render and
+        // joins the worker before it is returned, so no render keeps running behind the caller's back.
         let mut rx = rx;
-        let out = loop {
+        let waited: PyResult<_> = (|| loop {
             // The receiver is `Send` but not `Sync`: move it into the GIL-free closure and back.
             let (got, back) = py.allow_threads(move || (rx.recv_timeout(POLL), rx));
             rx = back;
             match got {
-                Ok(out) => break out,
+                Ok(out) => return Ok(out),
                 Err(mpsc::RecvTimeoutError::Timeout) => {}
                 Err(mpsc::RecvTimeoutError::Disconnected) => {
-                    let _ = py.allow_threads(|| worker.join());
                     return Err(pyo3::exceptions::PyRuntimeError::new_err(
                         "internal error in gonio: the render thread ended without a result",
-                    ));
+                    ))
                 }
             }
-            if let Err(e) = py.check_signals() {
-                cancel.store(true, Ordering::SeqCst);
-                let _ = py.allow_threads(|| worker.join());
-                finish_bar(py)?;
-                return Err(e);
-            }
+            py.check_signals()?;
             if let Some(b) = &bar {
                 b.call_method1("update", (done.load(Ordering::Relaxed),))?;
             }
-        };
+        })();
+        if waited.is_err() {
+            cancel.store(true, Ordering::SeqCst);
+        }
         let _ = py.allow_threads(|| worker.join());
-        finish_bar(py)?;
+        let closed = match &bar {
+            Some(b) => b.call_method1("close", (done.load(Ordering::Relaxed),)).map(drop),
+            None => Ok(()),
+        };
+        let out = waited?;
+        closed?;
         let out = out.map_err(panic_error)?;
         if out.nonfinite > 0 {
             let warn = py.import("warnings")?.getattr("warn")?;

@@ -289,3 +289,25 @@ def test_ctrl_c_interrupts_promptly_and_leaves_the_process_usable(scene_file):
     assert elapsed < 5.0, elapsed
     small = gonio.load_scene(scene_file)
     assert np.array_equal(small.render(seed=3, progress=False), small.render(seed=3, progress=False))
+
+
+def test_an_error_in_the_progress_bar_cancels_the_render(scene_file, monkeypatch):
+    # Ctrl-C may surface inside the bar's Python code rather than in check_signals; the render must
+    # stop either way, and the bar still be closed.
+    calls = []
+
+    class Interrupting:
+        def update(self, done):
+            calls.append("update")
+            raise KeyboardInterrupt
+
+        def close(self, done):
+            calls.append("close")
+
+    monkeypatch.setattr(_progress, "bar", lambda total, desc: Interrupting())
+    big = gonio.load_scene(scene_file, width=320, height=240)
+    start = time.monotonic()
+    with pytest.raises(KeyboardInterrupt):
+        big.render(spp=100_000, progress=True)
+    assert time.monotonic() - start < 5.0
+    assert calls == ["update", "close"]
