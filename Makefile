@@ -49,8 +49,9 @@ test-rust:
 test-python:
 	$(VPY) -m pytest -q -rxX crates/gonio-py/tests
 
-bench:
+bench: python
 	$(CARGO) bench -p gonio
+	$(VPY) bench/python_bsdf_vs_mitsuba.py
 
 fmt:
 	$(CARGO) fmt --all

@@ -9,16 +9,21 @@
 //! bad arrays raise `ValueError` naming the offending row. A panic inside gonio (a bug) is caught and
 //! raised as `RuntimeError` rather than unwinding into the interpreter.
 
+use batch::{broadcast, finish, for_chunks, output, Arg};
 use gonio::bsdf::{Bsdf, BsdfFlags, BsdfModel, BsdfSample, PLUGINS};
 use gonio::math::{Vec2, Vec3};
 use gonio::Rgb;
-use numpy::{PyArray1, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
+use numpy::{PyArray1, PyArrayDyn, PyUntypedArrayMethods};
 use pyo3::create_exception;
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
+use rayon::prelude::*;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
+mod batch;
+mod image;
+mod scene;
 mod verify;
 
 create_exception!(
@@ -38,134 +43,99 @@ fn spec_error(e: gonio::Error) -> PyErr {
 
 /// Run `work` without the GIL, turning a panic (a gonio bug) into `RuntimeError`.
 pub(crate) fn run_released<T: Send>(py: Python<'_>, work: impl FnOnce() -> T + Send) -> PyResult<T> {
-    py.allow_threads(|| catch_unwind(AssertUnwindSafe(work))).map_err(|payload| {
-        let what = payload
-            .downcast_ref::<&str>()
-            .map(|s| s.to_string())
-            .or_else(|| payload.downcast_ref::<String>().cloned())
-            .unwrap_or_else(|| "unknown panic".into());
-        PyRuntimeError::new_err(format!("internal error in gonio (please report): {what}"))
+    py.allow_threads(|| catch_unwind(AssertUnwindSafe(work))).map_err(panic_error)
+}
+
+/// A caught panic (a gonio bug) as `RuntimeError`.
+pub(crate) fn panic_error(payload: Box<dyn std::any::Any + Send>) -> PyErr {
+    let what = payload
+        .downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| payload.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "unknown panic".into());
+    PyRuntimeError::new_err(format!("internal error in gonio (please report): {what}"))
+}
+
+/// A direction as gonio takes it: finite and of unit length (within [`UNIT_TOLERANCE`]), or normalised
+/// when `normalize` (then it must be non-zero). `None` when it is not acceptable.
+#[inline]
+fn to_direction(w: [f64; 3], normalize: bool) -> Option<Vec3> {
+    if !w.iter().all(|v| v.is_finite()) {
+        return None;
+    }
+    if normalize {
+        let len = (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]).sqrt();
+        // len ≥ 0 here; it is infinite when the squares overflow f64.
+        if len == 0.0 || !len.is_finite() {
+            return None;
+        }
+        Some(Vec3::new((w[0] / len) as f32, (w[1] / len) as f32, (w[2] / len) as f32))
+    } else if is_unit(w[0], w[1], w[2]) {
+        Some(Vec3::new(w[0] as f32, w[1] as f32, w[2] as f32))
+    } else {
+        None
+    }
+}
+
+/// |(x, y, z)| within [`UNIT_TOLERANCE`] of 1, compared on the squared length (no square root); false for
+/// NaN or infinite components, whose squared length is NaN or infinite.
+#[inline]
+pub(crate) fn is_unit(x: f64, y: f64, z: f64) -> bool {
+    const LO: f64 = (1.0 - UNIT_TOLERANCE) * (1.0 - UNIT_TOLERANCE);
+    const HI: f64 = (1.0 + UNIT_TOLERANCE) * (1.0 + UNIT_TOLERANCE);
+    let l2 = x * x + y * y + z * z;
+    (LO..=HI).contains(&l2)
+}
+
+/// Why `to_direction` rejected `w`, given as row `i` of argument `name`.
+fn direction_error(name: &str, batched: bool, i: usize, w: [f64; 3], normalize: bool) -> PyErr {
+    let at = if batched { format!("{name}[{i}]") } else { name.to_string() };
+    let len = (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]).sqrt();
+    PyValueError::new_err(if !w.iter().all(|v| v.is_finite()) {
+        format!("{at} = {w:?} is not finite")
+    } else if normalize {
+        format!("{at} = {w:?} has zero or overflowing length and cannot be normalized")
+    } else {
+        format!("{at} = {w:?} is not a unit vector (|{name}| = {len}); pass normalize=True to normalize it")
     })
 }
 
-/// An array argument read into f64 rows of `width` numbers: `rows.len() == n * width`, `batched` false
-/// for a single row given without the leading axis (shape `(width,)`, or `()` when `width == 1`).
-pub(crate) struct Rows {
-    values: Vec<f64>,
-    pub(crate) n: usize,
-    pub(crate) batched: bool,
-}
-
-/// Read `obj` (any array-like; float32 and float64 arrays are read without conversion) as rows of
-/// `width` numbers. Accepted shapes: `(width,)` and `(N, width)`; for `width == 1` also `()` and `(N,)`.
-fn read_rows(obj: &Bound<'_, PyAny>, name: &str, width: usize) -> PyResult<Rows> {
-    let (values, shape): (Vec<f64>, Vec<usize>) = if let Ok(a) = obj.extract::<PyReadonlyArrayDyn<'_, f32>>() {
-        (a.as_array().iter().map(|&v| f64::from(v)).collect(), a.shape().to_vec())
-    } else if let Ok(a) = obj.extract::<PyReadonlyArrayDyn<'_, f64>>() {
-        (a.as_array().iter().copied().collect(), a.shape().to_vec())
-    } else {
-        let np = obj.py().import("numpy")?;
-        let converted = np
-            .getattr("asarray")?
-            .call1((obj, "float64"))
-            .map_err(|e| PyValueError::new_err(format!("`{name}` must be an array of numbers: {e}")))?;
-        let a = converted.extract::<PyReadonlyArrayDyn<'_, f64>>()?;
-        (a.as_array().iter().copied().collect(), a.shape().to_vec())
-    };
-    let (n, batched) = match (width, shape.as_slice()) {
-        (1, []) => (1, false),
-        (1, [n]) => (*n, true),
-        (w, [k]) if *k == w => (1, false),
-        (w, [n, k]) if *k == w => (*n, true),
-        _ => {
-            let expected = if width == 1 { "a number or shape (N,)".to_string() } else { format!("shape ({width},) or (N, {width})") };
-            return Err(PyValueError::new_err(format!("`{name}` must have {expected}, got shape {shape:?}")));
-        }
-    };
-    Ok(Rows { values, n, batched })
-}
-
-/// The common row count of several arguments (1-row arguments broadcast), and whether any was batched.
-fn broadcast(args: &[(&str, &Rows)]) -> PyResult<(usize, bool)> {
-    let batched = args.iter().any(|(_, r)| r.batched);
-    let mut n = 1;
-    for (_, r) in args {
-        if r.n != 1 {
-            if n != 1 && n != r.n {
-                let shapes: Vec<String> = args.iter().map(|(name, r)| format!("{name}: {} rows", r.n)).collect();
-                return Err(PyValueError::new_err(format!("cannot broadcast arguments together ({})", shapes.join(", "))));
-            }
-            n = r.n;
-        }
-    }
-    // numpy semantics: a (0, 3) argument broadcasts the others to zero rows.
-    if args.iter().any(|(_, r)| r.n == 0) {
-        n = 0;
-    }
-    Ok((n, batched))
-}
-
 /// Directions as `Vec3`s, checked: finite, and unit length unless `normalize` (then non-zero).
-pub(crate) fn read_directions(obj: &Bound<'_, PyAny>, name: &str, normalize: bool) -> PyResult<(Rows, Vec<Vec3>)> {
-    let rows = read_rows(obj, name, 3)?;
-    let mut dirs = Vec::with_capacity(rows.n);
-    for (i, w) in rows.values.chunks_exact(3).enumerate() {
-        let at = if rows.batched { format!("{name}[{i}]") } else { name.to_string() };
-        if !w.iter().all(|v| v.is_finite()) {
-            return Err(PyValueError::new_err(format!("{at} = {w:?} is not finite")));
+pub(crate) fn read_directions<'py>(obj: &Bound<'py, PyAny>, name: &'static str, normalize: bool) -> PyResult<(Arg<'py>, Vec<Vec3>)> {
+    let arg = Arg::read(obj, name, 3)?;
+    let col = arg.column();
+    let mut dirs = Vec::with_capacity(arg.n);
+    for i in 0..arg.n {
+        let w = col.row3(i);
+        dirs.push(to_direction(w, normalize).ok_or_else(|| direction_error(name, arg.batched, i, w, normalize))?);
+    }
+    Ok((arg, dirs))
+}
+
+/// The error for the first unacceptable row of the arguments (directions first, then numbers in
+/// [0, 1]), in argument order; called after a batched loop found that some row failed.
+fn first_bad_row(directions: &[&Arg<'_>], unit_numbers: &[&Arg<'_>], normalize: bool) -> PyErr {
+    for a in directions {
+        let col = a.column();
+        for i in 0..a.n {
+            let w = col.row3(i);
+            if to_direction(w, normalize).is_none() {
+                return direction_error(a.name, a.batched, i, w, normalize);
+            }
         }
-        let len = (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]).sqrt();
-        let w = if normalize {
-            // len ≥ 0 here; it is infinite when the squares overflow f64.
-            if len == 0.0 || !len.is_finite() {
-                return Err(PyValueError::new_err(format!("{at} = {w:?} has zero or overflowing length and cannot be normalized")));
+    }
+    for a in unit_numbers {
+        let col = a.column();
+        for i in 0..a.n {
+            for c in 0..a.width {
+                let v = col.get(i, c);
+                if !(0.0..=1.0).contains(&v) {
+                    return PyValueError::new_err(format!("{}[{i}] = {v} is outside [0, 1]", a.name));
+                }
             }
-            [w[0] / len, w[1] / len, w[2] / len]
-        } else {
-            if (len - 1.0).abs() > UNIT_TOLERANCE {
-                return Err(PyValueError::new_err(format!(
-                    "{at} = {w:?} is not a unit vector (|{name}| = {len}); pass normalize=True to normalize it"
-                )));
-            }
-            [w[0], w[1], w[2]]
-        };
-        dirs.push(Vec3::new(w[0] as f32, w[1] as f32, w[2] as f32));
+        }
     }
-    Ok((rows, dirs))
-}
-
-/// Row `i` of a broadcast argument.
-#[inline]
-fn pick<T: Copy>(v: &[T], i: usize) -> T {
-    if v.len() == 1 {
-        v[0]
-    } else {
-        v[i]
-    }
-}
-
-/// An (N, 3) float32 array from RGB rows, or shape (3,) when `!batched`.
-fn rgb_array<'py>(py: Python<'py>, rows: &[Rgb], batched: bool) -> PyResult<Bound<'py, PyAny>> {
-    let flat: Vec<f32> = rows.iter().flat_map(|c| c.0).collect();
-    let a = PyArray1::from_vec(py, flat);
-    Ok(if batched { a.reshape([rows.len(), 3])?.into_any() } else { a.into_any() })
-}
-
-/// An (N, 3) float32 array from directions, or shape (3,) when `!batched`.
-fn vec3_array<'py>(py: Python<'py>, rows: &[Vec3], batched: bool) -> PyResult<Bound<'py, PyAny>> {
-    let flat: Vec<f32> = rows.iter().flat_map(|w| w.to_array()).collect();
-    let a = PyArray1::from_vec(py, flat);
-    Ok(if batched { a.reshape([rows.len(), 3])?.into_any() } else { a.into_any() })
-}
-
-/// An (N,) array, or a numpy scalar when `!batched`.
-fn column<'py, T: numpy::Element>(py: Python<'py>, values: Vec<T>, batched: bool) -> PyResult<Bound<'py, PyAny>> {
-    let a = PyArray1::from_vec(py, values);
-    if batched {
-        Ok(a.into_any())
-    } else {
-        a.into_any().get_item(0)
-    }
+    PyRuntimeError::new_err("internal error in gonio: a row was rejected but every row is valid")
 }
 
 /// A reflection model. Build one with `gonio.load_bsdf`; evaluate it with `f`, `pdf`, `sample`, `albedo`.
@@ -186,28 +156,59 @@ impl PyBsdf {
     /// directions have shape (3,). Zero for delta lobes (see `sample`).
     #[pyo3(signature = (wo, wi, *, normalize = false))]
     fn f<'py>(&self, py: Python<'py>, wo: &Bound<'py, PyAny>, wi: &Bound<'py, PyAny>, normalize: bool) -> PyResult<Bound<'py, PyAny>> {
-        let (ro, wo) = read_directions(wo, "wo", normalize)?;
-        let (ri, wi) = read_directions(wi, "wi", normalize)?;
-        let (n, batched) = broadcast(&[("wo", &ro), ("wi", &ri)])?;
-        let bsdf = &self.bsdf;
-        let out = run_released(py, || (0..n).map(|i| bsdf.f(pick(&wo, i), pick(&wi, i))).collect::<Vec<Rgb>>())?;
-        rgb_array(py, &out, batched)
+        let (ao, ai) = (Arg::read(wo, "wo", 3)?, Arg::read(wi, "wi", 3)?);
+        let (n, batched) = broadcast(&[&ao, &ai])?;
+        let (out, ptr) = output::<f32>(py, 3 * n);
+        let (co, ci, bsdf) = (ao.column(), ai.column(), &self.bsdf);
+        let ok = run_released(py, || {
+            for_chunks(n, |rows| {
+                let (mut wo, mut wi) = (Vec::with_capacity(rows.len()), Vec::with_capacity(rows.len()));
+                if !(co.directions(rows.clone(), normalize, &mut wo) && ci.directions(rows.clone(), normalize, &mut wi)) {
+                    return false;
+                }
+                for (j, i) in rows.enumerate() {
+                    let c = bsdf.f(wo[j], wi[j]);
+                    // SAFETY: row i is written by this task only; 3i + 2 < 3n.
+                    unsafe { (0..3).for_each(|k| ptr.write(3 * i + k, c.0[k])) };
+                }
+                true
+            })
+        })?;
+        if !ok {
+            return Err(first_bad_row(&[&ao, &ai], &[], normalize));
+        }
+        finish(out, 3, batched)
     }
 
     /// The solid-angle density with which `sample` produces `wi` from `wo` (smooth lobes only), float32 of
     /// shape (N,), or a scalar when both directions have shape (3,).
     #[pyo3(signature = (wo, wi, *, normalize = false))]
     fn pdf<'py>(&self, py: Python<'py>, wo: &Bound<'py, PyAny>, wi: &Bound<'py, PyAny>, normalize: bool) -> PyResult<Bound<'py, PyAny>> {
-        let (ro, wo) = read_directions(wo, "wo", normalize)?;
-        let (ri, wi) = read_directions(wi, "wi", normalize)?;
-        let (n, batched) = broadcast(&[("wo", &ro), ("wi", &ri)])?;
-        let bsdf = &self.bsdf;
-        let out = run_released(py, || (0..n).map(|i| bsdf.pdf(pick(&wo, i), pick(&wi, i))).collect::<Vec<f32>>())?;
-        column(py, out, batched)
+        let (ao, ai) = (Arg::read(wo, "wo", 3)?, Arg::read(wi, "wi", 3)?);
+        let (n, batched) = broadcast(&[&ao, &ai])?;
+        let (out, ptr) = output::<f32>(py, n);
+        let (co, ci, bsdf) = (ao.column(), ai.column(), &self.bsdf);
+        let ok = run_released(py, || {
+            for_chunks(n, |rows| {
+                let (mut wo, mut wi) = (Vec::with_capacity(rows.len()), Vec::with_capacity(rows.len()));
+                if !(co.directions(rows.clone(), normalize, &mut wo) && ci.directions(rows.clone(), normalize, &mut wi)) {
+                    return false;
+                }
+                for (j, i) in rows.enumerate() {
+                    // SAFETY: index i is written by this task only.
+                    unsafe { ptr.write(i, bsdf.pdf(wo[j], wi[j])) };
+                }
+                true
+            })
+        })?;
+        if !ok {
+            return Err(first_bad_row(&[&ao, &ai], &[], normalize));
+        }
+        finish(out, 1, batched)
     }
 
     /// Sample `wi` given `wo` (shape (3,) or (N, 3)), `uc` (lobe choice; a number or shape (N,)) and `u`
-    /// (direction; shape (2,) or (N, 2)), all in [0, 1). Returns a `BsdfSample` of arrays; rows where the
+    /// (direction; shape (2,) or (N, 2)), all in [0, 1]. Returns a `BsdfSample` of arrays; rows where the
     /// model does not scatter have `valid == False` and zeros elsewhere.
     #[pyo3(signature = (wo, uc, u, *, normalize = false))]
     fn sample<'py>(
@@ -218,39 +219,65 @@ impl PyBsdf {
         u: &Bound<'py, PyAny>,
         normalize: bool,
     ) -> PyResult<PySample> {
-        let (ro, wo) = read_directions(wo, "wo", normalize)?;
-        let ruc = read_rows(uc, "uc", 1)?;
-        let ru = read_rows(u, "u", 2)?;
-        let (n, batched) = broadcast(&[("wo", &ro), ("uc", &ruc), ("u", &ru)])?;
-        let ucs: Vec<f32> = ruc.values.iter().map(|&v| v as f32).collect();
-        let us: Vec<Vec2> = ru.values.chunks_exact(2).map(|v| Vec2::new(v[0] as f32, v[1] as f32)).collect();
-        for (name, vals) in [("uc", &ruc.values), ("u", &ru.values)] {
-            if let Some(i) = vals.iter().position(|v| !(0.0..=1.0).contains(v)) {
-                let row = if name == "u" { i / 2 } else { i };
-                return Err(PyValueError::new_err(format!("{name}[{row}] = {} is outside [0, 1]", vals[i])));
+        let (ao, auc, au) = (Arg::read(wo, "wo", 3)?, Arg::read(uc, "uc", 1)?, Arg::read(u, "u", 2)?);
+        let (n, batched) = broadcast(&[&ao, &auc, &au])?;
+        let (wi_out, wi_ptr) = output::<f32>(py, 3 * n);
+        let (f_out, f_ptr) = output::<f32>(py, 3 * n);
+        let (pdf_out, pdf_ptr) = output::<f32>(py, n);
+        let (weight_out, weight_ptr) = output::<f32>(py, 3 * n);
+        let (flags_out, flags_ptr) = output::<u32>(py, n);
+        let (eta_out, eta_ptr) = output::<f32>(py, n);
+        let (valid_out, valid_ptr) = output::<bool>(py, n);
+        let (co, cuc, cu, bsdf) = (ao.column(), auc.column(), au.column(), &self.bsdf);
+        let in_unit = |v: f64| (0.0..=1.0).contains(&v);
+        let sample_row = |wo: Vec3, i: usize| {
+            let (uc, u0, u1) = (cuc.get(i, 0), cu.get(i, 0), cu.get(i, 1));
+            if !(in_unit(uc) && in_unit(u0) && in_unit(u1)) {
+                return false;
             }
-        }
-        let bsdf = &self.bsdf;
-        let samples = run_released(py, || {
-            (0..n).map(|i| bsdf.sample(pick(&wo, i), pick(&ucs, i), pick(&us, i))).collect::<Vec<Option<BsdfSample>>>()
-        })?;
-        let get = |s: &Option<BsdfSample>| {
-            s.unwrap_or(BsdfSample { wi: Vec3::ZERO, f: Rgb::ZERO, pdf: 0.0, weight: Rgb::ZERO, flags: BsdfFlags::NONE, eta: 0.0 })
+            let s = bsdf.sample(wo, uc as f32, Vec2::new(u0 as f32, u1 as f32));
+            let valid = s.is_some();
+            let s = s.unwrap_or(BsdfSample { wi: Vec3::ZERO, f: Rgb::ZERO, pdf: 0.0, weight: Rgb::ZERO, flags: BsdfFlags::NONE, eta: 0.0 });
+            // SAFETY: row i is written by this task only; every index is below the array's length.
+            unsafe {
+                for (k, wi) in s.wi.to_array().into_iter().enumerate() {
+                    wi_ptr.write(3 * i + k, wi);
+                    f_ptr.write(3 * i + k, s.f.0[k]);
+                    weight_ptr.write(3 * i + k, s.weight.0[k]);
+                }
+                pdf_ptr.write(i, s.pdf);
+                flags_ptr.write(i, s.flags.0);
+                eta_ptr.write(i, s.eta);
+                valid_ptr.write(i, valid);
+            }
+            true
         };
-        let all: Vec<BsdfSample> = samples.iter().map(get).collect();
+        let ok = run_released(py, || {
+            for_chunks(n, |rows| {
+                let mut wo = Vec::with_capacity(rows.len());
+                if !co.directions(rows.clone(), normalize, &mut wo) {
+                    return false;
+                }
+                rows.enumerate().all(|(j, i)| sample_row(wo[j], i))
+            })
+        })?;
+        if !ok {
+            return Err(first_bad_row(&[&ao], &[&auc, &au], normalize));
+        }
         Ok(PySample {
-            wi: vec3_array(py, &all.iter().map(|s| s.wi).collect::<Vec<_>>(), batched)?.unbind(),
-            f: rgb_array(py, &all.iter().map(|s| s.f).collect::<Vec<_>>(), batched)?.unbind(),
-            pdf: column(py, all.iter().map(|s| s.pdf).collect(), batched)?.unbind(),
-            weight: rgb_array(py, &all.iter().map(|s| s.weight).collect::<Vec<_>>(), batched)?.unbind(),
-            flags: column(py, all.iter().map(|s| s.flags.0).collect(), batched)?.unbind(),
-            eta: column(py, all.iter().map(|s| s.eta).collect(), batched)?.unbind(),
-            valid: column(py, samples.iter().map(Option::is_some).collect(), batched)?.unbind(),
+            wi: finish(wi_out, 3, batched)?.unbind(),
+            f: finish(f_out, 3, batched)?.unbind(),
+            pdf: finish(pdf_out, 1, batched)?.unbind(),
+            weight: finish(weight_out, 3, batched)?.unbind(),
+            flags: finish(flags_out, 1, batched)?.unbind(),
+            eta: finish(eta_out, 1, batched)?.unbind(),
+            valid: finish(valid_out, 1, batched)?.unbind(),
         })
     }
 
     /// Directional albedo ∫ f(wo, wi) |cos θi| dωi, estimated with `samples` of the model's own sampling
-    /// (seeded, so reproducible). Float32 RGB of shape (N, 3), or (3,) for a single `wo`.
+    /// (seeded, so reproducible: row i uses seed `seed + i`). Float32 RGB of shape (N, 3), or (3,) for a
+    /// single `wo`. Rows are computed in parallel.
     #[pyo3(signature = (wo, *, samples = 100_000, seed = 0, normalize = false))]
     fn albedo<'py>(
         &self,
@@ -263,15 +290,16 @@ impl PyBsdf {
         if samples == 0 {
             return Err(PyValueError::new_err("`samples` must be at least 1"));
         }
-        let (ro, wo) = read_directions(wo, "wo", normalize)?;
+        let (ao, wo) = read_directions(wo, "wo", normalize)?;
         let bsdf = &self.bsdf;
-        let out = run_released(py, || {
-            wo.iter()
+        let rows = run_released(py, || {
+            wo.par_iter()
                 .enumerate()
                 .map(|(i, &w)| gonio::verify::energy::albedo(bsdf, w, samples, seed.wrapping_add(i as u64)))
                 .collect::<Vec<Rgb>>()
         })?;
-        rgb_array(py, &out, ro.batched)
+        let flat: Vec<f32> = rows.iter().flat_map(|c| c.0).collect();
+        finish(PyArray1::from_vec(py, flat), 3, ao.batched)
     }
 
     /// The model's lobes as a bit set (see `gonio.BsdfFlags`).
@@ -398,6 +426,8 @@ fn _gonio(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(plugins, m)?)?;
     m.add_function(wrap_pyfunction!(examples, m)?)?;
     verify::register(m)?;
+    scene::register(m)?;
+    image::register(m)?;
     for (name, bit) in [
         ("FLAG_REFLECTION", BsdfFlags::REFLECTION),
         ("FLAG_TRANSMISSION", BsdfFlags::TRANSMISSION),

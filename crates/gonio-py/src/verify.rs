@@ -41,7 +41,7 @@ fn seed_value(seed: i64) -> PyResult<u64> {
 }
 
 /// One unit direction `wo` of shape (3,).
-fn single_direction(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec3> {
+fn single_direction(obj: &Bound<'_, PyAny>, name: &'static str) -> PyResult<Vec3> {
     let (rows, dirs) = read_directions(obj, name, false)?;
     require(!rows.batched && dirs.len() == 1, || format!("`{name}` must be one direction of shape (3,), got {} rows", rows.n))?;
     Ok(dirs[0])

@@ -358,6 +358,13 @@ impl Props {
 
     /// Build from an already parsed JSON object; `path` names it in messages (`$` for the root).
     pub fn from_json_value(value: &serde_json::Value, path: &str) -> Result<Props> {
+        Props::from_json_scoped(value, path, None)
+    }
+
+    /// Build from a JSON object inside a scene dictionary: `scope` names each plugin's class (the XML
+    /// tag it would have) and resolves `{"type": "ref", "id": …}`. Without a scope (one model on its own)
+    /// classes stay empty and a reference is an error.
+    pub(crate) fn from_json_scoped(value: &serde_json::Value, path: &str, scope: Option<&dyn JsonScope>) -> Result<Props> {
         let serde_json::Value::Object(map) = value else {
             return Err(Error::spec(path, "expected a JSON object with a \"type\" key"));
         };
@@ -365,6 +372,9 @@ impl Props {
             return Err(Error::spec(path, "expected a \"type\" key naming the plugin, e.g. {\"type\": \"diffuse\"}"));
         };
         let mut props = Props::new(plugin, path);
+        if let Some(scope) = scope {
+            props.class = scope.class_of(plugin, path)?.to_string();
+        }
         for (key, v) in map {
             let at = format!("{path}.{key}");
             match key.as_str() {
@@ -374,7 +384,7 @@ impl Props {
                     _ => return Err(Error::spec(at, "\"id\" must be a string")),
                 },
                 _ => {
-                    let value = json_value(v, &at)?;
+                    let value = json_value(v, &at, scope)?;
                     props.set(key, value, &at);
                 }
             }
@@ -516,9 +526,39 @@ fn parse_number(s: &str) -> Option<f64> {
     s.trim().parse::<f64>().ok()
 }
 
-fn json_value(v: &serde_json::Value, at: &str) -> Result<Value> {
+/// What a scene dictionary adds to a plugin's JSON: the class of each plugin type (Mitsuba knows it from
+/// its plugin registry; the XML format spells it as the tag) and the targets of references.
+pub(crate) trait JsonScope {
+    /// The class (`"bsdf"`, `"shape"`, `"emitter"`, …) of plugin type `plugin`, given at `at`.
+    fn class_of(&self, plugin: &str, at: &str) -> Result<&'static str>;
+    /// The plugin declared with id `id`, for a `{"type": "ref", "id": …}` at `at`.
+    fn reference(&self, id: &str, at: &str) -> Result<Props>;
+}
+
+/// A 4×4 matrix given as four rows of four numbers (a nested list, e.g. a numpy array's `tolist()`),
+/// read as a transform like the XML `<matrix value="…16 numbers, row-major…"/>`.
+fn json_matrix(rows: &[serde_json::Value], at: &str) -> Result<Value> {
+    let bad = || Error::spec(at, "a matrix must be 4 rows of 4 numbers (row-major, as numpy prints it)");
+    if rows.len() != 4 {
+        return Err(bad());
+    }
+    let mut m = [0.0f64; 16];
+    for (r, row) in rows.iter().enumerate() {
+        let row = row.as_array().filter(|row| row.len() == 4).ok_or_else(bad)?;
+        for (c, v) in row.iter().enumerate() {
+            m[4 * r + c] = v.as_f64().ok_or_else(bad)?;
+        }
+    }
+    let t = crate::math::Transform::from_rows(&m).ok_or_else(|| Error::spec(at, "the matrix is singular or not finite"))?;
+    // Composed onto the identity as the XML loader composes its operations, so that a dictionary and the
+    // equivalent XML give the same bits (products with the identity turn −0 into +0).
+    Ok(Value::Transform(t.then_after(crate::math::Transform::IDENTITY)))
+}
+
+fn json_value(v: &serde_json::Value, at: &str, scope: Option<&dyn JsonScope>) -> Result<Value> {
     use serde_json::Value as J;
     Ok(match v {
+        J::Array(items) if items.first().is_some_and(J::is_array) => json_matrix(items, at)?,
         J::Number(n) => Value::Number(n.as_f64().ok_or_else(|| Error::spec(at, "number out of range"))?),
         J::Bool(b) => Value::Bool(*b),
         J::String(s) => Value::String(s.clone()),
@@ -531,13 +571,23 @@ fn json_value(v: &serde_json::Value, at: &str) -> Result<Value> {
                 if let Some(extra) = map.keys().find(|k| *k != "type" && *k != "value") {
                     return Err(Error::spec(at, format!("unknown key `{extra}` in a colour")));
                 }
-                match json_value(inner, &format!("{at}.value"))? {
+                match json_value(inner, &format!("{at}.value"), None)? {
                     v @ Value::Number(_) => v,
                     Value::List(l) if l.len() == 3 && map["type"] == "rgb" => Value::List(l),
                     _ => return Err(Error::spec(at, "a colour's \"value\" must be a number or three numbers")),
                 }
             }
-            Some(_) => Value::Nested(Props::from_json_value(v, at)?),
+            Some("ref") => {
+                let Some(scope) = scope else {
+                    return Err(Error::spec(at, "a {\"type\": \"ref\"} can only refer to another plugin of a scene dictionary"));
+                };
+                let id = match (map.get("id"), map.len()) {
+                    (Some(J::String(id)), 2) => id,
+                    _ => return Err(Error::spec(at, "a reference is {\"type\": \"ref\", \"id\": \"<id of a plugin>\"}")),
+                };
+                Value::Nested(scope.reference(id, at)?)
+            }
+            Some(_) => Value::Nested(Props::from_json_scoped(v, at, scope)?),
             None => return Err(Error::spec(at, "a nested object needs a \"type\" key")),
         },
         J::Null => return Err(Error::spec(at, "null is not a parameter value")),

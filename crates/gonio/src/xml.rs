@@ -7,7 +7,7 @@ use crate::math::Transform;
 use crate::props::Props;
 use crate::spectrum::named::{parse_spd, spectrum_to_rgb};
 use crate::spectrum::Rgb;
-use glam::{Mat4, Vec3};
+use glam::Vec3;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
@@ -180,14 +180,12 @@ pub fn parse_transform(node: roxmltree::Node, env: &XmlEnv, source: &str) -> Res
             }
             "matrix" => {
                 let v = env.required(op, "value", source)?;
-                let m = match parse_numbers(&v) {
-                    Some(m) if m.len() == 16 => m,
+                let m: [f64; 16] = match parse_numbers(&v) {
+                    Some(m) if m.len() == 16 => std::array::from_fn(|i| m[i]),
                     Some(m) => return Err(bad(&format!("expected 16 numbers (row-major 4×4), got {}", m.len()))),
                     None => return Err(bad(&format!("expected 16 numbers, got \"{v}\""))),
                 };
-                let rows: Vec<f32> = m.iter().map(|&x| x as f32).collect();
-                // The value lists rows; glam stores columns.
-                Transform::from_matrix(Mat4::from_cols_slice(&rows).transpose()).ok_or_else(|| bad("the matrix is singular"))?
+                Transform::from_rows(&m).ok_or_else(|| bad("the matrix is singular"))?
             }
             "lookat" => {
                 let vec = |name: &str| -> Result<Vec3> {

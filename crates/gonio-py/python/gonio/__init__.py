@@ -1,7 +1,8 @@
 """gonio — a physically based reflectance toolkit.
 
 Reflection models (BSDFs) with ``f``, ``sample`` and ``pdf``, described with Mitsuba 3's plugin names and
-parameters, evaluated in Rust over numpy arrays.
+parameters, evaluated in Rust over numpy arrays; Mitsuba 3 scenes (XML files or scene dictionaries)
+rendered to numpy arrays; images read and written as EXR, PNG or HDR.
 
 Conventions
 -----------
@@ -30,7 +31,20 @@ import json
 from typing import Any, Mapping, Union
 
 from . import _gonio, verify
-from ._gonio import Bsdf, BsdfSample, SpecError, examples, plugins
+from ._gonio import (
+    Bsdf,
+    BsdfSample,
+    Scene,
+    SceneError,
+    SpecError,
+    examples,
+    load_dict,
+    load_scene,
+    look_at,
+    plugins,
+    read_image,
+    write_image,
+)
 
 __version__: str = _gonio.__version__
 
@@ -38,12 +52,19 @@ __all__ = [
     "Bsdf",
     "BsdfFlags",
     "BsdfSample",
+    "Scene",
+    "SceneError",
     "SpecError",
     "__version__",
     "examples",
     "load_bsdf",
+    "load_dict",
+    "load_scene",
+    "look_at",
     "plugins",
+    "read_image",
     "verify",
+    "write_image",
 ]
 
 

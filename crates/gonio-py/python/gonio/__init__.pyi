@@ -1,7 +1,8 @@
 """Type stub of the public API of gonio (the compiled part lives in gonio._gonio)."""
 
 import enum
-from typing import Any, Mapping, Tuple, Union
+import os
+from typing import Any, List, Mapping, Optional, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -15,6 +16,11 @@ Spec = Union[str, bytes, Mapping[str, Any]]
 
 class SpecError(ValueError):
     """A plugin description gonio cannot build; the message starts with where the problem is."""
+
+class SceneError(ValueError):
+    """A scene gonio cannot load (XML or dictionary that does not parse, an unknown or unsupported plugin
+    or parameter, a value out of range, a malformed mesh or image it refers to). The message starts with
+    where the problem is: `file:line:col`, or a dictionary path such as `$.ball.bsdf.alpha`."""
 
 class BsdfFlags(enum.IntFlag):
     NONE = 0
@@ -70,3 +76,69 @@ def plugins() -> Tuple[str, ...]:
 
 def examples() -> Tuple[str, ...]:
     """Example JSON specs per plugin, as used by `gonio check --all`."""
+
+PathLike = Union[str, "os.PathLike[str]"]
+
+class Scene:
+    """A renderable scene; build one with `load_scene` or `load_dict`."""
+
+    @property
+    def width(self) -> int:
+        """Image width in pixels (the film's `width`)."""
+    @property
+    def height(self) -> int:
+        """Image height in pixels (the film's `height`)."""
+    @property
+    def spp(self) -> int:
+        """Samples per pixel `render` takes by default (the sampler's `sample_count`)."""
+    @property
+    def seed(self) -> int:
+        """The seed `render` takes by default (the sampler's `seed`)."""
+    @property
+    def shape_count(self) -> int: ...
+    @property
+    def light_count(self) -> int: ...
+    @property
+    def primitive_count(self) -> int: ...
+    @property
+    def source(self) -> str:
+        """The file name, or "<dict>"."""
+    @property
+    def warnings(self) -> List[str]:
+        """What the loader accepted but approximates (also issued as UserWarnings at load time)."""
+    def render(
+        self, spp: Optional[int] = None, seed: Optional[int] = None, threads: Optional[int] = None, progress: bool = True
+    ) -> npt.NDArray[np.float32]:
+        """Render to linear RGB of shape (height, width, 3), float32, top row first.
+
+        `spp`/`seed` default to the scene's sampler; the image depends on the seed only (not on `threads`)
+        and equals `gonio render --seed` bit for bit. `threads` defaults to all cores. A progress bar goes to
+        stderr when it is a terminal (tqdm's widget in Jupyter). The GIL is released; Ctrl-C stops the
+        render promptly and raises KeyboardInterrupt.
+        """
+
+def load_scene(path: PathLike, **defines: Any) -> Scene:
+    """Load a Mitsuba 3 XML scene; `defines` override `<default>` parameters like `-D name=value`.
+
+    Raises FileNotFoundError for a missing file, SceneError for anything wrong inside it."""
+
+def load_dict(scene: Mapping[str, Any]) -> Scene:
+    """Build a scene from Mitsuba 3's scene dictionary ({"type": "scene", ...}, as `mitsuba.load_dict`).
+
+    Plugins are dicts with a "type"; top-level keys are ids for {"type": "ref", "id": ...}; `to_world` is a
+    4×4 matrix (nested list, numpy array, or an object with `.matrix` such as mitsuba.ScalarTransform4f).
+    Raises SceneError naming the dictionary path of the problem (`$.ball.bsdf.alpha`)."""
+
+def look_at(origin: ArrayLike, target: ArrayLike, up: ArrayLike = (0.0, 1.0, 0.0)) -> npt.NDArray[np.float64]:
+    """The 4×4 camera-to-world matrix of Mitsuba's `<lookat>` (the one gonio's XML loader builds)."""
+
+def read_image(path: PathLike) -> npt.NDArray[np.float32]:
+    """Read EXR, HDR, PNG or JPEG as linear RGB of shape (height, width, 3), float32 (PNG/JPEG sRGB-decoded).
+
+    Raises FileNotFoundError (or another OSError) when unreadable, ValueError when not a valid image."""
+
+def write_image(path: PathLike, array: npt.ArrayLike) -> None:
+    """Write linear RGB atomically: .exr float32, .png 8-bit sRGB (clamped), .hdr RGBE.
+
+    `array`: float32/float64 of shape (height, width, 3) or (height, width). Raises ValueError for another
+    shape, dtype or extension, FileNotFoundError when the directory does not exist."""

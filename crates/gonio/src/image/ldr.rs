@@ -1,4 +1,4 @@
-//! PNG, JPEG and Radiance HDR through the `image` crate (decoders only for JPEG and HDR; PNG both ways).
+//! PNG, JPEG and Radiance HDR through the `image` crate (JPEG read only; PNG and HDR both ways).
 //! Integer samples are sRGB-decoded to linear; HDR samples are linear already.
 
 use std::io::Cursor;
@@ -53,4 +53,19 @@ pub(super) fn encode_png(path: &Path, img: &Image) -> Result<Vec<u8>> {
     let mut out = Cursor::new(Vec::new());
     buffer.write_to(&mut out, ImageFormat::Png).map_err(|e| Error::format(path, "PNG encoding", e.to_string()))?;
     Ok(out.into_inner())
+}
+
+/// Radiance RGBE (run-length encoded), linear. RGBE has no sign and no NaN: negative and NaN samples
+/// are written as 0, values above its range (≈ 1.7·10³⁸) as its largest value.
+pub(super) fn encode_hdr(path: &Path, img: &Image) -> Result<Vec<u8>> {
+    let pixels: Vec<::image::Rgb<f32>> = img
+        .data
+        .chunks_exact(3)
+        .map(|p| ::image::Rgb(std::array::from_fn(|c| if p[c] > 0.0 { p[c].min(f32::MAX) } else { 0.0 })))
+        .collect();
+    let mut out = Vec::new();
+    ::image::codecs::hdr::HdrEncoder::new(&mut out)
+        .encode(&pixels, img.width, img.height)
+        .map_err(|e| Error::format(path, "HDR encoding", e.to_string()))?;
+    Ok(out)
 }

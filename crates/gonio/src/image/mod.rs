@@ -3,7 +3,7 @@
 //! | format | read | write |
 //! |---|---|---|
 //! | OpenEXR (`.exr`) | first layer; R, G, B (A ignored) or a single Y channel; half, float or uint → `f32` | float32 RGB, linear, lossless RLE compression (the `exr` crate's default) |
-//! | Radiance (`.hdr`, `.rgbe`, `.pic`) | RGBE, run-length encoded or flat | — |
+//! | Radiance (`.hdr`, `.rgbe`, `.pic`) | RGBE, run-length encoded or flat | RGBE, run-length encoded; negative and NaN samples as 0 |
 //! | PNG (`.png`) | 8- or 16-bit, grey or colour, alpha ignored; sRGB-decoded to linear | 8-bit RGB, sRGB-encoded, clamped to [0, 1], rounded |
 //! | JPEG (`.jpg`, `.jpeg`) | 8-bit, grey or colour; sRGB-decoded to linear | — |
 //!
@@ -109,7 +109,7 @@ enum Format {
 }
 
 const READ_EXTENSIONS: &str = ".exr, .hdr (also .rgbe, .pic), .png, .jpg, .jpeg";
-const WRITE_EXTENSIONS: &str = ".exr, .png";
+const WRITE_EXTENSIONS: &str = ".exr, .png, .hdr";
 
 fn format_from_extension(path: &Path) -> Option<Format> {
     let ext = path.extension()?.to_str()?.to_ascii_lowercase();
@@ -154,7 +154,7 @@ pub fn read_image(path: &Path) -> Result<Image> {
 }
 
 /// Writes `img` to `path`, atomically (see the module docs): `.exr` as float32 linear RGB, `.png` as
-/// 8-bit sRGB.
+/// 8-bit sRGB, `.hdr` as RGBE.
 pub fn write_image(path: &Path, img: &Image) -> Result<()> {
     let format = format_from_extension(path)
         .ok_or_else(|| Error::format(path, "file name", format!("cannot write this extension; accepted: {WRITE_EXTENSIONS}")))?;
@@ -165,9 +165,8 @@ pub fn write_image(path: &Path, img: &Image) -> Result<()> {
     let bytes = guard(path, || match format {
         Format::Exr => exr::encode(path, img),
         Format::Png => ldr::encode_png(path, img),
-        Format::Hdr | Format::Jpeg => {
-            Err(Error::format(path, "file name", format!("cannot write this extension; accepted: {WRITE_EXTENSIONS}")))
-        }
+        Format::Hdr => ldr::encode_hdr(path, img),
+        Format::Jpeg => Err(Error::format(path, "file name", format!("cannot write this extension; accepted: {WRITE_EXTENSIONS}"))),
     })?;
     write_atomically(path, &bytes)
 }
@@ -263,6 +262,26 @@ mod tests {
             let (sa, sb) = (linear_to_srgb(a.clamp(0.0, 1.0)), linear_to_srgb(*b));
             assert!((sa - sb).abs() <= 0.5 / 255.0 + 1e-6, "{a} → {b}");
         }
+    }
+
+    #[test]
+    fn hdr_round_trip_within_rgbe_precision() {
+        let dir = scratch_dir("hdr");
+        let mut img = test_pattern(6, 5);
+        img.set(1, 1, Rgb::new(-1.0, f32::NAN, 3000.5));
+        let path = dir.join("pattern.hdr");
+        write_image(&path, &img).unwrap();
+        let back = read_image(&path).unwrap();
+        assert_eq!((back.width, back.height), (6, 5));
+        for (a, b) in img.data.chunks_exact(3).zip(back.data.chunks_exact(3)) {
+            // RGBE shares one exponent: each channel is kept to 8 bits of the largest one.
+            let a: Vec<f32> = a.iter().map(|v| if *v > 0.0 { *v } else { 0.0 }).collect();
+            let max = a.iter().fold(0.0f32, |m, v| m.max(*v));
+            for (x, y) in a.iter().zip(b) {
+                assert!((x - y).abs() <= max / 128.0, "{a:?} → {b:?}");
+            }
+        }
+        assert!(std::fs::read_dir(&dir).unwrap().count() == 1, "temporary left behind");
     }
 
     #[test]

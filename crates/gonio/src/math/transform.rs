@@ -33,6 +33,15 @@ impl Transform {
         inverse.is_finite().then_some(Transform { matrix, inverse })
     }
 
+    /// A transform from 16 numbers listing the matrix row by row (Mitsuba's `<matrix value>`, numpy's
+    /// layout), rounded to `f32`; `None` when it is singular or not finite.
+    #[must_use]
+    pub fn from_rows(rows: &[f64; 16]) -> Option<Self> {
+        let values: Vec<f32> = rows.iter().map(|&x| x as f32).collect();
+        // glam stores columns: read the rows as columns, then transpose.
+        Transform::from_matrix(Mat4::from_cols_slice(&values).transpose())
+    }
+
     #[must_use]
     pub fn translate(v: Vec3) -> Self {
         Transform { matrix: Mat4::from_translation(v), inverse: Mat4::from_translation(-v) }

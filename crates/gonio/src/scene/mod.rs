@@ -1,10 +1,12 @@
 //! The in-memory scene: shapes with their BSDFs and area lights, other lights, the BVH over every
-//! primitive, the camera, film, sampler and integrator settings. [`mitsuba_xml`] reads the file format;
+//! primitive, the camera, film, sampler and integrator settings. [`mitsuba_xml`] reads the file format,
+//! [`mitsuba_dict`] Mitsuba's scene dictionaries;
 //! [`Scene::build`] (in `build.rs`) turns its plugins into these types.
 
 pub mod build;
 pub mod material;
 pub mod mesh_files;
+pub mod mitsuba_dict;
 pub mod mitsuba_xml;
 
 pub use material::Material;

@@ -1,0 +1,129 @@
+"""Benchmark (not a test): gonio's batched `f` and `sample` from Python against Mitsuba 3's `llvm_ad_rgb`
+`bsdf.eval` / `bsdf.sample` on the same 10⁶ direction pairs, in one run.
+
+    .venv/bin/python bench/python_bsdf_vs_mitsuba.py [--n 1000000] [--repeat 7]
+
+Inputs are float32 arrays of shape (N, 3) (gonio reads them in place); Mitsuba gets the same numbers as
+`mi.Vector3f` built from the (contiguous) columns, and its timing includes the conversion of the result
+back to numpy, as a user would do. Every figure is the median of `--repeat` runs after one warm-up (which
+also compiles Mitsuba's kernels). The issue's target: gonio at least as fast as Mitsuba's LLVM variant
+(whose `f`-equivalent is `eval`, which includes the cosine).
+
+Mitsuba's LLVM variant needs libLLVM ≥ 16 (19 here): set DRJIT_LIBLLVM_PATH, or it is looked up with
+`ldconfig -p`. Without Mitsuba (or LLVM) only gonio is timed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import subprocess
+import time
+
+import numpy as np
+
+import gonio
+
+MODELS = {
+    "diffuse": {"type": "diffuse", "reflectance": {"type": "rgb", "value": [0.2, 0.5, 0.8]}},
+    "roughconductor (GGX)": {"type": "roughconductor", "distribution": "ggx", "alpha": 0.3, "material": "Au"},
+    "roughplastic (GGX)": {"type": "roughplastic", "distribution": "ggx", "alpha": 0.3,
+                           "diffuse_reflectance": {"type": "rgb", "value": [0.2, 0.5, 0.8]}},
+}
+
+
+def find_llvm() -> str | None:
+    if os.environ.get("DRJIT_LIBLLVM_PATH"):
+        return os.environ["DRJIT_LIBLLVM_PATH"]
+    try:
+        out = subprocess.run(["ldconfig", "-p"], capture_output=True, text=True, check=True).stdout
+    except (OSError, subprocess.CalledProcessError):
+        return None
+    for line in out.splitlines():
+        if "libLLVM" in line and ("-19" in line or ".so.19" in line):
+            return line.split("=>")[-1].strip()
+    return None
+
+
+def median_ms(fn, repeat: int) -> float:
+    fn()  # warm-up (and Mitsuba's kernel compilation)
+    times = []
+    for _ in range(repeat):
+        t = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t)
+    return 1e3 * statistics.median(times)
+
+
+def directions(rng, n):
+    w = rng.normal(size=(n, 3))
+    w[:, 2] = np.abs(w[:, 2])
+    return (w / np.linalg.norm(w, axis=1, keepdims=True)).astype(np.float32)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--n", type=int, default=1_000_000)
+    parser.add_argument("--repeat", type=int, default=7)
+    args = parser.parse_args()
+    n = args.n
+    rng = np.random.default_rng(1)
+    wo, wi = directions(rng, n), directions(rng, n)
+    uc = rng.random(n, dtype=np.float32)
+    u = rng.random((n, 2), dtype=np.float32)
+
+    mi = dr = None
+    llvm = find_llvm()
+    if llvm:
+        os.environ["DRJIT_LIBLLVM_PATH"] = llvm
+        try:
+            import drjit as dr
+            import mitsuba as mi
+
+            mi.set_variant("llvm_ad_rgb")
+        except (ImportError, AttributeError, RuntimeError) as e:
+            print(f"Mitsuba llvm_ad_rgb unavailable ({e}); timing gonio only")
+            mi = None
+    else:
+        print("libLLVM-19 not found; timing gonio only")
+
+    if mi is not None:
+        mi_wo = mi.Vector3f(*(np.ascontiguousarray(wo[:, k]) for k in range(3)))
+        mi_wi = mi.Vector3f(*(np.ascontiguousarray(wi[:, k]) for k in range(3)))
+        mi_uc = mi.Float(uc)
+        mi_u = mi.Point2f(np.ascontiguousarray(u[:, 0]), np.ascontiguousarray(u[:, 1]))
+        si = dr.zeros(mi.SurfaceInteraction3f, n)
+        si.wi = mi_wo
+        ctx = mi.BSDFContext()
+
+    print(f"{n:,} direction pairs, float32 (N, 3) inputs, median of {args.repeat}; ms per million pairs")
+    header = f"{'model':<22} {'gonio f':>9} {'mi eval':>9} {'ratio':>7}   {'gonio sample':>12} {'mi sample':>10} {'ratio':>7}"
+    print(header)
+    print("-" * len(header))
+    per_million = 1e6 / n
+    for name, spec in MODELS.items():
+        g = gonio.load_bsdf(spec)
+        g_f = median_ms(lambda: g.f(wo, wi), args.repeat) * per_million
+        g_s = median_ms(lambda: g.sample(wo, uc, u), args.repeat) * per_million
+        if mi is not None:
+            m = mi.load_dict(spec)
+
+            def mi_eval():
+                v = m.eval(ctx, si, mi_wi)
+                return np.array(v)
+
+            def mi_sample():
+                bs, weight = m.sample(ctx, si, mi_uc, mi_u)
+                return np.array(bs.wo), np.array(weight), np.array(bs.pdf)
+
+            m_f = median_ms(mi_eval, args.repeat) * per_million
+            m_s = median_ms(mi_sample, args.repeat) * per_million
+            print(f"{name:<22} {g_f:9.2f} {m_f:9.2f} {m_f / g_f:6.2f}×   {g_s:12.2f} {m_s:10.2f} {m_s / g_s:6.2f}×")
+        else:
+            print(f"{name:<22} {g_f:9.2f} {'—':>9} {'':>7}   {g_s:12.2f} {'—':>10}")
+    print("ratio = Mitsuba time / gonio time (> 1: gonio is faster)")
+
+
+if __name__ == "__main__":
+    main()
