@@ -53,8 +53,12 @@ impl Material {
                 let mut p = template.lock().map_or_else(|poisoned| poisoned.into_inner().clone(), |t| t.clone());
                 let at = p.at().to_string();
                 for (path, t) in textures {
+                    // A grey value goes in as a number so that float parameters (`alpha`, `opacity`) take
+                    // it; colour parameters read a number as a grey too.
                     let c = t.eval(uv);
-                    p.set_path(path, Value::List(c.to_f64().to_vec()), &at);
+                    let value =
+                        if c.r() == c.g() && c.g() == c.b() { Value::Number(f64::from(c.r())) } else { Value::List(c.to_f64().to_vec()) };
+                    p.set_path(path, value, &at);
                 }
                 Cow::Owned(Bsdf::from_props(&p)?)
             }
