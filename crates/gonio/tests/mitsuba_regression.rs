@@ -56,6 +56,12 @@ fn z_test_scene(name: &str) -> f64 {
     assert_eq!((reference.width * reference.height, variance.width * variance.height), (pixels, pixels));
     let spp = (2e6 / pixels as f64) as u32;
     let out = render(&scene, spp, 0x5eed, &AtomicBool::new(false), &|_| {});
+    // For a look at a failure: GONIO_REGRESSION_OUT=dir writes the render and the reference as EXR there.
+    if let Some(dir) = std::env::var_os("GONIO_REGRESSION_OUT") {
+        let render_img = gonio::image::Image { width: reference.width, height: reference.height, data: out.data.clone() };
+        gonio::image::write_image(&PathBuf::from(&dir).join(format!("{name}.exr")), &render_img).unwrap();
+        gonio::image::write_image(&PathBuf::from(&dir).join(format!("{name}_ref.exr")), &reference).unwrap();
+    }
     let (img, reference, variance) = (to_xyz(&out.data), to_xyz(&reference.data), to_xyz(&variance.data));
     let alpha = sidak_alpha(0.01, pixels);
     let mut passed = 0usize;

@@ -9,6 +9,10 @@ use glam::Vec2;
 use std::borrow::Cow;
 use std::sync::Mutex;
 
+/// BSDF parameters that take a float, not a colour: a texture there is read with Mitsuba's scalar lookup
+/// ([`Texture::eval_1`]), which differs from the colour lookup for checkerboards.
+const SCALAR_PARAMETERS: &[&str] = &["alpha", "alpha_u", "alpha_v", "opacity", "weight", "exponent"];
+
 /// One shape's reflection model.
 #[derive(Debug)]
 pub enum Material {
@@ -53,11 +57,11 @@ impl Material {
                 let mut p = template.lock().map_or_else(|poisoned| poisoned.into_inner().clone(), |t| t.clone());
                 let at = p.at().to_string();
                 for (path, t) in textures {
-                    // A grey value goes in as a number so that float parameters (`alpha`, `opacity`) take
-                    // it; colour parameters read a number as a grey too.
-                    let c = t.eval(uv);
-                    let value =
-                        if c.r() == c.g() && c.g() == c.b() { Value::Number(f64::from(c.r())) } else { Value::List(c.to_f64().to_vec()) };
+                    let value = if path.last().is_some_and(|name| SCALAR_PARAMETERS.contains(&name.as_str())) {
+                        Value::Number(f64::from(t.eval_1(uv)))
+                    } else {
+                        Value::List(t.eval(uv).to_f64().to_vec())
+                    };
                     p.set_path(path, value, &at);
                 }
                 Cow::Owned(Bsdf::from_props(&p)?)
