@@ -30,6 +30,7 @@ pub mod conductor;
 pub mod dielectric;
 pub mod diffuse;
 pub mod glossy_mix;
+pub mod mask;
 pub mod oren_nayar;
 pub mod phong;
 pub mod plastic;
@@ -51,6 +52,7 @@ pub use blinn_phong::BlinnPhong;
 pub use conductor::Conductor;
 pub use dielectric::Dielectric;
 pub use diffuse::Diffuse;
+pub use mask::Mask;
 pub use oren_nayar::OrenNayar;
 pub use phong::Phong;
 pub use plastic::Plastic;
@@ -287,6 +289,7 @@ bsdf_models! {
     Blend(BlendBsdf) = "blendbsdf",
     Sum(Sum) = "sum",
     TwoSided(TwoSided) = "twosided",
+    Mask(Mask) = "mask",
     Phong(Phong) = "phong",
     BlinnPhong(BlinnPhong) = "blinn_phong",
     OrenNayar(OrenNayar) = "oren_nayar",

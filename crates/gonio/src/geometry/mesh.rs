@@ -172,7 +172,29 @@ impl Mesh {
         let p = p0 * (1.0 - b.x - b.y) + p1 * b.x + p2 * b.y;
         let (ng, ns, uv) = self.surface_at(tri, b);
         let _ = ray;
-        SurfaceInteraction { t: hit.t, p, n: ng, shading: Frame::from_normal(ns), uv, shape: 0, prim: tri }
+        SurfaceInteraction { t: hit.t, p, n: ng, shading: self.shading_frame(tri, ns), uv, shape: 0, prim: tri }
+    }
+
+    /// The shading frame around `ns`, oriented as Mitsuba 3 orients it (`SurfaceInteraction::
+    /// initialize_sh_frame`): with texture coordinates, the first tangent is ∂p/∂u made orthogonal to `ns`
+    /// (Gram–Schmidt), so anisotropic models (`alpha_u` along s) follow the parameterisation. ∂p/∂u solves
+    /// [Δp₁ Δp₂] = [∂p/∂u ∂p/∂v] [Δuv₁ Δuv₂] over the triangle's edges (pbrt-v4 §6.5.3). Without texture
+    /// coordinates, or for a degenerate parameterisation, any frame around `ns` will do.
+    fn shading_frame(&self, tri: u32, ns: Vec3) -> Frame {
+        let Some(uvs) = &self.uvs else { return Frame::from_normal(ns) };
+        let idx = self.indices[tri as usize];
+        let [p0, p1, p2] = self.vertices(tri);
+        let (uv0, uv1, uv2) = (uvs[idx[0] as usize], uvs[idx[1] as usize], uvs[idx[2] as usize]);
+        let (duv1, duv2) = (uv1 - uv0, uv2 - uv0);
+        let det = duv1.x * duv2.y - duv1.y * duv2.x;
+        if det == 0.0 {
+            return Frame::from_normal(ns);
+        }
+        let dp_du = ((p1 - p0) * duv2.y - (p2 - p0) * duv1.y) / det;
+        match (dp_du - ns * ns.dot(dp_du)).try_normalize() {
+            Some(s) => Frame { s, t: ns.cross(s), n: ns },
+            None => Frame::from_normal(ns),
+        }
     }
 
     /// A point uniformly distributed over the whole mesh: a triangle by area, then uniform barycentrics
@@ -247,6 +269,21 @@ mod tests {
         assert!((h.1.t - 2.0).abs() < 1e-6);
         let si = m.interaction(h.0, &r, &h.1);
         assert!((si.n - Vec3::Z).length() < 1e-6 && (si.p - Vec3::new(0.3, 0.2, 0.0)).length() < 1e-6);
+    }
+
+    /// The first shading tangent follows ∂p/∂u (Mitsuba's convention, which anisotropic models rely on):
+    /// u grows along −y here, and the mesh is tilted so that ∂p/∂u is not orthogonal to the shading normal.
+    #[test]
+    fn shading_tangent_follows_dp_du() {
+        let p = vec![Vec3::new(-1.0, -1.0, 0.0), Vec3::new(1.0, -1.0, 0.0), Vec3::new(1.0, 1.0, 0.0), Vec3::new(-1.0, 1.0, 0.0)];
+        let uv = vec![Vec2::new(1.0, 0.0), Vec2::new(1.0, 1.0), Vec2::new(0.0, 1.0), Vec2::new(0.0, 0.0)];
+        let tilt = Transform::rotate(Vec3::X, 30.0).unwrap();
+        let m = Mesh::new(p, None, Some(uv), vec![[0, 1, 2], [2, 3, 0]], &tilt, false, false, "test").unwrap();
+        let r = Ray::new(tilt.point(Vec3::new(0.3, 0.2, 0.0)) + tilt.vector(Vec3::Z) * 2.0, -tilt.vector(Vec3::Z), 10.0);
+        let h = (0..2).find_map(|t| m.intersect(t, &r).map(|h| (t, h))).unwrap();
+        let f = m.interaction(h.0, &r, &h.1).shading;
+        assert!((f.s - tilt.vector(-Vec3::Y)).length() < 1e-5, "{:?}", f.s);
+        assert!((f.s.cross(f.t) - f.n).length() < 1e-5 && f.s.dot(f.n).abs() < 1e-6);
     }
 
     #[test]

@@ -82,8 +82,8 @@ pub fn emitter_hit(scene: &Scene, ray: &Ray, hit: Option<&SurfaceInteraction>, p
         }
         None => {
             let Some(index) = scene.environment else { return Rgb::ZERO };
-            let crate::light::Light::Constant(env) = &scene.lights[index as usize] else { return Rgb::ZERO };
-            (env.radiance, env.pdf_li(ray.d) / n)
+            let Some((le, pdf)) = scene.lights[index as usize].environment(ray.d) else { return Rgb::ZERO };
+            (le, pdf / n)
         }
     };
     match prev {

@@ -1,5 +1,6 @@
-//! Light sources: `area` (emission from a shape), `point`, `constant` (a uniform environment).
-//! Later: `directional`, `spot`, `envmap` (importance sampled) — one file each, one variant each below.
+//! Light sources: `area` (emission from a shape), `point`, `spot`, `directional`, and the environments
+//! `constant` (uniform) and `envmap` (a lat-long image, importance sampled) — one file each, one variant
+//! each below. `point`, `spot` and `directional` are delta lights: only light sampling finds them.
 //!
 //! Every light answers three questions for next-event estimation and multiple importance sampling:
 //! sample a direction from a reference point ([`Light::sample_li`]), the solid-angle density of a
@@ -7,11 +8,17 @@
 
 pub mod area;
 pub mod constant;
+pub mod directional;
+pub mod envmap;
 pub mod point;
+pub mod spot;
 
 pub use area::AreaLight;
 pub use constant::ConstantLight;
+pub use directional::DirectionalLight;
+pub use envmap::EnvMap;
 pub use point::PointLight;
+pub use spot::SpotLight;
 
 use crate::geometry::{Ray, Shape};
 use crate::spectrum::Rgb;
@@ -36,7 +43,10 @@ pub struct LightSample {
 pub enum Light {
     Area(AreaLight),
     Point(PointLight),
+    Spot(SpotLight),
+    Directional(DirectionalLight),
     Constant(ConstantLight),
+    EnvMap(EnvMap),
 }
 
 impl Light {
@@ -46,13 +56,33 @@ impl Light {
         match self {
             Light::Area(l) => l.sample_li(&shapes[l.shape as usize], p, n, uc, u),
             Light::Point(l) => l.sample_li(p, n),
+            Light::Spot(l) => l.sample_li(p, n),
+            Light::Directional(l) => l.sample_li(p, n),
             Light::Constant(l) => l.sample_li(p, n, u),
+            Light::EnvMap(l) => l.sample_li(p, n, u),
         }
     }
 
     /// Whether the light is a delta distribution (no chance of hitting it by BSDF sampling).
     #[must_use]
     pub fn is_delta(&self) -> bool {
-        matches!(self, Light::Point(_))
+        matches!(self, Light::Point(_) | Light::Spot(_) | Light::Directional(_))
+    }
+
+    /// Whether the light is an environment (seen by rays that escape the scene).
+    #[must_use]
+    pub fn is_environment(&self) -> bool {
+        matches!(self, Light::Constant(_) | Light::EnvMap(_))
+    }
+
+    /// For an environment: the radiance arriving along world direction `wi` (a ray that escaped towards
+    /// `wi`) and the solid-angle density with which [`Self::sample_li`] picks `wi`. `None` for other lights.
+    #[must_use]
+    pub fn environment(&self, wi: Vec3) -> Option<(Rgb, f32)> {
+        match self {
+            Light::Constant(l) => Some((l.radiance, l.pdf_li(wi))),
+            Light::EnvMap(l) => Some((l.radiance(wi), l.pdf_li(wi))),
+            _ => None,
+        }
     }
 }

@@ -12,12 +12,12 @@ use crate::geometry::builtin_meshes::{cube, rectangle};
 use crate::geometry::disk::Disk;
 use crate::geometry::sphere::Sphere;
 use crate::geometry::{Mesh, Shape};
-use crate::light::{AreaLight, ConstantLight, Light, PointLight};
+use crate::light::{AreaLight, ConstantLight, DirectionalLight, EnvMap, Light, PointLight, SpotLight};
 use crate::props::Props;
 use crate::spectrum::Rgb;
 use glam::Vec3;
 
-const SHAPES: &str = "sphere, rectangle, cube, disk, obj, ply";
+const SHAPES: &str = "sphere, rectangle, cube, disk, obj, ply, serialized";
 
 impl Scene {
     /// Build every plugin of a parsed scene.
@@ -53,7 +53,7 @@ impl Scene {
         }
         for e in &desc.emitters {
             let light = light_from_props(e)?;
-            if matches!(light, Light::Constant(_)) && lights.iter().any(|l| matches!(l, Light::Constant(_))) {
+            if light.is_environment() && lights.iter().any(Light::is_environment) {
                 return Err(Error::spec(e.at(), "a scene takes at most one environment emitter"));
             }
             lights.push(light);
@@ -97,12 +97,14 @@ fn shape_from_props(p: &Props) -> Result<Shape> {
         "rectangle" => Shape::Mesh(rectangle(&to_world, flip, at)?),
         "cube" => Shape::Mesh(cube(&to_world, flip, at)?),
         "disk" => Shape::Disk(Disk::new(to_world, flip)),
-        kind @ ("obj" | "ply") => {
+        kind @ ("obj" | "ply" | "serialized") => {
             let filename = p.string("filename")?.ok_or_else(|| Error::spec(at, format!("`{kind}` needs a `filename`")))?;
             let face_normals = p.bool("face_normals", false)?;
             // Mitsuba's OBJ loader flips v (v ↦ 1 − v) by default; mesh_io returns the file's values.
             let flip_tex = if kind == "obj" { p.bool("flip_tex_coords", true)? } else { false };
-            let data = super::mesh_files::load(kind, std::path::Path::new(&filename), p.at_param("filename"))?;
+            // Mitsuba's `serialized` picks one mesh of a multi-mesh file by `shape_index` (0-based).
+            let shape_index = if kind == "serialized" { p.integer_in("shape_index", 0, 0, i64::from(u32::MAX))? as usize } else { 0 };
+            let data = super::mesh_files::load(kind, std::path::Path::new(&filename), shape_index, p.at_param("filename"))?;
             let uvs = data.uvs.map(|uv| uv.into_iter().map(|t| if flip_tex { glam::Vec2::new(t.x, 1.0 - t.y) } else { t }).collect());
             Shape::Mesh(Mesh::from_file_data(
                 data.positions,
@@ -132,9 +134,17 @@ fn light_from_props(e: &Props) -> Result<Light> {
             };
             Light::Point(PointLight { position, intensity: e.rgb_in("intensity", Rgb::ONE, 0.0, f32::MAX)? })
         }
+        "spot" => Light::Spot(SpotLight::from_props(e)?),
+        "directional" => Light::Directional(DirectionalLight::from_props(e)?),
         "constant" => Light::Constant(ConstantLight { radiance: e.rgb_in("radiance", Rgb::ONE, 0.0, f32::MAX)? }),
+        "envmap" => Light::EnvMap(EnvMap::from_props(e)?),
         "area" => return Err(Error::spec(e.at(), "an `area` emitter must be nested in a <shape>")),
-        other => return Err(Error::spec(e.at(), format!("unsupported emitter `{other}` (gonio has: area, point, constant)"))),
+        other => {
+            return Err(Error::spec(
+                e.at(),
+                format!("unsupported emitter `{other}` (gonio has: area, point, spot, directional, constant, envmap)"),
+            ))
+        }
     };
     e.finish()?;
     Ok(light)

@@ -7,7 +7,16 @@ use crate::props::{Props, Value};
 use crate::texture::Texture;
 use glam::Vec2;
 use std::borrow::Cow;
-use std::sync::Mutex;
+use std::collections::HashMap;
+use std::sync::{Mutex, RwLock};
+
+/// Most distinct texture-value combinations a [`Material::Textured`] keeps built models for (2026-11:
+/// checkerboards and binary masks have a handful; continuous textures miss the cache and rebuild).
+const CACHE_CAPACITY: usize = 256;
+
+/// BSDF parameters that take a float, not a colour: a texture there is read with Mitsuba's scalar lookup
+/// ([`Texture::eval_1`]), which differs from the colour lookup for checkerboards.
+const SCALAR_PARAMETERS: &[&str] = &["alpha", "alpha_u", "alpha_v", "opacity", "weight", "exponent"];
 
 /// One shape's reflection model.
 #[derive(Debug)]
@@ -19,9 +28,13 @@ pub enum Material {
     /// parameter paths. Rebuilt at every hit from a copy of the template (`Props` tracks which parameters
     /// were read, so it is not `Sync`: the template sits behind a mutex held only for the copy). A slow,
     /// general path; models gain direct texture support as they need it, like `TexturedDiffuse`.
+    ///
+    /// Built models are kept per combination of texture values (bit patterns) up to `CACHE_CAPACITY`
+    /// entries, so textures with few distinct values (checkerboards, masks) build each model once.
     Textured {
         template: Mutex<Props>,
         textures: Vec<(Vec<String>, Texture)>,
+        cache: RwLock<HashMap<Vec<u32>, Bsdf>>,
     },
 }
 
@@ -36,7 +49,7 @@ impl Material {
         let textures = taken.iter().map(|(path, t)| Ok((path.clone(), Texture::from_props(t)?))).collect::<Result<Vec<_>>>()?;
         let material = match (template.plugin_type(), textures.as_slice()) {
             ("diffuse", [(path, t)]) if path == &["reflectance"] => Material::TexturedDiffuse(t.clone()),
-            _ => Material::Textured { template: Mutex::new(template), textures },
+            _ => Material::Textured { template: Mutex::new(template), textures, cache: RwLock::new(HashMap::new()) },
         };
         // Build once now so that parameter errors surface at load time.
         if let Material::Textured { .. } = &material {
@@ -49,14 +62,24 @@ impl Material {
         Ok(match self {
             Material::Fixed(b) => Cow::Borrowed(b),
             Material::TexturedDiffuse(t) => Cow::Owned(Bsdf::Diffuse(Diffuse::new(t.eval(uv).map(|v| v.clamp(0.0, 1.0))))),
-            Material::Textured { template, textures } => {
+            Material::Textured { template, textures, cache } => {
+                let values: Vec<TextureValue> = textures.iter().map(|(path, t)| TextureValue::of(path, t, uv)).collect();
+                let key: Vec<u32> = values.iter().flat_map(TextureValue::bits).collect();
+                if let Some(b) = cache.read().ok().and_then(|c| c.get(&key).cloned()) {
+                    return Ok(Cow::Owned(b));
+                }
                 let mut p = template.lock().map_or_else(|poisoned| poisoned.into_inner().clone(), |t| t.clone());
                 let at = p.at().to_string();
-                for (path, t) in textures {
-                    let c = t.eval(uv);
-                    p.set_path(path, Value::List(c.to_f64().to_vec()), &at);
+                for ((path, _), value) in textures.iter().zip(&values) {
+                    p.set_path(path, value.to_value(), &at);
                 }
-                Cow::Owned(Bsdf::from_props(&p)?)
+                let bsdf = Bsdf::from_props(&p)?;
+                if let Ok(mut c) = cache.write() {
+                    if c.len() < CACHE_CAPACITY {
+                        c.insert(key, bsdf.clone());
+                    }
+                }
+                Cow::Owned(bsdf)
             }
         })
     }
@@ -66,5 +89,35 @@ impl Material {
     #[must_use]
     pub fn at(&self, uv: Vec2) -> Cow<'_, Bsdf> {
         self.try_at(uv).unwrap_or_else(|_| Cow::Owned(Bsdf::Diffuse(Diffuse::new(crate::spectrum::Rgb::ZERO))))
+    }
+}
+
+/// A texture's value at a hit: a float for the parameters in `SCALAR_PARAMETERS`, else a colour.
+enum TextureValue {
+    Scalar(f32),
+    Colour(crate::spectrum::Rgb),
+}
+
+impl TextureValue {
+    fn of(path: &[String], t: &Texture, uv: Vec2) -> Self {
+        if path.last().is_some_and(|name| SCALAR_PARAMETERS.contains(&name.as_str())) {
+            TextureValue::Scalar(t.eval_1(uv))
+        } else {
+            TextureValue::Colour(t.eval(uv))
+        }
+    }
+
+    fn bits(&self) -> Vec<u32> {
+        match self {
+            TextureValue::Scalar(v) => vec![v.to_bits()],
+            TextureValue::Colour(c) => c.0.iter().map(|v| v.to_bits()).collect(),
+        }
+    }
+
+    fn to_value(&self) -> Value {
+        match self {
+            TextureValue::Scalar(v) => Value::Number(f64::from(*v)),
+            TextureValue::Colour(c) => Value::List(c.to_f64().to_vec()),
+        }
     }
 }

@@ -47,7 +47,7 @@ pub struct Scene {
     /// The area light of each shape (index into `lights`), if it emits.
     pub shape_lights: Vec<Option<u32>>,
     pub lights: Vec<Light>,
-    /// Index of the environment light (`constant`), seen by rays that escape.
+    /// Index of the environment light (`constant` or `envmap`), seen by rays that escape.
     pub environment: Option<u32>,
     pub camera: PerspectiveCamera,
     pub film: FilmSpec,
@@ -121,7 +121,7 @@ impl Scene {
                 }
             })
             .collect();
-        let environment = lights.iter().position(|l| matches!(l, Light::Constant(_))).map(|i| i as u32);
+        let environment = lights.iter().position(Light::is_environment).map(|i| i as u32);
         Scene { shapes, materials, shape_lights, lights, environment, camera, film, sampler, integrator, warnings, bvh, prims }
     }
 

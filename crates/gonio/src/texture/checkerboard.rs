@@ -28,15 +28,35 @@ impl Checkerboard {
         })
     }
 
+    /// Whether `uv` falls in a `color0` square of the colour lookup: frac(u) and frac(v) on the same side of ½.
+    #[inline]
+    fn same_side(&self, uv: Vec2) -> bool {
+        let q = self.to_uv.point(Vec3::new(uv.x, uv.y, 0.0));
+        (q.x - q.x.floor() > 0.5) == (q.y - q.y.floor() > 0.5)
+    }
+
     #[inline]
     #[must_use]
     pub fn eval(&self, uv: Vec2) -> Rgb {
-        let q = self.to_uv.point(Vec3::new(uv.x, uv.y, 0.0));
-        let (a, b) = (q.x - q.x.floor() > 0.5, q.y - q.y.floor() > 0.5);
-        if a == b {
+        if self.same_side(uv) {
             self.color0
         } else {
             self.color1
+        }
+    }
+
+    /// The scalar lookup for float parameters (`alpha`, `opacity`, …), as Mitsuba 3's `eval_1`: the grey
+    /// value (luminance) of the colours, **with the squares swapped** relative to [`Self::eval`] — Mitsuba
+    /// 3.9.1's `checkerboard.cpp` tests `mask.x != mask.y` for `color0` in `eval_1` but `==` in `eval`
+    /// (checked against the `mitsuba` 3.9.1 wheel; its regression scene `test_textured_roughconductor`
+    /// depends on it).
+    #[inline]
+    #[must_use]
+    pub fn eval_1(&self, uv: Vec2) -> f32 {
+        if self.same_side(uv) {
+            self.color1.luminance()
+        } else {
+            self.color0.luminance()
         }
     }
 }
@@ -51,5 +71,10 @@ mod tests {
         assert_eq!(c.eval(Vec2::new(0.1, 0.1)), Rgb::ONE);
         assert_eq!(c.eval(Vec2::new(0.3, 0.1)), Rgb::ZERO);
         assert_eq!(c.eval(Vec2::new(0.3, 0.3)), Rgb::ONE);
+        // Mitsuba 3.9.1: checkerboard(color0 = 0.05, color1 = 0.3) gives eval = 0.05 but eval_1 = 0.3 at
+        // uv (0.1, 0.1), and eval = 0.3, eval_1 = 0.05 at (0.7, 0.1).
+        let m = Checkerboard { color0: Rgb::splat(0.05), color1: Rgb::splat(0.3), to_uv: Transform::IDENTITY };
+        assert_eq!((m.eval(Vec2::new(0.1, 0.1)).r(), m.eval_1(Vec2::new(0.1, 0.1))), (0.05, 0.3));
+        assert_eq!((m.eval(Vec2::new(0.7, 0.1)).r(), m.eval_1(Vec2::new(0.7, 0.1))), (0.3, 0.05));
     }
 }

@@ -42,4 +42,15 @@ impl Texture {
             Texture::Bitmap(b) => b.eval(uv),
         }
     }
+
+    /// The value for a float parameter (Mitsuba's `eval_1`): a bitmap's luminance, a checkerboard's scalar
+    /// lookup (see [`Checkerboard::eval_1`]).
+    #[inline]
+    #[must_use]
+    pub fn eval_1(&self, uv: Vec2) -> f32 {
+        match self {
+            Texture::Checkerboard(c) => c.eval_1(uv),
+            Texture::Bitmap(b) => b.eval(uv).luminance(),
+        }
+    }
 }
