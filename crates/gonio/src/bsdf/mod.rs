@@ -31,6 +31,7 @@ pub mod dielectric;
 pub mod diffuse;
 pub mod glossy_mix;
 pub mod mask;
+pub mod measured;
 pub mod oren_nayar;
 pub mod phong;
 pub mod plastic;
@@ -53,6 +54,7 @@ pub use conductor::Conductor;
 pub use dielectric::Dielectric;
 pub use diffuse::Diffuse;
 pub use mask::Mask;
+pub use measured::Measured;
 pub use oren_nayar::OrenNayar;
 pub use phong::Phong;
 pub use plastic::Plastic;
@@ -293,6 +295,7 @@ bsdf_models! {
     Phong(Phong) = "phong",
     BlinnPhong(BlinnPhong) = "blinn_phong",
     OrenNayar(OrenNayar) = "oren_nayar",
+    Measured(Measured) = "measured",
 }
 
 impl Bsdf {

@@ -1,7 +1,8 @@
 //! Sampling: warps of the unit square ([`warp`]), piecewise-constant distributions ([`distribution`]),
-//! the random number generator ([`rng`]) and multiple importance sampling weights ([`mis`]).
+//! bilinear interpolants conditioned on parameters ([`marginal2d`]), the random number generator ([`rng`]) and multiple importance sampling weights ([`mis`]).
 
 pub mod distribution;
+pub mod marginal2d;
 pub mod mis;
 pub mod rng;
 pub mod warp;
