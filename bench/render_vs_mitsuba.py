@@ -18,7 +18,8 @@ Run by `make bench` (never by `make test`): a benchmark, not a test. It prints t
 On a shared machine wall time depends on the other processes: the CPU-time ratio is the fairer one
 there, wall time on an idle machine. The load average is printed with each table.
 
-Usage: python bench/render_vs_mitsuba.py [--spp 64] [--ref-spp 4096] [--repeats 2] [--skip-scaling]
+Usage: python bench/render_vs_mitsuba.py [--spp 64] [--ref-spp 2048] [--repeats 2] [--skip-compare] [--skip-scaling]
+(GONIO_BIN overrides the gonio binary, target/release/gonio by default.)
 """
 
 from __future__ import annotations
@@ -41,15 +42,16 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 SCENES = ROOT.parent / "shared" / "scenes"
 CACHE = ROOT / "bench" / ".cache"
-GONIO = ROOT / "target" / "release" / "gonio"
+GONIO = Path(os.environ.get("GONIO_BIN", ROOT / "target" / "release" / "gonio"))
 VARIANTS = ["scalar_rgb", "llvm_ad_rgb"]
+REF_SEED = 7
 
 
 # ---------------------------------------------------------------------------------------------------------
 # Workers: one Mitsuba render per process (so that variants and their thread pools do not interfere).
 
 
-def mitsuba_worker(variant: str, scene: str, spp: int, out: str, defines: dict[str, str]) -> None:
+def mitsuba_worker(variant: str, scene: str, spp: int, out: str, defines: dict[str, str], seed: int) -> None:
     import mitsuba as mi
 
     mi.set_variant(variant)
@@ -57,7 +59,7 @@ def mitsuba_worker(variant: str, scene: str, spp: int, out: str, defines: dict[s
 
     s = mi.load_file(scene, **defines)
     wall0, cpu0 = time.perf_counter(), time.process_time()
-    img = mi.render(s, spp=spp, seed=0)
+    img = mi.render(s, spp=spp, seed=seed)
     dr.eval(img)
     arr = np.array(img, dtype=np.float32)
     wall, cpu = time.perf_counter() - wall0, time.process_time() - cpu0
@@ -81,13 +83,13 @@ def llvm_library() -> str | None:
     return None
 
 
-def run_mitsuba(variant: str, scene: Path, spp: int, defines: dict[str, str], llvm: str | None) -> tuple[dict, np.ndarray]:
+def run_mitsuba(variant: str, scene: Path, spp: int, defines: dict[str, str], llvm: str | None, seed: int = 0) -> tuple[dict, np.ndarray]:
     env = dict(os.environ)
     if variant.startswith("llvm"):
         env["DRJIT_LIBLLVM_PATH"] = llvm or ""
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "img.npy"
-        cmd = [sys.executable, __file__, "--worker", variant, str(scene), str(spp), str(out), json.dumps(defines)]
+        cmd = [sys.executable, __file__, "--worker", variant, str(scene), str(spp), str(out), json.dumps(defines), str(seed)]
         p = subprocess.run(cmd, capture_output=True, text=True, env=env, check=False)
         if p.returncode != 0:
             raise RuntimeError(f"mitsuba {variant} failed on {scene.name}:\n{p.stderr[-2000:]}")
@@ -141,7 +143,8 @@ def mse(a: np.ndarray, b: np.ndarray) -> float:
 
 def reference(scene: Path, ref_spp: int, llvm: str | None) -> tuple[np.ndarray, str]:
     variant = "llvm_ad_rgb" if llvm else "scalar_rgb"
-    key = hashlib.sha256(scene.read_bytes() + f"{ref_spp}".encode()).hexdigest()[:16]
+    # Its own seed, so that its samples are independent of the timed renders' (seed 0).
+    key = hashlib.sha256(scene.read_bytes() + f"{ref_spp} seed {REF_SEED}".encode()).hexdigest()[:16]
     CACHE.mkdir(parents=True, exist_ok=True)
     path = CACHE / f"{scene.stem}-{ref_spp}spp-{key}.npy"
     label = f"Mitsuba {variant} at {ref_spp} spp"
@@ -149,13 +152,13 @@ def reference(scene: Path, ref_spp: int, llvm: str | None) -> tuple[np.ndarray, 
         return np.load(path), label + " (cached)"
     print(f"rendering the reference of {scene.name}: {label} (once; cached in {path.relative_to(ROOT)}) …", flush=True)
     try:
-        _, img = run_mitsuba(variant, scene, ref_spp, {}, llvm)
+        _, img = run_mitsuba(variant, scene, ref_spp, {}, llvm, REF_SEED)
     except RuntimeError:
         if variant == "scalar_rgb":
             raise
         variant = "scalar_rgb"
         label = f"Mitsuba {variant} at {ref_spp} spp"
-        _, img = run_mitsuba(variant, scene, ref_spp, {}, llvm)
+        _, img = run_mitsuba(variant, scene, ref_spp, {}, llvm, REF_SEED)
     np.save(path, img)
     return img, label
 
@@ -268,7 +271,7 @@ SPHERE_SCENE = """<scene version="3.0.0">
 
 def scaling_triangles(repeats: int, tmp: Path) -> None:
     print(f"\n== gonio: tessellated sphere, BVH build and render (128×128, 8 spp) against triangles ({load_note()})")
-    print(f"{'triangles':>10} {'BVH build s':>12} {'build/(n log2 n) ns':>20} {'render wall s':>14} {'render cpu s':>13} {'cpu/log2 n':>11}")
+    print(f"{'triangles':>10} {'BVH build s':>12} {'build/(n log2 n) ns':>20} {'render s':>9} {'render/log2 n':>14}")
     base = None
     for n_theta, n_phi in [(23, 23), (71, 71), (224, 224), (708, 708)]:
         ply = tmp / f"sphere-{n_theta}.ply"
@@ -276,22 +279,20 @@ def scaling_triangles(repeats: int, tmp: Path) -> None:
         xml = tmp / f"sphere-{n_theta}.xml"
         xml.write_text(SPHERE_SCENE.format(ply=ply))
         g = best_of(repeats, lambda xml=xml: run_gonio(xml, 8, {}, tmp / "tri.exr"))
-        # CPU time of the render alone: the whole process less the time spent loading (one thread).
-        render_cpu = max(g["cpu"] - g["load"], 0.0)
         lg = np.log2(n)
-        base = base or render_cpu / lg
-        print(f"{n:>10} {g['bvh']:>12.4f} {1e9 * g['bvh'] / (n * lg):>20.1f} {g['wall']:>14.3f} {render_cpu:>13.3f} {render_cpu / lg / base:>11.2f}")
-    print("(cpu/log2 n relative to the smallest mesh: constant when render time grows as log n)")
+        base = base or g["wall"] / lg
+        print(f"{n:>10} {g['bvh']:>12.4f} {1e9 * g['bvh'] / (n * lg):>20.1f} {g['wall']:>9.3f} {g['wall'] / lg / base:>14.2f}")
+    print("(render time of the render loop, wall; render/log2 n relative to the smallest mesh: constant when it grows as log n)")
 
 
 def main() -> None:
     if len(sys.argv) > 1 and sys.argv[1] == "--worker":
-        _, _, variant, scene, spp, out, defines = sys.argv
-        mitsuba_worker(variant, scene, int(spp), out, json.loads(defines))
+        _, _, variant, scene, spp, out, defines, seed = sys.argv
+        mitsuba_worker(variant, scene, int(spp), out, json.loads(defines), int(seed))
         return
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--spp", type=int, default=64)
-    ap.add_argument("--ref-spp", type=int, default=4096)
+    ap.add_argument("--ref-spp", type=int, default=2048)
     ap.add_argument("--repeats", type=int, default=2)
     ap.add_argument("--skip-compare", action="store_true")
     ap.add_argument("--skip-scaling", action="store_true")

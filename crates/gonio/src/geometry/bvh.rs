@@ -2,7 +2,7 @@
 //!
 //! Built in two steps:
 //! 1. a binary tree with the binned surface area heuristic (Wald 2007, "On fast Construction of SAH-based
-//!    Bounding Volume Hierarchies", §3: 16 bins over the centroid extent), whose leaf cost counts
+//!    Bounding Volume Hierarchies", §3: 16 bins over the centroid extent of each axis), whose leaf cost counts
 //!    primitives in packets of [`LANES`] because leaves are intersected four at a time;
 //! 2. collapsed into nodes of four children (Dammertz et al. 2008, "Shallow Bounding Volume Hierarchies
 //!    for Fast SIMD Ray Tracing of Incoherent Rays"; Wald et al. 2008, "Getting Rid of Packets"): each
@@ -359,7 +359,7 @@ impl Builder {
         let axis = cbounds.longest_axis();
         let (lo, hi) = (cbounds.min[axis], cbounds.max[axis]);
         let mid = if hi > lo && depth < MAX_SAH_DEPTH {
-            match sah_split(prims, &bounds, axis, lo, hi) {
+            match sah_split(prims, &bounds, &cbounds) {
                 Some(mid) => mid,
                 None if n <= MAX_LEAF => {
                     self.push_leaf(bounds, prims);
@@ -383,45 +383,55 @@ impl Builder {
     }
 }
 
-/// Partition by the cheapest bin boundary; `None` when a leaf is cheaper (and small enough).
-fn sah_split(prims: &mut [BuildPrim], bounds: &Bounds3, axis: usize, lo: f32, hi: f32) -> Option<usize> {
-    let scale = BINS as f32 / (hi - lo);
-    let bin_of = |c: Vec3| (((c[axis] - lo) * scale) as usize).min(BINS - 1);
-    let mut counts = [0usize; BINS];
-    let mut bin_bounds = [Bounds3::EMPTY; BINS];
-    for p in prims.iter() {
-        let b = bin_of(p.centroid);
-        counts[b] += 1;
-        bin_bounds[b] = bin_bounds[b].union(p.bounds);
-    }
-    // Sweep from the right to get the area and count right of each boundary, then from the left.
-    let mut right_area = [0.0f32; BINS];
-    let mut right_count = [0usize; BINS];
-    let (mut acc, mut cnt) = (Bounds3::EMPTY, 0);
-    for i in (1..BINS).rev() {
-        acc = acc.union(bin_bounds[i]);
-        cnt += counts[i];
-        right_area[i] = acc.surface_area();
-        right_count[i] = cnt;
-    }
-    let (mut acc, mut cnt) = (Bounds3::EMPTY, 0);
-    let mut best = (f32::INFINITY, 0);
-    for i in 1..BINS {
-        acc = acc.union(bin_bounds[i - 1]);
-        cnt += counts[i - 1];
-        let cost = packets(cnt) * acc.surface_area() + packets(right_count[i]) * right_area[i];
-        if cnt > 0 && right_count[i] > 0 && cost < best.0 {
-            best = (cost, i);
+/// Partition by the cheapest bin boundary over all three axes (`cbounds` bounds the centroids);
+/// `None` when a leaf is cheaper (and small enough).
+fn sah_split(prims: &mut [BuildPrim], bounds: &Bounds3, cbounds: &Bounds3) -> Option<usize> {
+    // (cost, axis, bin boundary)
+    let mut best = (f32::INFINITY, 0, 0);
+    for axis in 0..3 {
+        let (lo, hi) = (cbounds.min[axis], cbounds.max[axis]);
+        if !(hi > lo) {
+            continue;
+        }
+        let scale = BINS as f32 / (hi - lo);
+        let mut counts = [0usize; BINS];
+        let mut bin_bounds = [Bounds3::EMPTY; BINS];
+        for p in prims.iter() {
+            let b = (((p.centroid[axis] - lo) * scale) as usize).min(BINS - 1);
+            counts[b] += 1;
+            bin_bounds[b] = bin_bounds[b].union(p.bounds);
+        }
+        // Sweep from the right to get the area and count right of each boundary, then from the left.
+        let mut right_area = [0.0f32; BINS];
+        let mut right_count = [0usize; BINS];
+        let (mut acc, mut cnt) = (Bounds3::EMPTY, 0);
+        for i in (1..BINS).rev() {
+            acc = acc.union(bin_bounds[i]);
+            cnt += counts[i];
+            right_area[i] = acc.surface_area();
+            right_count[i] = cnt;
+        }
+        let (mut acc, mut cnt) = (Bounds3::EMPTY, 0);
+        for i in 1..BINS {
+            acc = acc.union(bin_bounds[i - 1]);
+            cnt += counts[i - 1];
+            let cost = packets(cnt) * acc.surface_area() + packets(right_count[i]) * right_area[i];
+            if cnt > 0 && right_count[i] > 0 && cost < best.0 {
+                best = (cost, axis, i);
+            }
         }
     }
+    let (cost, axis, boundary) = best;
     let leaf_cost = packets(prims.len());
-    let split_cost = TRAVERSAL_COST + best.0 / bounds.surface_area().max(f32::MIN_POSITIVE);
-    if best.1 == 0 || (split_cost >= leaf_cost && prims.len() <= MAX_LEAF) {
+    let split_cost = TRAVERSAL_COST + cost / bounds.surface_area().max(f32::MIN_POSITIVE);
+    if boundary == 0 || (split_cost >= leaf_cost && prims.len() <= MAX_LEAF) {
         return None;
     }
+    let (lo, hi) = (cbounds.min[axis], cbounds.max[axis]);
+    let scale = BINS as f32 / (hi - lo);
     let mut mid = 0;
     for i in 0..prims.len() {
-        if bin_of(prims[i].centroid) < best.1 {
+        if ((((prims[i].centroid[axis] - lo) * scale) as usize).min(BINS - 1)) < boundary {
             prims.swap(i, mid);
             mid += 1;
         }

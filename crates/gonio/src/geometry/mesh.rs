@@ -360,7 +360,8 @@ mod tests {
             for (lane, t) in tris.iter().enumerate() {
                 packet.set(lane, *t);
             }
-            let ray = Ray::new(v() * 3.0, crate::sampling::warp::sample_uniform_sphere(Vec2::new(v().x * 0.5 + 0.5, v().y * 0.5 + 0.5)), 4.0);
+            let ray =
+                Ray::new(v() * 3.0, crate::sampling::warp::sample_uniform_sphere(Vec2::new(v().x * 0.5 + 0.5, v().y * 0.5 + 0.5)), 4.0);
             let h = packet.intersect(&ray, ray.tmax);
             assert_eq!(h.mask & 8, 0, "the empty lane is never hit");
             for (lane, t) in tris.iter().enumerate() {

@@ -82,7 +82,8 @@ struct Primitives {
 impl Primitives {
     fn new(shapes: &[Shape], refs: &[SlotRef], order: &[u32]) -> Self {
         let packets = order.len() / LANES;
-        let mut p = Primitives { triangles: vec![Triangle4::default(); packets], others: vec![0; packets], slots: Vec::with_capacity(order.len()) };
+        let mut p =
+            Primitives { triangles: vec![Triangle4::default(); packets], others: vec![0; packets], slots: Vec::with_capacity(order.len()) };
         for (slot, &i) in order.iter().enumerate() {
             let (packet, lane) = (slot / LANES, slot % LANES);
             if i == EMPTY_SLOT {
