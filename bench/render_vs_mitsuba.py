@@ -287,8 +287,9 @@ def scaling_triangles(repeats: int, tmp: Path) -> None:
 
 def main() -> None:
     if len(sys.argv) > 1 and sys.argv[1] == "--worker":
-        _, _, variant, scene, spp, out, defines, seed = sys.argv
-        mitsuba_worker(variant, scene, int(spp), out, json.loads(defines), int(seed))
+        variant, scene, spp, out, defines = sys.argv[2:7]
+        seed = int(sys.argv[7]) if len(sys.argv) > 7 else 0
+        mitsuba_worker(variant, scene, int(spp), out, json.loads(defines), seed)
         return
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--spp", type=int, default=64)
