@@ -1,6 +1,7 @@
 # gonio — the only entry points a newcomer needs.
 #   make demo   build, render scenes/demo.xml to out/demo.png, then prove every model's physics with `gonio check --all`
 #   make test   build, then run the Rust tests and the Python tests (incl. the Mitsuba 3 cross-checks)
+#   make bench  criterion benchmarks, and gonio vs Mitsuba 3 timings, errors and scaling tables
 
 PYTHON ?= python3
 VENV   := .venv
@@ -49,8 +50,12 @@ test-rust:
 test-python:
 	$(VPY) -m pytest -q -rxX crates/gonio-py/tests
 
-bench: python
+# Benchmarks, run by hand (never part of `make test`): criterion micro-benchmarks, then gonio against
+# Mitsuba 3 (scalar_rgb, llvm_ad_rgb) on ../shared/scenes with the scaling tables (bench/render_vs_mitsuba.py),
+# and the Python package's batched f/sample against Mitsuba's bsdf.eval (bench/python_bsdf_vs_mitsuba.py).
+bench: cli python
 	$(CARGO) bench -p gonio
+	$(VPY) bench/render_vs_mitsuba.py
 	$(VPY) bench/python_bsdf_vs_mitsuba.py
 
 fmt:

@@ -104,9 +104,10 @@ pub fn run(args: Args) -> Result<ExitCode, Error> {
     if !args.quiet {
         let rate = f64::from(out.spp_done) * f64::from(w) * f64::from(h) / out.seconds.max(1e-9);
         eprintln!(
-            "gonio: {w}×{h}, {} spp, {} primitives: loaded in {load_seconds:.2} s, rendered in {:.2} s ({:.2} Msamples/s) → {}",
+            "gonio: {w}×{h}, {} spp, {} primitives: loaded in {load_seconds:.3} s, BVH built in {:.4} s, rendered in {:.3} s ({:.2} Msamples/s) → {}",
             out.spp_done,
             scene.primitive_count(),
+            scene.bvh_seconds,
             out.seconds,
             rate / 1e6,
             output.display()

@@ -14,10 +14,11 @@ pub use material::Material;
 use crate::camera::PerspectiveCamera;
 use crate::error::Result;
 use crate::film::FilmSpec;
-use crate::geometry::mesh::intersect_triangle;
+use crate::geometry::bvh::{EMPTY_SLOT, LANES};
+use crate::geometry::mesh::Triangle4;
 use crate::geometry::{Bvh, PrimHit, Ray, Shape, SurfaceInteraction};
 use crate::light::Light;
-use glam::Vec3;
+use glam::Vec2;
 use std::path::Path;
 
 /// Which integrator renders the scene.
@@ -55,26 +56,99 @@ pub struct Scene {
     pub integrator: IntegratorKind,
     /// Things accepted but approximated (e.g. a Gaussian filter rendered as a box).
     pub warnings: Vec<String>,
+    /// Seconds spent building the BVH and its primitive packets (for benchmarks).
+    pub bvh_seconds: f64,
     bvh: Bvh,
     /// The primitives in BVH leaf order.
-    prims: Vec<Primitive>,
+    prims: Primitives,
 }
 
-/// One primitive as the BVH's leaves need it: triangles inline (no index lookups in the inner loop),
-/// other shapes by reference.
+/// The shape and primitive at one BVH slot ([`EMPTY_SLOT`] as the shape for padding).
 #[derive(Clone, Copy, Debug)]
-enum Primitive {
-    Triangle { p0: Vec3, e1: Vec3, e2: Vec3, shape: u32, prim: u32 },
-    Other { shape: u32, prim: u32 },
+struct SlotRef {
+    shape: u32,
+    prim: u32,
 }
 
-impl Primitive {
-    #[inline]
-    fn intersect(&self, shapes: &[Shape], ray: &Ray) -> Option<(u32, u32, PrimHit)> {
-        match *self {
-            Primitive::Triangle { p0, e1, e2, shape, prim } => intersect_triangle(p0, e1, e2, ray).map(|h| (shape, prim, h)),
-            Primitive::Other { shape, prim } => shapes[shape as usize].intersect(prim, ray).map(|h| (shape, prim, h)),
+/// The primitives in BVH leaf order, in packets of four slots: triangles inline as a [`Triangle4`] (no
+/// index lookups in the inner loop), other shapes (spheres, disks) flagged in `others` and intersected
+/// one by one.
+#[derive(Clone, Debug, Default)]
+struct Primitives {
+    triangles: Vec<Triangle4>,
+    /// Bit `i` of `others[k]`: slot `4k + i` holds a shape that is not a triangle.
+    others: Vec<u8>,
+    slots: Vec<SlotRef>,
+}
+
+impl Primitives {
+    fn new(shapes: &[Shape], refs: &[SlotRef], order: &[u32]) -> Self {
+        let packets = order.len() / LANES;
+        let mut p =
+            Primitives { triangles: vec![Triangle4::default(); packets], others: vec![0; packets], slots: Vec::with_capacity(order.len()) };
+        for (slot, &i) in order.iter().enumerate() {
+            let (packet, lane) = (slot / LANES, slot % LANES);
+            if i == EMPTY_SLOT {
+                p.slots.push(SlotRef { shape: EMPTY_SLOT, prim: 0 });
+                continue;
+            }
+            let r = refs[i as usize];
+            match &shapes[r.shape as usize] {
+                Shape::Mesh(m) => p.triangles[packet].set(lane, m.triangle_edges(r.prim)),
+                _ => p.others[packet] |= 1 << lane,
+            }
+            p.slots.push(r);
         }
+        p
+    }
+
+    /// The closest hit among slots `first..first + count` (a BVH leaf) below `tmax`.
+    #[inline(always)]
+    fn closest(&self, shapes: &[Shape], ray: &Ray, first: u32, count: u32, mut tmax: f32) -> Option<(f32, (SlotRef, PrimHit))> {
+        let mut best = None;
+        for packet in (first as usize / LANES)..(first + count) as usize / LANES {
+            let h = self.triangles[packet].intersect(ray, tmax);
+            let mut mask = h.mask;
+            while mask != 0 {
+                let lane = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                if h.t[lane] < tmax {
+                    tmax = h.t[lane];
+                    best = Some((packet * LANES + lane, PrimHit { t: h.t[lane], uv: Vec2::new(h.b1[lane], h.b2[lane]) }));
+                }
+            }
+            let mut others = u32::from(self.others[packet]);
+            while others != 0 {
+                let slot = packet * LANES + others.trailing_zeros() as usize;
+                others &= others - 1;
+                let r = self.slots[slot];
+                let clipped = Ray { tmax, ..*ray };
+                if let Some(hit) = shapes[r.shape as usize].intersect(r.prim, &clipped) {
+                    tmax = hit.t;
+                    best = Some((slot, hit));
+                }
+            }
+        }
+        best.map(|(slot, hit)| (hit.t, (self.slots[slot], hit)))
+    }
+
+    /// Whether any of slots `first..first + count` blocks `ray`.
+    #[inline(always)]
+    fn any(&self, shapes: &[Shape], ray: &Ray, first: u32, count: u32) -> bool {
+        for packet in (first as usize / LANES)..(first + count) as usize / LANES {
+            if self.triangles[packet].intersect(ray, ray.tmax).mask != 0 {
+                return true;
+            }
+            let mut others = u32::from(self.others[packet]);
+            while others != 0 {
+                let r = self.slots[packet * LANES + others.trailing_zeros() as usize];
+                others &= others - 1;
+                if shapes[r.shape as usize].intersect(r.prim, ray).is_some() {
+                    return true;
+                }
+            }
+        }
+        false
     }
 }
 
@@ -102,49 +176,34 @@ impl Scene {
         let mut bounds = Vec::new();
         for (s, shape) in shapes.iter().enumerate() {
             for p in 0..shape.primitive_count() as u32 {
-                refs.push((s as u32, p));
+                refs.push(SlotRef { shape: s as u32, prim: p });
                 bounds.push(shape.primitive_bounds(p));
             }
         }
+        let start = std::time::Instant::now();
         let bvh = Bvh::build(&bounds);
-        let prims = bvh
-            .order()
-            .iter()
-            .map(|&i| {
-                let (shape, prim) = refs[i as usize];
-                match &shapes[shape as usize] {
-                    Shape::Mesh(m) => {
-                        let [p0, e1, e2] = m.triangle_edges(prim);
-                        Primitive::Triangle { p0, e1, e2, shape, prim }
-                    }
-                    _ => Primitive::Other { shape, prim },
-                }
-            })
-            .collect();
+        let prims = Primitives::new(&shapes, &refs, bvh.order());
+        let bvh_seconds = start.elapsed().as_secs_f64();
         let environment = lights.iter().position(Light::is_environment).map(|i| i as u32);
-        Scene { shapes, materials, shape_lights, lights, environment, camera, film, sampler, integrator, warnings, bvh, prims }
+        Scene { shapes, materials, shape_lights, lights, environment, camera, film, sampler, integrator, warnings, bvh_seconds, bvh, prims }
     }
 
     /// Number of primitives in the BVH.
     #[must_use]
     pub fn primitive_count(&self) -> usize {
-        self.prims.len()
+        self.prims.slots.iter().filter(|r| r.shape != EMPTY_SLOT).count()
     }
 
     /// The closest surface along `ray`.
     #[must_use]
     pub fn intersect(&self, ray: &Ray) -> Option<SurfaceInteraction> {
-        let mut r = *ray;
-        let (_, (shape, prim, hit)) = self.bvh.closest(ray, |slot, tmax| {
-            r.tmax = tmax;
-            self.prims[slot as usize].intersect(&self.shapes, &r).map(|h| (h.2.t, h))
-        })?;
-        Some(self.shapes[shape as usize].interaction(shape, prim, ray, &hit))
+        let (r, hit) = self.bvh.closest(ray, |first, count, tmax| self.prims.closest(&self.shapes, ray, first, count, tmax))?;
+        Some(self.shapes[r.shape as usize].interaction(r.shape, r.prim, ray, &hit))
     }
 
     /// Whether anything blocks `ray` before its `tmax`.
     #[must_use]
     pub fn occluded(&self, ray: &Ray) -> bool {
-        self.bvh.any(ray, |slot| self.prims[slot as usize].intersect(&self.shapes, ray).is_some())
+        self.bvh.any(ray, |first, count| self.prims.any(&self.shapes, ray, first, count))
     }
 }
