@@ -612,3 +612,119 @@ def test_roughconductor_ggx_visible_samples(alphas):
     mi_val_g, mi_pdf_g = mi_eval_pdf(m, wo[v], s.wi[v].astype(np.float64))
     np.testing.assert_allclose(g_f, mi_val_g, rtol=ROUGH_RTOL, atol=ROUGH_RTOL * ROUGH_FLOOR, err_msg="eval at gonio's wi")
     np.testing.assert_allclose(s.pdf[v], mi_pdf_g, rtol=ROUGH_RTOL, atol=ROUGH_RTOL * ROUGH_FLOOR, err_msg="pdf at gonio's wi")
+
+
+# --- roughdielectric, plastic, roughplastic --------------------------------------------------------------
+
+DIELECTRIC_ETAS = [{"int_ior": 1.5, "ext_ior": 1.0}, {"int_ior": 1.0, "ext_ior": 1.5}, {"int_ior": 2.417, "ext_ior": 1.0}]
+ROUGH_DIELECTRIC_SETS = [(d, a, e) for d in ("beckmann", "ggx") for a in ROUGH_ALPHAS for e in DIELECTRIC_ETAS[:2]] + [
+    ("ggx", {"alpha": 0.3}, DIELECTRIC_ETAS[2]), ("beckmann", {"alpha_u": 0.1, "alpha_v": 0.4}, DIELECTRIC_ETAS[2])]
+
+
+def rough_dielectric_id(params):
+    d, a, e = params
+    return rough_id((d, a, True)) + f"-eta={e['int_ior']}/{e['ext_ior']}"
+
+
+def rough_dielectric_pairs(g, seed, n=1000):
+    """n uniform pairs over the sphere and 2n with wi sampled by gonio from wo on either side (reflection
+    and transmission, from outside and from inside)."""
+    r = rng(seed)
+    wo_a, wi_a = sphere(r, n), sphere(r, n)
+    wo_b = sphere(r, 2 * n)
+    s = g.sample(wo_b, r.random(2 * n, dtype=np.float32), r.random((2 * n, 2), dtype=np.float32))
+    return np.concatenate([wo_a, wo_b[s.valid]]), np.concatenate([wi_a, s.wi[s.valid]])
+
+
+@pytest.mark.parametrize("params", ROUGH_DIELECTRIC_SETS, ids=rough_dielectric_id)
+def test_roughdielectric_eval_pdf(params):
+    """gonio f(a, b)·|cos θb| == Mitsuba eval and pdf == pdf to 1e-3 relative where the value exceeds 1e-4,
+    reflection and transmission, from both sides. Beckmann: Mitsuba's values × G1_exact/G1_walter (its
+    rational approximation of G1, Walter 2007 eq. 27, undone as for roughconductor): f has G1(ωo) G1(ωi),
+    the visible-normal pdf G1(ωo)."""
+    distribution, alphas, etas = params
+    spec = {"type": "roughdielectric", "distribution": distribution, **alphas, **etas}
+    g, m = load_both(spec)
+    wo, wi = rough_dielectric_pairs(g, seed=31)
+    mi_val, mi_pdf = mi_eval_pdf(m, wo, wi)
+    g_val = g.f(wo, wi).astype(np.float64) * np.abs(wi[:, 2:3].astype(np.float64))
+    g_pdf = g.pdf(wo, wi).astype(np.float64)
+    if distribution == "beckmann":
+        au, av = alpha_uv(alphas)
+        r_o, r_i = g1_ratio(wo, au, av), g1_ratio(wi, au, av)
+        mi_val, mi_pdf = mi_val * (r_o * r_i)[:, None], mi_pdf * r_o
+    err_val, big_val = relative_errors(g_val, mi_val)
+    err_pdf, big_pdf = relative_errors(g_pdf, mi_pdf)
+    transmitted = (wo[:, 2] * wi[:, 2] < 0)[:, None] & big_val
+    print(f"\n{rough_dielectric_id(params)}: max rel error f·cos {err_val.max():.2e} ({big_val.sum()} values, "
+          f"{transmitted.sum()} transmitted), pdf {err_pdf.max():.2e} ({big_pdf.sum()} values)")
+    assert big_val.any(axis=1).sum() >= 1000 and big_pdf.sum() >= 1000, "too few non-negligible pairs"
+    assert transmitted.any(axis=1).sum() >= 200, "too few transmitted pairs"
+    assert err_val.max() < ROUGH_RTOL, f"f·cos vs Mitsuba eval: max relative error {err_val.max():.3e}"
+    assert err_pdf.max() < ROUGH_RTOL, f"pdf vs Mitsuba pdf: max relative error {err_pdf.max():.3e}"
+    # Below the floor the issue sets no bound; measured (2026-11): at most 1.02e-7 absolute (GGX α = 1,
+    # η = 1.5, a value of 2e-6 near grazing), so values below it must agree to 2e-7.
+    np.testing.assert_allclose(g_val[~big_val], mi_val[~big_val], rtol=0, atol=2e-7, err_msg="small f·cos")
+    np.testing.assert_allclose(g_pdf[~big_pdf], mi_pdf[~big_pdf], rtol=0, atol=2e-7, err_msg="small pdf")
+
+
+def fresnel_f64(mu, eta):
+    """Exact unpolarised Fresnel reflectance for cos θ = mu > 0 on the side of relative index eta (ηt/ηi)."""
+    sin2_t = (1 - mu * mu) / (eta * eta)
+    cos_t = np.sqrt(np.clip(1 - sin2_t, 0, None))
+    rs = (mu - eta * cos_t) / (mu + eta * cos_t)
+    rp = (eta * mu - cos_t) / (eta * mu + cos_t)
+    return np.where(sin2_t >= 1, 1.0, 0.5 * (rs * rs + rp * rp))
+
+
+def fdr_exact(eta, n=200_000):
+    """F̄ = 2∫₀¹ F(μ) μ dμ by the midpoint rule in float64 (error ~1e-10; the kink at the critical angle
+    costs O(1/n²) too)."""
+    mu = (np.arange(n) + 0.5) / n
+    return float(2 * np.sum(fresnel_f64(mu, eta) * mu) / n)
+
+
+def mitsuba_fdr(eta):
+    """Mitsuba's fitted F̄ (Egan & Hilgeman 1973 for η < 1, d'Eon & Irving 2011 otherwise), from Mitsuba."""
+    return float(mi.fresnel_diffuse_reflectance(eta))
+
+
+PLASTIC_SETS = [
+    {"diffuse_reflectance": 0.5, "int_ior": 1.5, "ext_ior": 1.0},
+    {"diffuse_reflectance": [0.1, 0.5, 0.9], "int_ior": 1.49, "ext_ior": 1.000277, "nonlinear": True},
+    {"diffuse_reflectance": [0.8, 0.3, 0.2], "specular_reflectance": [0.5, 0.7, 1.0], "int_ior": 1.8, "ext_ior": 1.0},
+]
+
+
+@pytest.mark.parametrize("params", PLASTIC_SETS, ids=lambda p: "-".join(f"{k}={v}" for k, v in p.items()))
+def test_plastic_eval_pdf(params):
+    """plastic's diffuse lobe (eval sees no delta) and pdf at random pairs, 1e-3 relative above 1e-4. The
+    pdf has no F̄ in it and is compared as is. Mitsuba's f uses its fitted F̄ᵢ where gonio integrates it
+    exactly: Mitsuba's eval × (1 − X_mitsuba)/(1 − X_exact), X = F̄ᵢ (or ρF̄ᵢ with `nonlinear`), undoes that
+    (a constant factor per channel, 1.2e-3 at η = 1.5), and the raw gap must be no larger than it."""
+    spec = {"type": "plastic", **params}
+    g, m = load_both(spec)
+    r = rng(41)
+    wo, wi = sphere(r, 3 * N), sphere(r, 3 * N)
+    # Two thirds of the pairs above the surface (where plastic scatters), the rest anywhere (zeros agree).
+    wo[N:, 2], wi[N:, 2] = np.abs(wo[N:, 2]), np.abs(wi[N:, 2])
+    mi_val, mi_pdf = mi_eval_pdf(m, wo, wi)
+    g_val = g.f(wo, wi).astype(np.float64) * np.abs(wi[:, 2:3].astype(np.float64))
+    g_pdf = g.pdf(wo, wi).astype(np.float64)
+    eta = params["int_ior"] / params["ext_ior"]
+    rho = np.broadcast_to(np.asarray(params["diffuse_reflectance"], dtype=np.float64), (3,))
+    fi_exact, fi_mi = fdr_exact(1 / eta), mitsuba_fdr(1 / eta)
+    if params.get("nonlinear", False):
+        factor = (1 - rho * fi_mi) / (1 - rho * fi_exact)
+    else:
+        factor = np.full(3, (1 - fi_mi) / (1 - fi_exact))
+    raw, big = relative_errors(g_val, mi_val)
+    err_val, big_val = relative_errors(g_val, mi_val * factor)
+    err_pdf, big_pdf = relative_errors(g_pdf, mi_pdf)
+    print(f"\nplastic {params}: F̄ᵢ exact {fi_exact:.6f}, Mitsuba {fi_mi:.6f}; raw max rel difference f·cos "
+          f"{raw.max():.2e}, corrected {err_val.max():.2e} ({big_val.sum()} values), pdf {err_pdf.max():.2e} "
+          f"({big_pdf.sum()} values)")
+    assert big_val.any(axis=1).sum() >= 1000 and big_pdf.sum() >= 1000
+    assert err_val.max() < ROUGH_RTOL, f"f·cos vs corrected Mitsuba eval: {err_val.max():.3e}"
+    assert err_pdf.max() < ROUGH_RTOL, f"pdf vs Mitsuba pdf: {err_pdf.max():.3e}"
+    assert raw.max() <= np.abs(factor - 1).max() + 1e-4, "the raw gap exceeds what the fitted F̄ explains"

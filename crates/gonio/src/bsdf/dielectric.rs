@@ -106,6 +106,28 @@ fn ior(p: &Props, name: &'static str, default: f32) -> Result<f32> {
     }
 }
 
+/// The delta sampling shared by the smooth interfaces (`dielectric`, `thindielectric`): mirror `wo`
+/// about +z with probability `r` (the reflected fraction), else follow `transmitted()` = (ωt, ηₜ/ηᵢ),
+/// with probability 1 − r. Choosing a lobe in proportion to its energy cancels the Fresnel factor from
+/// both weights: they are the multipliers, and transmission carries the radiance factor (ηᵢ/ηₜ)² = 1/η²
+/// (1 for a slab, whose two refractions cancel). `None` when `transmitted` has no direction.
+pub(crate) fn sample_reflect_or_transmit(
+    wo: Vec3,
+    uc: f32,
+    r: f32,
+    reflectance: Rgb,
+    transmittance: Rgb,
+    transmitted: impl FnOnce() -> Option<(Vec3, f32)>,
+) -> Option<BsdfSample> {
+    if uc < r {
+        return BsdfSample::delta(reflect(wo, Vec3::Z), reflectance * r, r, BsdfFlags::DELTA_REFLECTION, 1.0);
+    }
+    let t = 1.0 - r;
+    let (wt, eta) = transmitted()?;
+    // Radiance is compressed into a smaller solid angle on the denser side: (ηᵢ/ηₜ)².
+    BsdfSample::delta(wt, transmittance * (t / (eta * eta)), t, BsdfFlags::DELTA_TRANSMISSION, eta)
+}
+
 impl crate::bsdf::Examples for Dielectric {
     const EXAMPLES: &'static [&'static str] = &[
         r#"{"type": "dielectric"}"#,
@@ -131,16 +153,8 @@ impl BsdfModel for Dielectric {
             return None;
         }
         let r = self.reflected_fraction(wo.z);
-        // Choose a lobe in proportion to its energy: the Fresnel factor cancels from both weights.
-        if uc < r {
-            let wi = reflect(wo, Vec3::Z);
-            return BsdfSample::delta(wi, self.specular_reflectance * r, r, BsdfFlags::DELTA_REFLECTION, 1.0);
-        }
-        let t = 1.0 - r;
-        let refr = refract(wo, self.eta)?;
-        // Radiance is compressed into a smaller solid angle on the denser side: (ηᵢ/ηₜ)².
-        let value = self.specular_transmittance * (t / (refr.eta * refr.eta));
-        BsdfSample::delta(refr.wt, value, t, BsdfFlags::DELTA_TRANSMISSION, refr.eta)
+        let transmitted = || refract(wo, self.eta).map(|refr| (refr.wt, refr.eta));
+        sample_reflect_or_transmit(wo, uc, r, self.specular_reflectance, self.specular_transmittance, transmitted)
     }
 
     fn pdf(&self, _wo: Vec3, _wi: Vec3) -> f32 {

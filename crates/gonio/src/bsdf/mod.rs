@@ -32,6 +32,7 @@ pub mod diffuse;
 pub mod glossy_mix;
 pub mod mask;
 pub mod measured;
+pub mod layered;
 pub mod oren_nayar;
 pub mod phong;
 pub mod plastic;
@@ -55,6 +56,7 @@ pub use dielectric::Dielectric;
 pub use diffuse::Diffuse;
 pub use mask::Mask;
 pub use measured::Measured;
+pub use layered::Layered;
 pub use oren_nayar::OrenNayar;
 pub use phong::Phong;
 pub use plastic::Plastic;
@@ -296,6 +298,7 @@ bsdf_models! {
     BlinnPhong(BlinnPhong) = "blinn_phong",
     OrenNayar(OrenNayar) = "oren_nayar",
     Measured(Measured) = "measured",
+    Layered(Layered) = "layered",
 }
 
 impl Bsdf {

@@ -25,10 +25,10 @@
 //! assert!((s.pdf - (1.0 - 2.0 * 0.04 / 1.04)).abs() < 1e-6);
 //! ```
 
-use super::dielectric::relative_ior;
+use super::dielectric::{relative_ior, sample_reflect_or_transmit};
 use super::{BsdfFlags, BsdfModel, BsdfSample};
 use crate::error::Result;
-use crate::fresnel::{fresnel_dielectric, reflect};
+use crate::fresnel::fresnel_dielectric;
 use crate::math::{Vec2, Vec3};
 use crate::props::Props;
 use crate::spectrum::Rgb;
@@ -82,12 +82,8 @@ impl BsdfModel for ThinDielectric {
             return None;
         }
         let r = self.reflected_fraction(wo.z);
-        if uc < r {
-            BsdfSample::delta(reflect(wo, Vec3::Z), self.specular_reflectance * r, r, BsdfFlags::DELTA_REFLECTION, 1.0)
-        } else {
-            let t = 1.0 - r;
-            BsdfSample::delta(-wo, self.specular_transmittance * t, t, BsdfFlags::DELTA_TRANSMISSION, 1.0)
-        }
+        // Transmission is undeviated and leaves into the medium it came from: η = 1.
+        sample_reflect_or_transmit(wo, uc, r, self.specular_reflectance, self.specular_transmittance, || Some((-wo, 1.0)))
     }
 
     fn pdf(&self, _wo: Vec3, _wi: Vec3) -> f32 {
