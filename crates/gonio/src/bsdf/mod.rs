@@ -24,6 +24,31 @@
 //! assert!((bsdf.f(wo, s.wi).g() - 0.5 / std::f32::consts::PI).abs() < 1e-6);
 //! ```
 
+/// Implements [`BsdfModel`] for a type that is one model under another name (a plugin over a shared core)
+/// by forwarding all four methods to the field given: `forward_bsdf_model!(RoughConductor => 0);`.
+macro_rules! forward_bsdf_model {
+    ($ty:ty => $field:tt) => {
+        impl $crate::bsdf::BsdfModel for $ty {
+            #[inline]
+            fn flags(&self) -> $crate::bsdf::BsdfFlags {
+                self.$field.flags()
+            }
+            #[inline]
+            fn f(&self, wo: $crate::math::Vec3, wi: $crate::math::Vec3) -> $crate::spectrum::Rgb {
+                self.$field.f(wo, wi)
+            }
+            #[inline]
+            fn sample(&self, wo: $crate::math::Vec3, uc: f32, u: $crate::math::Vec2) -> Option<$crate::bsdf::BsdfSample> {
+                self.$field.sample(wo, uc, u)
+            }
+            #[inline]
+            fn pdf(&self, wo: $crate::math::Vec3, wi: $crate::math::Vec3) -> f32 {
+                self.$field.pdf(wo, wi)
+            }
+        }
+    };
+}
+
 pub mod blend;
 pub mod blinn_phong;
 pub mod conductor;

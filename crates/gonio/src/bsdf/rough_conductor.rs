@@ -129,12 +129,7 @@ impl MicrofacetConductor {
             return 0.0;
         }
         let wm = (wo + wi).normalize();
-        let pdf = self.distribution.pdf_wm(wo, wm, self.sample_visible) / (4.0 * wo.dot(wm));
-        if pdf.is_finite() {
-            pdf
-        } else {
-            0.0
-        }
+        self.distribution.pdf_reflected(wo, wm, self.sample_visible)
     }
 
     /// Sample ωh, reflect ωo about it; `f` and `pdf` are those of the returned ωi.
@@ -262,20 +257,7 @@ impl RoughConductor {
     }
 }
 
-impl BsdfModel for RoughConductor {
-    fn flags(&self) -> BsdfFlags {
-        self.0.flags()
-    }
-    fn f(&self, wo: Vec3, wi: Vec3) -> Rgb {
-        self.0.f(wo, wi)
-    }
-    fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
-        self.0.sample(wo, uc, u)
-    }
-    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        self.0.pdf(wo, wi)
-    }
-}
+forward_bsdf_model!(RoughConductor => 0);
 
 /// The harness on lobes too narrow for its chi-square cell integrals: every check but chi-square must
 /// pass; the chi-square is rerun with 24 (instead of 6) Gauss–Legendre points per cell and axis and must
