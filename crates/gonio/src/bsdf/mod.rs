@@ -49,11 +49,13 @@ macro_rules! forward_bsdf_model {
     };
 }
 
+pub mod ashikhmin_shirley;
 pub mod blend;
 pub mod blinn_phong;
 pub mod conductor;
 pub mod dielectric;
 pub mod diffuse;
+pub mod energy_compensation;
 pub mod glossy_mix;
 pub mod oren_nayar;
 pub mod phong;
@@ -71,6 +73,7 @@ use crate::math::{Vec2, Vec3};
 use crate::props::Props;
 use crate::spectrum::Rgb;
 
+pub use ashikhmin_shirley::AshikhminShirley;
 pub use blend::BlendBsdf;
 pub use blinn_phong::BlinnPhong;
 pub use conductor::Conductor;
@@ -315,6 +318,7 @@ bsdf_models! {
     Phong(Phong) = "phong",
     BlinnPhong(BlinnPhong) = "blinn_phong",
     OrenNayar(OrenNayar) = "oren_nayar",
+    AshikhminShirley(AshikhminShirley) = "ashikhmin_shirley",
 }
 
 impl Bsdf {

@@ -37,6 +37,7 @@
 //! assert!(s.weight.r() > s.weight.b());
 //! ```
 
+use super::energy_compensation::ConductorCompensation;
 use super::{BsdfFlags, BsdfModel, BsdfSample, Conductor};
 use crate::error::{Error, Result};
 use crate::fresnel::reflect;
@@ -58,6 +59,8 @@ pub struct MicrofacetConductor {
     pub sample_visible: bool,
     /// The smooth conductor whose reflectance F(cos) weights each microfacet.
     pub fresnel: Conductor,
+    /// The multiple-scattering lobe added by `energy_compensation` ([`ConductorCompensation`]).
+    pub compensation: Option<ConductorCompensation>,
 }
 
 /// What a plugin accepts and defaults to; the plugins differ only in these.
@@ -77,7 +80,15 @@ impl MicrofacetConductor {
     /// A microfacet conductor with `distribution`, `shadowing` and the Fresnel term of `fresnel`.
     #[must_use]
     pub fn new(distribution: MicrofacetDistribution, shadowing: Shadowing, sample_visible: bool, fresnel: Conductor) -> Self {
-        MicrofacetConductor { distribution, shadowing, sample_visible, fresnel }
+        MicrofacetConductor { distribution, shadowing, sample_visible, fresnel, compensation: None }
+    }
+
+    /// The same model with Kulla & Conty's multiple-scattering lobe added (isotropic roughness only;
+    /// see [`super::energy_compensation`]).
+    #[must_use]
+    pub fn with_energy_compensation(mut self) -> Self {
+        self.compensation = Some(ConductorCompensation::new(&self));
+        self
     }
 
     pub(crate) fn from_props(p: &Props, rules: &MicrofacetParams) -> Result<Self> {
@@ -216,19 +227,49 @@ impl crate::bsdf::Examples for RoughConductor {
 
 impl BsdfModel for MicrofacetConductor {
     fn flags(&self) -> BsdfFlags {
-        BsdfFlags::GLOSSY_REFLECTION
+        if self.compensation.is_some() {
+            BsdfFlags::GLOSSY_REFLECTION | BsdfFlags::DIFFUSE_REFLECTION
+        } else {
+            BsdfFlags::GLOSSY_REFLECTION
+        }
     }
 
     fn f(&self, wo: Vec3, wi: Vec3) -> Rgb {
-        self.eval(wo, wi)
+        let single = self.eval(wo, wi);
+        match &self.compensation {
+            Some(ms) if wo.z > 0.0 && wi.z > 0.0 => single + ms.f(wo.z, wi.z),
+            _ => single,
+        }
     }
 
-    fn sample(&self, wo: Vec3, _uc: f32, u: Vec2) -> Option<BsdfSample> {
-        self.sample_lobe(wo, u)
+    /// The glossy lobe; with compensation, a direction of the multiple-scattering lobe with probability
+    /// 1 − E(μo) instead.
+    fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
+        let Some(ms) = &self.compensation else { return self.sample_lobe(wo, u) };
+        if !(wo.z > 0.0) {
+            return None;
+        }
+        let (wi, flags) = if uc < ms.probability(wo.z) {
+            (ms.sample(u), BsdfFlags::DIFFUSE_REFLECTION)
+        } else {
+            (self.sample_lobe(wo, u)?.wi, BsdfFlags::GLOSSY_REFLECTION)
+        };
+        if !(wi.z > 0.0) {
+            return None;
+        }
+        let s = BsdfSample::smooth(wi, self.f(wo, wi), self.pdf(wo, wi), flags, 1.0)?;
+        s.weight.is_finite().then_some(s)
     }
 
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        self.pdf_lobe(wo, wi)
+        let lobe = self.pdf_lobe(wo, wi);
+        match &self.compensation {
+            Some(ms) if wo.z > 0.0 && wi.z > 0.0 => {
+                let p = ms.probability(wo.z);
+                (1.0 - p) * lobe + p * ms.pdf(wi)
+            }
+            _ => lobe,
+        }
     }
 }
 
@@ -253,7 +294,17 @@ impl RoughConductor {
     }
 
     pub fn from_props(p: &Props) -> Result<Self> {
-        MicrofacetConductor::from_props(p, &Self::PARAMS).map(RoughConductor)
+        let core = MicrofacetConductor::from_props(p, &Self::PARAMS)?;
+        if !p.bool("energy_compensation", false)? {
+            return Ok(RoughConductor(core));
+        }
+        if core.distribution.is_anisotropic() {
+            return Err(Error::spec(
+                p.at(),
+                "`roughconductor`: `energy_compensation` needs an isotropic roughness (`alpha`, not `alpha_u` ≠ `alpha_v`): its albedo tables are functions of cos θo alone".to_string(),
+            ));
+        }
+        Ok(RoughConductor(core.with_energy_compensation()))
     }
 }
 
