@@ -10,6 +10,11 @@
 //! | `eta`, `k`             | rgb ≥ 0         | preset       | complex index η + i k (instead of `material`)     |
 //! | `specular_reflectance` | rgb [0,1]       | 1            | multiplier (not physical)                          |
 //! | `sample_visible`       | bool            | true         | sample the visible normals (Heitz & d'Eon 2014) rather than D·cos |
+//! | `energy_compensation`  | bool            | false        | add the multiple-scattering lobe of Kulla & Conty 2017 (isotropic `alpha` only; see [`super::energy_compensation`]) |
+//!
+//! Without compensation a white rough conductor loses the light that bounces between microfacets: white
+//! furnace 0.99 (GGX α = 0.05), 0.88 (0.25), 0.69 (0.5), 0.38 (1.0); Beckmann 0.97 (0.25), 0.66 (1.0).
+//! With it, 1.000 ± 0.003 at every α ≤ 1 (2026-11, `energy_compensation` tests); `gonio albedo` shows both.
 //!
 //! f(ωo, ωi) = F(ωo·ωh) D(ωh) G1(ωo, ωh) G1(ωi, ωh) / (4 cos θo cos θi), ωh = (ωo + ωi)/|ωo + ωi|
 //! (Walter 2007 eq. 20 with the separable Smith G of eq. 23 — what Mitsuba 3 uses). Λ is exact for both
@@ -222,6 +227,7 @@ impl crate::bsdf::Examples for RoughConductor {
         r#"{"type": "roughconductor", "distribution": "ggx", "alpha": 0.001, "material": "Au"}"#,
         r#"{"type": "roughconductor", "distribution": "beckmann", "alpha": 0.001}"#,
         r#"{"type": "roughconductor", "distribution": "beckmann", "alpha": 0.001, "sample_visible": false}"#,
+        r#"{"type": "roughconductor", "distribution": "ggx", "alpha": 0.5, "energy_compensation": true}"#,
     ];
 }
 
