@@ -308,6 +308,22 @@ impl MicrofacetDistribution {
         self.g1(wo, wm) * wo.dot(wm).max(0.0) * self.d(wm) / wo.z
     }
 
+    /// The solid-angle density of ωi = reflect(ωo, ωm) when ωm is drawn by [`sample_wm`](Self::sample_wm):
+    /// pdf(ωm) / (4 |ωo·ωm|) (Walter 2007 eq. 14).
+    #[must_use]
+    pub fn pdf_reflected(&self, wo: Vec3, wm: Vec3, visible: bool) -> f32 {
+        scattered_density(self.pdf_wm(wo, wm, visible), 1.0 / (4.0 * wo.dot(wm).abs()))
+    }
+
+    /// The solid-angle density of ωi refracted from ωo about ωm with relative index `eta` = ηi/ηo, when ωm
+    /// is drawn by [`sample_wm`](Self::sample_wm): pdf(ωm) η² |ωi·ωm| / (ωo·ωm + η ωi·ωm)² (Walter 2007
+    /// eqs. 16, 17).
+    #[must_use]
+    pub fn pdf_refracted(&self, wo: Vec3, wi: Vec3, wm: Vec3, eta: f32, visible: bool) -> f32 {
+        let denom = wo.dot(wm) + eta * wi.dot(wm);
+        scattered_density(self.pdf_wm(wo, wm, visible), eta * eta * wi.dot(wm).abs() / (denom * denom))
+    }
+
     /// Walter 2007 eqs. 28/35 (Blinn: eq. 31), with the anisotropic azimuth.
     fn sample_d_cos(&self, u: Vec2) -> Vec3 {
         if self.kind == MicrofacetKind::Blinn {
@@ -484,6 +500,20 @@ fn sample_beckmann_visible_slope_x(sin_theta: f64, cos_theta: f64, u: f64) -> f6
         x = next;
     }
     x
+}
+
+/// pdf(ωm) · |dωm/dωi|, the density of a direction scattered about a sampled microfacet normal; 0 where it
+/// is not finite. Within f32 underflow of the horizon (ωo·ωm → 0, or ωo + η ωi → 0 for refraction) the
+/// Jacobian overflows while the direction has no measurable density (2026-11: one guard for every
+/// microfacet BSDF, which used to repeat it).
+#[inline]
+fn scattered_density(pdf_wm: f32, jacobian: f32) -> f32 {
+    let pdf = pdf_wm * jacobian;
+    if pdf.is_finite() {
+        pdf
+    } else {
+        0.0
+    }
 }
 
 #[cfg(test)]

@@ -15,11 +15,9 @@
 //! assert!((b.f(Vec3::Z, Vec3::Z).r() - 0.25 / std::f32::consts::PI).abs() < 1e-6);
 //! ```
 
-use super::{Bsdf, BsdfFlags, BsdfModel, BsdfSample, Sum};
+use super::{Bsdf, Sum};
 use crate::error::{Error, Result};
-use crate::math::{Vec2, Vec3};
 use crate::props::Props;
-use crate::spectrum::Rgb;
 
 /// A convex blend of two BSDFs.
 #[derive(Clone, Debug, PartialEq)]
@@ -53,26 +51,15 @@ impl crate::bsdf::Examples for BlendBsdf {
     ];
 }
 
-impl BsdfModel for BlendBsdf {
-    fn flags(&self) -> BsdfFlags {
-        self.mix.flags()
-    }
-    fn f(&self, wo: Vec3, wi: Vec3) -> Rgb {
-        self.mix.f(wo, wi)
-    }
-    fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
-        self.mix.sample(wo, uc, u)
-    }
-    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        self.mix.pdf(wo, wi)
-    }
-}
+forward_bsdf_model!(BlendBsdf => mix);
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bsdf::BsdfModel;
     #[allow(unused_imports)]
     use crate::bsdf::Examples;
+    use crate::math::Vec3;
 
     #[test]
     fn weight_follows_mitsuba_zero_is_first_one_is_second() {

@@ -24,15 +24,42 @@
 //! assert!((bsdf.f(wo, s.wi).g() - 0.5 / std::f32::consts::PI).abs() < 1e-6);
 //! ```
 
+/// Implements [`BsdfModel`] for a type that is one model under another name (a plugin over a shared core)
+/// by forwarding all four methods to the field given: `forward_bsdf_model!(RoughConductor => 0);`.
+macro_rules! forward_bsdf_model {
+    ($ty:ty => $field:tt) => {
+        impl $crate::bsdf::BsdfModel for $ty {
+            #[inline]
+            fn flags(&self) -> $crate::bsdf::BsdfFlags {
+                self.$field.flags()
+            }
+            #[inline]
+            fn f(&self, wo: $crate::math::Vec3, wi: $crate::math::Vec3) -> $crate::spectrum::Rgb {
+                self.$field.f(wo, wi)
+            }
+            #[inline]
+            fn sample(&self, wo: $crate::math::Vec3, uc: f32, u: $crate::math::Vec2) -> Option<$crate::bsdf::BsdfSample> {
+                self.$field.sample(wo, uc, u)
+            }
+            #[inline]
+            fn pdf(&self, wo: $crate::math::Vec3, wi: $crate::math::Vec3) -> f32 {
+                self.$field.pdf(wo, wi)
+            }
+        }
+    };
+}
+
+pub mod ashikhmin_shirley;
 pub mod blend;
 pub mod blinn_phong;
 pub mod conductor;
 pub mod dielectric;
 pub mod diffuse;
+pub mod energy_compensation;
 pub mod glossy_mix;
+pub mod layered;
 pub mod mask;
 pub mod measured;
-pub mod layered;
 pub mod oren_nayar;
 pub mod phong;
 pub mod plastic;
@@ -49,14 +76,15 @@ use crate::math::{Vec2, Vec3};
 use crate::props::Props;
 use crate::spectrum::Rgb;
 
+pub use ashikhmin_shirley::AshikhminShirley;
 pub use blend::BlendBsdf;
 pub use blinn_phong::BlinnPhong;
 pub use conductor::Conductor;
 pub use dielectric::Dielectric;
 pub use diffuse::Diffuse;
+pub use layered::Layered;
 pub use mask::Mask;
 pub use measured::Measured;
-pub use layered::Layered;
 pub use oren_nayar::OrenNayar;
 pub use phong::Phong;
 pub use plastic::Plastic;
@@ -299,6 +327,7 @@ bsdf_models! {
     OrenNayar(OrenNayar) = "oren_nayar",
     Measured(Measured) = "measured",
     Layered(Layered) = "layered",
+    AshikhminShirley(AshikhminShirley) = "ashikhmin_shirley",
 }
 
 impl Bsdf {

@@ -10,6 +10,11 @@
 //! | `eta`, `k`             | rgb ≥ 0         | preset       | complex index η + i k (instead of `material`)     |
 //! | `specular_reflectance` | rgb [0,1]       | 1            | multiplier (not physical)                          |
 //! | `sample_visible`       | bool            | true         | sample the visible normals (Heitz & d'Eon 2014) rather than D·cos |
+//! | `energy_compensation`  | bool            | false        | add the multiple-scattering lobe of Kulla & Conty 2017 (isotropic `alpha` only; see [`super::energy_compensation`]) |
+//!
+//! Without compensation a white rough conductor loses the light that bounces between microfacets: white
+//! furnace 0.99 (GGX α = 0.05), 0.88 (0.25), 0.69 (0.5), 0.38 (1.0); Beckmann 0.97 (0.25), 0.66 (1.0).
+//! With it, 1.000 ± 0.003 at every α ≤ 1 (2026-11, `energy_compensation` tests); `gonio albedo` shows both.
 //!
 //! f(ωo, ωi) = F(ωo·ωh) D(ωh) G1(ωo, ωh) G1(ωi, ωh) / (4 cos θo cos θi), ωh = (ωo + ωi)/|ωo + ωi|
 //! (Walter 2007 eq. 20 with the separable Smith G of eq. 23 — what Mitsuba 3 uses). Λ is exact for both
@@ -37,6 +42,7 @@
 //! assert!(s.weight.r() > s.weight.b());
 //! ```
 
+use super::energy_compensation::ConductorCompensation;
 use super::{BsdfFlags, BsdfModel, BsdfSample, Conductor};
 use crate::error::{Error, Result};
 use crate::fresnel::reflect;
@@ -58,6 +64,8 @@ pub struct MicrofacetConductor {
     pub sample_visible: bool,
     /// The smooth conductor whose reflectance F(cos) weights each microfacet.
     pub fresnel: Conductor,
+    /// The multiple-scattering lobe added by `energy_compensation` ([`ConductorCompensation`]).
+    pub compensation: Option<ConductorCompensation>,
 }
 
 /// What a plugin accepts and defaults to; the plugins differ only in these.
@@ -77,7 +85,15 @@ impl MicrofacetConductor {
     /// A microfacet conductor with `distribution`, `shadowing` and the Fresnel term of `fresnel`.
     #[must_use]
     pub fn new(distribution: MicrofacetDistribution, shadowing: Shadowing, sample_visible: bool, fresnel: Conductor) -> Self {
-        MicrofacetConductor { distribution, shadowing, sample_visible, fresnel }
+        MicrofacetConductor { distribution, shadowing, sample_visible, fresnel, compensation: None }
+    }
+
+    /// The same model with Kulla & Conty's multiple-scattering lobe added (isotropic roughness only;
+    /// see [`super::energy_compensation`]).
+    #[must_use]
+    pub fn with_energy_compensation(mut self) -> Self {
+        self.compensation = Some(ConductorCompensation::new(&self));
+        self
     }
 
     pub(crate) fn from_props(p: &Props, rules: &MicrofacetParams) -> Result<Self> {
@@ -129,12 +145,7 @@ impl MicrofacetConductor {
             return 0.0;
         }
         let wm = (wo + wi).normalize();
-        let pdf = self.distribution.pdf_wm(wo, wm, self.sample_visible) / (4.0 * wo.dot(wm));
-        if pdf.is_finite() {
-            pdf
-        } else {
-            0.0
-        }
+        self.distribution.pdf_reflected(wo, wm, self.sample_visible)
     }
 
     /// Sample ωh, reflect ωo about it; `f` and `pdf` are those of the returned ωi.
@@ -216,24 +227,55 @@ impl crate::bsdf::Examples for RoughConductor {
         r#"{"type": "roughconductor", "distribution": "ggx", "alpha": 0.001, "material": "Au"}"#,
         r#"{"type": "roughconductor", "distribution": "beckmann", "alpha": 0.001}"#,
         r#"{"type": "roughconductor", "distribution": "beckmann", "alpha": 0.001, "sample_visible": false}"#,
+        r#"{"type": "roughconductor", "distribution": "ggx", "alpha": 0.5, "energy_compensation": true}"#,
     ];
 }
 
 impl BsdfModel for MicrofacetConductor {
     fn flags(&self) -> BsdfFlags {
-        BsdfFlags::GLOSSY_REFLECTION
+        if self.compensation.is_some() {
+            BsdfFlags::GLOSSY_REFLECTION | BsdfFlags::DIFFUSE_REFLECTION
+        } else {
+            BsdfFlags::GLOSSY_REFLECTION
+        }
     }
 
     fn f(&self, wo: Vec3, wi: Vec3) -> Rgb {
-        self.eval(wo, wi)
+        let single = self.eval(wo, wi);
+        match &self.compensation {
+            Some(ms) if wo.z > 0.0 && wi.z > 0.0 => single + ms.f(wo.z, wi.z),
+            _ => single,
+        }
     }
 
-    fn sample(&self, wo: Vec3, _uc: f32, u: Vec2) -> Option<BsdfSample> {
-        self.sample_lobe(wo, u)
+    /// The glossy lobe; with compensation, a direction of the multiple-scattering lobe with probability
+    /// 1 − E(μo) instead.
+    fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
+        let Some(ms) = &self.compensation else { return self.sample_lobe(wo, u) };
+        if !(wo.z > 0.0) {
+            return None;
+        }
+        let (wi, flags) = if uc < ms.probability(wo.z) {
+            (ms.sample(u), BsdfFlags::DIFFUSE_REFLECTION)
+        } else {
+            (self.sample_lobe(wo, u)?.wi, BsdfFlags::GLOSSY_REFLECTION)
+        };
+        if !(wi.z > 0.0) {
+            return None;
+        }
+        let s = BsdfSample::smooth(wi, self.f(wo, wi), self.pdf(wo, wi), flags, 1.0)?;
+        s.weight.is_finite().then_some(s)
     }
 
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        self.pdf_lobe(wo, wi)
+        let lobe = self.pdf_lobe(wo, wi);
+        match &self.compensation {
+            Some(ms) if wo.z > 0.0 && wi.z > 0.0 => {
+                let p = ms.probability(wo.z);
+                (1.0 - p) * lobe + p * ms.pdf(wi)
+            }
+            _ => lobe,
+        }
     }
 }
 
@@ -258,24 +300,21 @@ impl RoughConductor {
     }
 
     pub fn from_props(p: &Props) -> Result<Self> {
-        MicrofacetConductor::from_props(p, &Self::PARAMS).map(RoughConductor)
+        let core = MicrofacetConductor::from_props(p, &Self::PARAMS)?;
+        if !p.bool("energy_compensation", false)? {
+            return Ok(RoughConductor(core));
+        }
+        if core.distribution.is_anisotropic() {
+            return Err(Error::spec(
+                p.at(),
+                "`roughconductor`: `energy_compensation` needs an isotropic roughness (`alpha`, not `alpha_u` ≠ `alpha_v`): its albedo tables are functions of cos θo alone".to_string(),
+            ));
+        }
+        Ok(RoughConductor(core.with_energy_compensation()))
     }
 }
 
-impl BsdfModel for RoughConductor {
-    fn flags(&self) -> BsdfFlags {
-        self.0.flags()
-    }
-    fn f(&self, wo: Vec3, wi: Vec3) -> Rgb {
-        self.0.f(wo, wi)
-    }
-    fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
-        self.0.sample(wo, uc, u)
-    }
-    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        self.0.pdf(wo, wi)
-    }
-}
+forward_bsdf_model!(RoughConductor => 0);
 
 /// The harness on lobes too narrow for its chi-square cell integrals: every check but chi-square must
 /// pass; the chi-square is rerun with 24 (instead of 6) Gauss–Legendre points per cell and axis and must

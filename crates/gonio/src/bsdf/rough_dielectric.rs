@@ -228,12 +228,7 @@ impl RoughDielectric {
         if o_m <= 0.0 {
             return 0.0;
         }
-        let pdf = self.distribution.pdf_wm(wo, wm, self.sample_visible) / (4.0 * o_m);
-        if pdf.is_finite() {
-            pdf
-        } else {
-            0.0
-        }
+        self.distribution.pdf_reflected(wo, wm, self.sample_visible)
     }
 
     /// Reflect `wo` (above) about a sampled microfacet normal: the specular lobe of `roughplastic`, whose
@@ -260,13 +255,7 @@ impl RoughDielectric {
         if reflection {
             return self.reflection_pdf(wo, wi) * f;
         }
-        let denom = o_m + eta * i_m;
-        let pdf = self.distribution.pdf_wm(wo, wm, self.sample_visible) * (1.0 - f) * eta * eta * (-i_m) / (denom * denom);
-        if pdf.is_finite() {
-            pdf
-        } else {
-            0.0
-        }
+        self.distribution.pdf_refracted(wo, wi, wm, eta, self.sample_visible) * (1.0 - f)
     }
 
     /// The microfacet normal, and the direction scattered about it, for `wo` above: reflection when

@@ -35,12 +35,10 @@
 //! ```
 
 use super::rough_conductor::{MicrofacetConductor, MicrofacetParams};
-use super::{BsdfFlags, BsdfModel, BsdfSample, Conductor};
+use super::Conductor;
 use crate::error::Result;
-use crate::math::{Vec2, Vec3};
 use crate::microfacet::{MicrofacetDistribution, MicrofacetKind, Shadowing};
 use crate::props::Props;
-use crate::spectrum::Rgb;
 
 /// The Torrance–Sparrow family of microfacet conductors.
 #[derive(Clone, Debug, PartialEq)]
@@ -93,27 +91,17 @@ impl crate::bsdf::Examples for TorranceSparrow {
     ];
 }
 
-impl BsdfModel for TorranceSparrow {
-    fn flags(&self) -> BsdfFlags {
-        self.0.flags()
-    }
-    fn f(&self, wo: Vec3, wi: Vec3) -> Rgb {
-        self.0.f(wo, wi)
-    }
-    fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
-        self.0.sample(wo, uc, u)
-    }
-    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        self.0.pdf(wo, wi)
-    }
-}
+forward_bsdf_model!(TorranceSparrow => 0);
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::bsdf::Bsdf;
+    use crate::bsdf::BsdfModel;
     #[allow(unused_imports)]
     use crate::bsdf::Examples;
+    use crate::math::Vec3;
+    use crate::spectrum::Rgb;
     use crate::verify::energy;
 
     #[test]
