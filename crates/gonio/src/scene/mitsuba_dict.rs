@@ -87,11 +87,9 @@ const CLASSES: &[(&str, &[&str])] = &[
         "bsdf",
         &[
             "hair",
-            "measured",
             "pplastic",
             "bumpmap",
             "normalmap",
-            "mask",
             "principled",
             "principledthindielectric",
             "polarizer",
