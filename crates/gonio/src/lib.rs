@@ -25,6 +25,7 @@ pub mod image;
 pub mod integrator;
 pub mod light;
 pub mod math;
+pub mod measured;
 pub mod microfacet;
 pub mod props;
 pub mod render;

@@ -30,6 +30,7 @@ pub mod conductor;
 pub mod dielectric;
 pub mod diffuse;
 pub mod glossy_mix;
+pub mod merl;
 pub mod oren_nayar;
 pub mod phong;
 pub mod plastic;
@@ -51,6 +52,7 @@ pub use blinn_phong::BlinnPhong;
 pub use conductor::Conductor;
 pub use dielectric::Dielectric;
 pub use diffuse::Diffuse;
+pub use merl::Merl;
 pub use oren_nayar::OrenNayar;
 pub use phong::Phong;
 pub use plastic::Plastic;
@@ -290,6 +292,7 @@ bsdf_models! {
     Phong(Phong) = "phong",
     BlinnPhong(BlinnPhong) = "blinn_phong",
     OrenNayar(OrenNayar) = "oren_nayar",
+    Merl(Merl) = "merl",
 }
 
 impl Bsdf {

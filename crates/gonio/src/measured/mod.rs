@@ -1,0 +1,43 @@
+//! Measured reflectance: the MERL table file ([`merl_file`]) and the virtual gonioreflectometer that
+//! tabulates any model into one ([`gonioreflectometer`]).
+
+pub mod gonioreflectometer;
+pub mod merl_file;
+
+pub use merl_file::{Interpolation, MerlTable};
+
+/// Tables shared by the tests: generating one costs 1.46 M evaluations of f, so each is made once.
+#[cfg(test)]
+pub(crate) mod fixtures {
+    use super::gonioreflectometer::measure;
+    use super::MerlTable;
+    use crate::bsdf::Bsdf;
+    use std::path::PathBuf;
+    use std::sync::OnceLock;
+
+    /// A Lambertian base plus a GGX copper lobe, as used by the reader tests.
+    pub const SMOOTH_SPEC: &str = r#"{"type": "sum", "weights": [1, 1],
+        "a": {"type": "diffuse", "reflectance": [0.2, 0.1, 0.05]},
+        "b": {"type": "roughconductor", "distribution": "ggx", "alpha": 0.2, "material": "Cu"}}"#;
+
+    /// A scratch directory for this test process.
+    pub fn scratch_dir() -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("gonio-merl-tests-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    /// [`SMOOTH_SPEC`] tabulated at the cell centres, written with gonio's writer and read back: the
+    /// model, the path of the file and the table as read.
+    pub fn smooth() -> &'static (Bsdf, PathBuf, MerlTable) {
+        static CELL: OnceLock<(Bsdf, PathBuf, MerlTable)> = OnceLock::new();
+        CELL.get_or_init(|| {
+            let model = Bsdf::from_json(SMOOTH_SPEC).unwrap();
+            let table = measure(&model, 1, "smooth").unwrap();
+            let path = scratch_dir().join("smooth.binary");
+            table.write(&path).unwrap();
+            let read = MerlTable::read(&path).unwrap();
+            (model, path, read)
+        })
+    }
+}
