@@ -117,14 +117,21 @@ impl Merl {
     }
 }
 
+/// Tables made in memory from analytic models (a real MERL file cannot ship with gonio): a shiny
+/// aluminium GGX lobe, a rough Beckmann copper read with `nearest`, and a rough plastic. They are not in
+/// [`crate::bsdf::Examples::EXAMPLES`] (so not in `gonio check --all`): the sampling density is piecewise constant
+/// over 64 × 64 cells of the warped square, and the chi-square harness's adaptive quadrature splits every
+/// chi-square cell crossed by one of those edges down to its depth limit, which costs minutes of CPU per
+/// direction (2026-11). `gonio check` runs them by hand; the `#[ignore]`d test `harness_on_tables` too.
+pub const HARNESS_SPECS: &[&str] = &[
+    r#"{"type": "merl", "bsdf": {"type": "roughconductor", "distribution": "ggx", "alpha": 0.05, "material": "Al"}}"#,
+    r#"{"type": "merl", "interpolation": "nearest", "bsdf": {"type": "roughconductor", "alpha": 0.4, "material": "Cu"}}"#,
+    r#"{"type": "merl", "bsdf": {"type": "roughplastic", "distribution": "ggx", "alpha": 0.2, "diffuse_reflectance": [0.6, 0.3, 0.1]}}"#,
+];
+
 impl crate::bsdf::Examples for Merl {
-    /// Tables made in memory from analytic models (a real MERL file cannot ship with gonio): a shiny
-    /// aluminium GGX lobe, a rough Beckmann copper, and a rough plastic.
-    const EXAMPLES: &'static [&'static str] = &[
-        r#"{"type": "merl", "bsdf": {"type": "roughconductor", "distribution": "ggx", "alpha": 0.05, "material": "Al"}}"#,
-        r#"{"type": "merl", "interpolation": "nearest", "bsdf": {"type": "roughconductor", "alpha": 0.4, "material": "Cu"}}"#,
-        r#"{"type": "merl", "bsdf": {"type": "roughplastic", "distribution": "ggx", "alpha": 0.2, "diffuse_reflectance": [0.6, 0.3, 0.1]}}"#,
-    ];
+    /// None: see [`HARNESS_SPECS`].
+    const EXAMPLES: &'static [&'static str] = &[];
 }
 
 impl BsdfModel for Merl {
@@ -289,5 +296,94 @@ impl HalfVectorSampler {
         } else {
             0.0
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sampling::Pcg32;
+    use crate::verify::{check_named, energy::direction, CheckConfig};
+
+    /// Minutes of CPU (see [`HARNESS_SPECS`]): run by hand with `--ignored`.
+    #[test]
+    #[ignore]
+    fn harness_on_tables() {
+        let failed: Vec<String> = HARNESS_SPECS
+            .iter()
+            .map(|spec| check_named(&Bsdf::from_json(spec).unwrap(), spec, &CheckConfig::default()))
+            .inspect(|r| eprintln!("{}", r.to_table()))
+            .filter(|r| !r.passed())
+            .map(|r| r.to_table())
+            .collect();
+        assert!(failed.is_empty(), "{}", failed.join("\n"));
+    }
+
+    /// Variance of the white-environment estimate f cos θi / pdf (one sample) with the model's sampling
+    /// and with cosine-weighted sampling.
+    fn variances(b: &Bsdf, wo: Vec3, n: usize) -> (f64, f64, f64) {
+        let mut rng = Pcg32::new(17, 5);
+        let (mut s1, mut s2, mut c1, mut c2) = (0f64, 0f64, 0f64, 0f64);
+        for _ in 0..n {
+            let (uc, u) = (rng.next_f32(), rng.next_vec2());
+            let w = b.sample(wo, uc, u).map_or(0.0, |s| f64::from(s.weight.luminance()));
+            s1 += w;
+            s2 += w * w;
+            let wi = sample_cosine_hemisphere(u);
+            let w = f64::from(b.f(wo, wi).luminance() * PI);
+            c1 += w;
+            c2 += w * w;
+        }
+        let n = n as f64;
+        (s2 / n - (s1 / n).powi(2), c2 / n - (c1 / n).powi(2), s1 / n)
+    }
+
+    #[test]
+    fn sampling_beats_cosine_sampling_on_a_shiny_material() {
+        let b = Bsdf::from_json(HARNESS_SPECS[0]).unwrap();
+        for mu in [0.95f32, 0.7, 0.4] {
+            let (var, var_cos, mean) = variances(&b, direction(mu, 0.3), 400_000);
+            let factor = var_cos / var;
+            eprintln!(
+                "shiny Al GGX α=0.05 table, cosθo={mu}: albedo {mean:.4}, variance {var:.3e} vs cosine {var_cos:.3e}: factor {factor:.1}"
+            );
+            assert!(factor >= 5.0, "cosθo={mu}: variance factor {factor}");
+        }
+    }
+
+    #[test]
+    fn half_vector_warp_round_trips() {
+        let mut rng = Pcg32::new(2, 9);
+        for _ in 0..10_000 {
+            let ab = rng.next_vec2();
+            let (wh, area) = half_vector(ab);
+            let (back, area2) = invert_half_vector(wh);
+            assert!((back - ab).abs().max_element() < 1e-4 && (area - area2).abs() < 1e-3 * area, "{ab} → {wh} → {back}");
+            assert!((wh.length() - 1.0).abs() < 1e-5 && area.is_finite() && area > 0.0);
+        }
+    }
+
+    #[test]
+    fn parameters_are_checked() {
+        for (bad, expect) in [
+            (r#"{"type": "merl"}"#, "needs a `filename`"),
+            (r#"{"type": "merl", "filename": "/no/such.binary"}"#, "/no/such.binary"),
+            (r#"{"type": "merl", "filename": "x", "bsdf": {"type": "diffuse"}}"#, "not both"),
+            (r#"{"type": "merl", "interpolation": "cubic", "bsdf": {"type": "diffuse"}}"#, "`trilinear` or `nearest`"),
+        ] {
+            let err = Bsdf::from_json(bad).unwrap_err().to_string();
+            assert!(err.contains(expect), "{bad}: {err}");
+        }
+    }
+
+    #[test]
+    fn a_file_loads_through_the_registry() {
+        let (model, path, _) = crate::measured::fixtures::smooth();
+        let spec = format!(r#"{{"type": "merl", "filename": "{}"}}"#, path.display());
+        let b = Bsdf::from_json(&spec).unwrap();
+        assert_eq!(b.plugin_name(), "merl");
+        let (wo, wi) = (Vec3::new(0.3, 0.1, 0.9).normalize(), Vec3::new(-0.4, 0.0, 0.8).normalize());
+        let (got, want) = (b.f(wo, wi), model.f(wo, wi));
+        assert!((got.r() / want.r() - 1.0).abs() < 0.01, "{got:?} vs {want:?}");
     }
 }
