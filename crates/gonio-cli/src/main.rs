@@ -23,6 +23,8 @@ enum Command {
     Albedo(cmd::albedo::Args),
     /// Render a Mitsuba 3 XML scene to an EXR or PNG image.
     Render(cmd::render::Args),
+    /// Tabulate a BSDF into a MERL table (the virtual gonioreflectometer).
+    Measure(cmd::measure::Args),
 }
 
 fn main() -> ExitCode {
@@ -31,6 +33,7 @@ fn main() -> ExitCode {
         Command::Check(args) => cmd::check::run(args),
         Command::Albedo(args) => cmd::albedo::run(args),
         Command::Render(args) => cmd::render::run(args),
+        Command::Measure(args) => cmd::measure::run(args),
     };
     match result {
         Ok(code) => code,

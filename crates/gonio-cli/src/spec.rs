@@ -1,5 +1,5 @@
 //! Reading a BSDF argument: a JSON object in Mitsuba's dictionary form, or a path to an XML file holding
-//! one `<bsdf>` element (or a JSON file).
+//! one `<bsdf>` element (or a JSON file), a MERL table (`.binary`) or an RGL measurement (`.bsdf`).
 
 use gonio::{Bsdf, Error};
 use std::path::Path;
@@ -14,6 +14,15 @@ pub fn load_bsdf(arg: &str) -> Result<Bsdf, Error> {
         return Bsdf::from_xml(trimmed, "<argument>");
     }
     let path = Path::new(arg);
+    // Measured data: by extension, through the plugin registry (`merl`, and Mitsuba's `measured`).
+    let plugin = match path.extension().and_then(|e| e.to_str()) {
+        Some("binary") => Some("merl"),
+        Some("bsdf") => Some("measured"),
+        _ => None,
+    };
+    if let Some(plugin) = plugin {
+        return Bsdf::from_json(&serde_json::json!({"type": plugin, "filename": arg}).to_string());
+    }
     let text = std::fs::read_to_string(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
     if text.trim_start().starts_with('{') {
         Bsdf::from_json(&text).map_err(|e| match e {

@@ -93,3 +93,43 @@ fn check_all_passes_at_the_full_standard() {
         assert!(checks.iter().any(|c| c["check"].as_str().unwrap().starts_with(kind) && c["passed"] == false), "{r}");
     }
 }
+
+/// The virtual gonioreflectometer end to end: measure a model into a MERL file, load the file back
+/// (by its `.binary` extension) and compare directional albedos with the model's.
+#[test]
+fn measure_then_load_round_trips() {
+    let dir = std::env::temp_dir().join(format!("gonio-cli-measure-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("plastic.binary");
+    let spec = r#"{"type": "roughplastic", "distribution": "ggx", "alpha": 0.3, "diffuse_reflectance": [0.5, 0.3, 0.1]}"#;
+    let m = gonio(&["measure", spec, "-o", out.to_str().unwrap(), "--supersample", "1"]);
+    assert_eq!(m.status.code(), Some(0), "{}", String::from_utf8_lossy(&m.stderr));
+    assert_eq!(std::fs::metadata(&out).unwrap().len(), 34_992_012);
+    let albedos = |arg: &str| -> Vec<[f64; 3]> {
+        let o = gonio(&["albedo", arg, "--angles", "4", "--samples", "40000"]);
+        assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8_lossy(&o.stdout)
+            .lines()
+            .filter_map(|l| {
+                let v: Vec<f64> = l.split_whitespace().filter_map(|t| t.parse().ok()).collect();
+                (v.len() == 5).then(|| [v[2], v[3], v[4]])
+            })
+            .collect()
+    };
+    let (table, model) = (albedos(out.to_str().unwrap()), albedos(spec));
+    assert_eq!(table.len(), 4);
+    for (t, m) in table.iter().zip(&model) {
+        for c in 0..3 {
+            assert!((t[c] - m[c]).abs() < 0.02 * m[c] + 2e-3, "table {t:?} vs model {m:?}");
+        }
+    }
+    for (args, expect) in [
+        (vec!["measure", spec, "-o", "/no/such/dir/x.binary"], "/no/such/dir/x.binary"),
+        (vec!["check", "/no/such.binary"], "/no/such.binary"),
+    ] {
+        let o = gonio(&args);
+        assert_eq!(o.status.code(), Some(2));
+        assert!(String::from_utf8_lossy(&o.stderr).contains(expect));
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}

@@ -22,6 +22,7 @@ pub mod bsdf;
 pub mod camera;
 pub mod error;
 pub mod film;
+pub mod fit;
 pub mod fresnel;
 pub mod geometry;
 pub mod image;

@@ -1,3 +1,4 @@
 pub mod albedo;
 pub mod check;
+pub mod measure;
 pub mod render;

@@ -60,6 +60,7 @@ pub mod glossy_mix;
 pub mod layered;
 pub mod mask;
 pub mod measured;
+pub mod merl;
 pub mod oren_nayar;
 pub mod phong;
 pub mod plastic;
@@ -85,6 +86,7 @@ pub use diffuse::Diffuse;
 pub use layered::Layered;
 pub use mask::Mask;
 pub use measured::Measured;
+pub use merl::Merl;
 pub use oren_nayar::OrenNayar;
 pub use phong::Phong;
 pub use plastic::Plastic;
@@ -328,6 +330,7 @@ bsdf_models! {
     Measured(Measured) = "measured",
     Layered(Layered) = "layered",
     AshikhminShirley(AshikhminShirley) = "ashikhmin_shirley",
+    Merl(Merl) = "merl",
 }
 
 impl Bsdf {

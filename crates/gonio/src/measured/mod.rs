@@ -1,6 +1,49 @@
-//! Measured reflectance data: the file formats gonio reads measured materials from.
+//! Measured reflectance data: the file formats gonio reads measured materials from, and the virtual
+//! gonioreflectometer.
 //!
+//! - [`merl_file`]: the MERL BRDF table (Matusik et al. 2003), read by the [`merl`](crate::bsdf::merl) BSDF;
+//! - [`gonioreflectometer`]: tabulates any model into a MERL table;
 //! - [`tensor_file`]: the `tensor_file` container of Mitsuba and the RGL material database
 //!   (read by the [`measured`](crate::bsdf::measured) BSDF).
 
+pub mod gonioreflectometer;
+pub mod merl_file;
 pub mod tensor_file;
+
+pub use merl_file::{Interpolation, MerlTable};
+
+/// Tables shared by the tests: generating one costs 1.46 M evaluations of f, so each is made once.
+#[cfg(test)]
+pub(crate) mod fixtures {
+    use super::gonioreflectometer::measure;
+    use super::MerlTable;
+    use crate::bsdf::Bsdf;
+    use std::path::PathBuf;
+    use std::sync::OnceLock;
+
+    /// A Lambertian base plus a GGX copper lobe, as used by the reader tests.
+    pub const SMOOTH_SPEC: &str = r#"{"type": "sum", "weights": [1, 1],
+        "a": {"type": "diffuse", "reflectance": [0.2, 0.1, 0.05]},
+        "b": {"type": "roughconductor", "distribution": "ggx", "alpha": 0.2, "material": "Cu"}}"#;
+
+    /// A scratch directory for this test process.
+    pub fn scratch_dir() -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("gonio-merl-tests-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    /// [`SMOOTH_SPEC`] tabulated at the cell centres, written with gonio's writer and read back: the
+    /// model, the path of the file and the table as read.
+    pub fn smooth() -> &'static (Bsdf, PathBuf, MerlTable) {
+        static CELL: OnceLock<(Bsdf, PathBuf, MerlTable)> = OnceLock::new();
+        CELL.get_or_init(|| {
+            let model = Bsdf::from_json(SMOOTH_SPEC).unwrap();
+            let table = measure(&model, 1, "smooth").unwrap();
+            let path = scratch_dir().join("smooth.binary");
+            table.write(&path).unwrap();
+            let read = MerlTable::read(&path).unwrap();
+            (model, path, read)
+        })
+    }
+}
