@@ -5,6 +5,8 @@ Conventions: Mitsuba's `si.wi` is gonio's `wo` (towards the viewer) and its samp
 f·|cos|/pdf like gonio's. Both compute in float32, so values agree to 1e-5 relative.
 """
 
+import functools
+
 import numpy as np
 import pytest
 
@@ -728,3 +730,137 @@ def test_plastic_eval_pdf(params):
     assert err_val.max() < ROUGH_RTOL, f"f·cos vs corrected Mitsuba eval: {err_val.max():.3e}"
     assert err_pdf.max() < ROUGH_RTOL, f"pdf vs Mitsuba pdf: {err_pdf.max():.3e}"
     assert raw.max() <= np.abs(factor - 1).max() + 1e-4, "the raw gap exceeds what the fitted F̄ explains"
+
+
+# roughplastic: gonio and Mitsuba 3 share the model (see crates/gonio/src/bsdf/rough_plastic.rs) and differ in
+# how the coating's tables are integrated: T(μ) (both a 64-point table, each by its own quadrature) and R̄ᵢ
+# (gonio: Gauss–Legendre in μ; Mitsuba: 2·mean of Rᵢ(μ)μ over its 64 table points). The specular part has
+# neither and is compared directly; the diffuse part ρ T(μo) T(μi) / (π η² (1 − X)), X = R̄ᵢ (or ρR̄ᵢ with
+# `nonlinear`), must be Mitsuba's times one constant per channel, the R̄ᵢ ratio.
+ROUGH_PLASTIC_RHO = np.array([0.2, 0.5, 0.8])
+ROUGH_PLASTIC_SETS = [(d, a, e) for d in ("ggx", "beckmann") for a in (0.05, 0.3, 1.0) for e in ("1.5",)] + [
+    ("ggx", 0.3, "default"), ("beckmann", 0.3, "default")]
+
+
+def rough_plastic_id(params):
+    d, a, e = params
+    return f"{d}-alpha={a}-eta={e}"
+
+
+def rough_plastic_spec(params, rho, nonlinear):
+    d, a, e = params
+    spec = {"type": "roughplastic", "distribution": d, "alpha": a, "diffuse_reflectance": rho, "nonlinear": nonlinear}
+    if e == "1.5":
+        spec.update(int_ior=1.5, ext_ior=1.0)
+    return spec
+
+
+def internal_reflectance_from(linear, nonlinear):
+    """R̄ᵢ from a renderer's own diffuse parts with and without `nonlinear` at the same pairs: their ratio is
+    (1 − ρR̄ᵢ)/(1 − R̄ᵢ) = q, so R̄ᵢ = (1 − q)/(ρ − q); the median over pairs, per channel."""
+    big = (linear > ROUGH_FLOOR) & (nonlinear > ROUGH_FLOOR)
+    out = []
+    for c in range(3):
+        q = linear[big[:, c], c] / nonlinear[big[:, c], c]
+        out.append(np.median((1 - q) / (ROUGH_PLASTIC_RHO[c] - q)))
+    return np.array(out)
+
+
+@functools.lru_cache(maxsize=None)
+def rough_plastic_values(params):
+    """gonio's and Mitsuba's f·cos and pdf at 1000 uniform pairs above the surface (where roughplastic
+    scatters) and 300 with wi sampled from the glossy lobe by gonio (which the uniform ones rarely hit at
+    α = 0.05), for ρ = 0 (specular only) and ρ = ROUGH_PLASTIC_RHO linear and nonlinear."""
+    r = rng(51)
+    wo, wi = sphere(r, N), sphere(r, N)
+    wo[:, 2], wi[:, 2] = np.abs(wo[:, 2]), np.abs(wi[:, 2])
+    glossy = gonio.load_bsdf(rough_plastic_spec(params, 0.0, False))
+    wo_s = sphere(r, 300)
+    wo_s[:, 2] = np.abs(wo_s[:, 2])
+    s = glossy.sample(wo_s, r.random(300, dtype=np.float32), r.random((300, 2), dtype=np.float32))
+    wo, wi = np.concatenate([wo, wo_s[s.valid]]), np.concatenate([wi, s.wi[s.valid].astype(np.float32)])
+    out = {"wo": wo, "wi": wi}
+    for key, rho, nonlinear in (("spec", 0.0, False), ("lin", ROUGH_PLASTIC_RHO.tolist(), False),
+                                ("nl", ROUGH_PLASTIC_RHO.tolist(), True)):
+        g, m = load_both(rough_plastic_spec(params, rho, nonlinear))
+        mi_val, mi_pdf = mi_eval_pdf(m, wo, wi)
+        g_val = g.f(wo, wi).astype(np.float64) * wi[:, 2:3].astype(np.float64)
+        out[key] = (g_val, g.pdf(wo, wi).astype(np.float64), mi_val, mi_pdf)
+    return out
+
+
+@pytest.mark.parametrize("params", ROUGH_PLASTIC_SETS, ids=rough_plastic_id)
+def test_roughplastic_specular(params):
+    """(a) With diffuse_reflectance 0 roughplastic is the coating's reflection lobe alone: gonio's f·cos ==
+    Mitsuba's eval to 1e-3 relative above 1e-4 (Beckmann: Mitsuba × G1_exact/G1_walter for ωo and ωi)."""
+    v = rough_plastic_values(params)
+    g_val, _, mi_val, _ = v["spec"]
+    if params[0] == "beckmann":
+        a = params[1]
+        mi_val = mi_val * (g1_ratio(v["wo"], a, a) * g1_ratio(v["wi"], a, a))[:, None]
+    err, big = relative_errors(g_val, mi_val)
+    print(f"\nroughplastic {rough_plastic_id(params)} specular: max rel error {err.max():.2e} ({big.sum()} values)")
+    assert big.any(axis=1).sum() >= 300, "too few non-negligible specular values"
+    assert err.max() < ROUGH_RTOL, f"specular f·cos vs Mitsuba: {err.max():.3e}"
+    np.testing.assert_allclose(g_val[~big], mi_val[~big], rtol=0, atol=ROUGH_RTOL * ROUGH_FLOOR)
+
+
+BECKMANN_TABLE_REASON = (
+    "open (2026-11): Mitsuba 3.9.1 integrates its T(μ) table with its Beckmann G1, Walter 2007's rational "
+    "approximation (eq. 27); gonio with the exact G1. At α = 1 that makes the diffuse ratio vary by 3.9e-3 "
+    "over the pairs (α ≤ 0.3: ≤ 6e-4). Not corrected here: the table is internal to Mitsuba")
+
+
+@pytest.mark.parametrize("params", [pytest.param(p, marks=pytest.mark.xfail(strict=True, reason=BECKMANN_TABLE_REASON))
+                                    if p[:2] == ("beckmann", 1.0) else p for p in ROUGH_PLASTIC_SETS], ids=rough_plastic_id)
+def test_roughplastic_diffuse(params):
+    """(b) The diffuse part (total − specular) of gonio == Mitsuba's × one constant per channel, to 1e-3
+    relative at every pair where Mitsuba's exceeds 1e-4 and both are ≥ 1 % of their totals, linear and nonlinear; the constant (the median
+    ratio) equals the one predicted from the two renderers' R̄ᵢ, (1 − X_mitsuba)/(1 − X_gonio), to 1e-3, where
+    each renderer's R̄ᵢ is read off its own linear / nonlinear ratio (`internal_reflectance_from`)."""
+    v = rough_plastic_values(params)
+    diffuse = {k: (v[k][0] - v["spec"][0], v[k][2] - v["spec"][2]) for k in ("lin", "nl")}
+    r_g = internal_reflectance_from(diffuse["lin"][0], diffuse["nl"][0])
+    r_mi = internal_reflectance_from(diffuse["lin"][1], diffuse["nl"][1])
+    report = [f"\nroughplastic {rough_plastic_id(params)}: R̄ᵢ gonio {r_g.mean():.5f} (channels within "
+              f"{np.ptp(r_g):.1e}), Mitsuba {r_mi.mean():.5f} (within {np.ptp(r_mi):.1e})"]
+    failures = []
+    for key in ("lin", "nl"):
+        ours, theirs = diffuse[key]
+        # total − specular cancels in float32 where the glossy peak dominates (relative error ~2⁻²³ total /
+        # diffuse): compare the diffuse part where it is ≥ 1 % of the total, i.e. known to ~1e-5.
+        big = (theirs > ROUGH_FLOOR) & (theirs >= 1e-2 * v[key][2]) & (ours >= 1e-2 * v[key][0])
+        assert big.all(axis=1).sum() >= 1000 * 0.9, "too few non-negligible diffuse values"
+        const = np.array([np.median(ours[big[:, c], c] / theirs[big[:, c], c]) for c in range(3)])
+        spread = max(np.abs(ours[big[:, c], c] / (theirs[big[:, c], c] * const[c]) - 1).max() for c in range(3))
+        x_g, x_mi = (ROUGH_PLASTIC_RHO * r_g.mean(), ROUGH_PLASTIC_RHO * r_mi.mean()) if key == "nl" else (r_g.mean(), r_mi.mean())
+        predicted = (1 - x_mi) / (1 - x_g)
+        pred_err = np.abs(const / predicted - 1).max()
+        report.append(f"  {key}: constant {np.array2string(const, precision=6)}, max deviation {spread:.2e}, "
+                      f"predicted {np.array2string(np.broadcast_to(predicted, (3,)), precision=6)} (off {pred_err:.2e})")
+        if spread >= ROUGH_RTOL:
+            failures.append(f"{key}: diffuse ratio not constant, max deviation {spread:.3e}")
+        if pred_err >= ROUGH_RTOL:
+            failures.append(f"{key}: constant {const} vs predicted {predicted}: {pred_err:.3e}")
+    print("\n".join(report))
+    assert not failures, "; ".join(failures)
+    # Both readings of R̄ᵢ are consistent across channels (the model is ρ/(1 − R̄ᵢ) vs ρ/(1 − ρR̄ᵢ) in each).
+    assert np.ptp(r_g) < 1e-3 and np.ptp(r_mi) < 1e-3
+
+
+PDF_TABLE_REASON = (
+    "open (2026-11): the glossy-lobe probability is (1 − T(μo)) w / ((1 − T) w + T (1 − w)); gonio's T(μ) table is "
+    "below Mitsuba's by 0.8e-4..2.6e-4 (GGX, read off both pdfs at ωi = n), and where T ≈ 0.95 that is ~4e-3 "
+    "relative in 1 − T: pdf up to 3e-3 apart. Which table is closer to the integral is not yet established. "
+    "Beckmann adds Mitsuba's G1 approximation in its T table and in the visible-normal pdf (not undone here)")
+
+
+@pytest.mark.parametrize("params", [p if p[:2] == ("ggx", 1.0) else pytest.param(
+    p, marks=pytest.mark.xfail(strict=True, reason=PDF_TABLE_REASON)) for p in ROUGH_PLASTIC_SETS], ids=rough_plastic_id)
+def test_roughplastic_pdf(params):
+    """(c) pdfs (linear, coloured ρ) agree to 1e-3 relative above 1e-4."""
+    _, g_pdf, _, mi_pdf = rough_plastic_values(params)["lin"]
+    err, big = relative_errors(g_pdf, mi_pdf)
+    print(f"\nroughplastic {rough_plastic_id(params)} pdf: max rel error {err.max():.2e} ({big.sum()} values)")
+    assert big.sum() >= 1000 * 0.9
+    assert err.max() < ROUGH_RTOL, f"pdf vs Mitsuba: {err.max():.3e}"
