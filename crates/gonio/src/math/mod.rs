@@ -3,6 +3,7 @@
 pub mod frame;
 pub mod spherical;
 pub mod transform;
+pub mod trig;
 
 pub use frame::Frame;
 pub use glam::{DVec3, Vec2, Vec3};

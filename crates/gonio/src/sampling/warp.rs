@@ -5,6 +5,7 @@
 //! that produces it. The round-trip and chi-square tests beside them (and in `verify::chi2`) hold the
 //! three together.
 
+use crate::math::trig::sin_cos_quarter;
 use crate::math::{Vec2, Vec3};
 use std::f32::consts::{FRAC_1_PI, FRAC_PI_2, FRAC_PI_4, PI};
 
@@ -19,9 +20,13 @@ pub fn sample_uniform_disk_concentric(u: Vec2) -> Vec2 {
     if o.x == 0.0 && o.y == 0.0 {
         return Vec2::ZERO;
     }
-    // Map each of the four wedges of the square to a wedge of the disk.
-    let (r, theta) = if o.x.abs() > o.y.abs() { (o.x, FRAC_PI_4 * (o.y / o.x)) } else { (o.y, FRAC_PI_2 - FRAC_PI_4 * (o.x / o.y)) };
-    r * Vec2::new(theta.cos(), theta.sin())
+    // Map each of the four wedges of the square to a wedge of the disk: θ = π/4 · (y/x) about the x axis,
+    // or π/2 − π/4 · (x/y) about the y axis, whose cosine and sine are the sine and cosine of π/4 · (x/y).
+    // Either way the angle to evaluate is in [−π/4, π/4], where a short polynomial is exact to f32.
+    let x_major = o.x.abs() > o.y.abs();
+    let (r, t) = if x_major { (o.x, o.y / o.x) } else { (o.y, o.x / o.y) };
+    let (s, c) = sin_cos_quarter(FRAC_PI_4 * t);
+    r * if x_major { Vec2::new(c, s) } else { Vec2::new(s, c) }
 }
 
 /// Density of [`sample_uniform_disk_concentric`] per unit area: 1/π inside the disk.
