@@ -25,6 +25,8 @@ enum Command {
     Render(cmd::render::Args),
     /// Tabulate a BSDF into a MERL table (the virtual gonioreflectometer).
     Measure(cmd::measure::Args),
+    /// Fit an analytic model to a measured BSDF and write it as a Mitsuba <bsdf>.
+    Fit(cmd::fit::Args),
 }
 
 fn main() -> ExitCode {
@@ -34,6 +36,7 @@ fn main() -> ExitCode {
         Command::Albedo(args) => cmd::albedo::run(args),
         Command::Render(args) => cmd::render::run(args),
         Command::Measure(args) => cmd::measure::run(args),
+        Command::Fit(args) => cmd::fit::run(args),
     };
     match result {
         Ok(code) => code,

@@ -1,4 +1,5 @@
 pub mod albedo;
 pub mod check;
+pub mod fit;
 pub mod measure;
 pub mod render;

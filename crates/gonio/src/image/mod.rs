@@ -187,7 +187,7 @@ fn temporary_path(path: &Path) -> PathBuf {
 
 /// Writes `bytes` to a temporary file beside `path`, flushes it and renames it over `path`. On any error
 /// the temporary is removed and `path` is untouched.
-pub(crate) fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
+pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
     use std::io::Write;
     let tmp = temporary_path(path);
     let result = (|| -> std::io::Result<()> {
