@@ -62,9 +62,10 @@ pub fn run(args: Args) -> Result<ExitCode, Error> {
         }
     }
     if let (Some(path), Some(best)) = (&args.output, &best) {
+        // XML comments may not contain "--": hyphens in the source's name become U+2010.
         let comment = format!(
-            "<!-- gonio fit {} --model {}: relative error {:.4} (Ngan et al. 2005 metric, {} direction pairs) -->\n",
-            args.measured.replace("--", "- -"),
+            "<!-- fitted by gonio to {}: model {}, relative error {:.4} (Ngan et al. 2005 metric, {} direction pairs) -->\n",
+            args.measured.replace('-', "\u{2010}"),
             best.model,
             best.relative_error,
             set.len()
