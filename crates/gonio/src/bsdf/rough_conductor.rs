@@ -81,6 +81,18 @@ pub(crate) struct MicrofacetParams {
     pub exponent: bool,
 }
 
+impl MicrofacetParams {
+    /// Mitsuba's microfacet plugins (`roughconductor`, `roughdielectric`, `roughplastic`): Beckmann (the
+    /// default) or GGX, α = 0.1 by default, Smith shadowing, no Blinn exponent.
+    pub const MITSUBA: MicrofacetParams = MicrofacetParams {
+        kinds: &[MicrofacetKind::Beckmann, MicrofacetKind::Ggx],
+        default_kind: MicrofacetKind::Beckmann,
+        default_alpha: 0.1,
+        shadowing: None,
+        exponent: false,
+    };
+}
+
 impl MicrofacetConductor {
     /// A microfacet conductor with `distribution`, `shadowing` and the Fresnel term of `fresnel`.
     #[must_use]
@@ -284,14 +296,6 @@ impl BsdfModel for MicrofacetConductor {
 pub struct RoughConductor(pub MicrofacetConductor);
 
 impl RoughConductor {
-    const PARAMS: MicrofacetParams = MicrofacetParams {
-        kinds: &[MicrofacetKind::Beckmann, MicrofacetKind::Ggx],
-        default_kind: MicrofacetKind::Beckmann,
-        default_alpha: 0.1,
-        shadowing: None,
-        exponent: false,
-    };
-
     /// A rough conductor of distribution `kind` (Beckmann or GGX) with Fresnel term `fresnel`.
     #[must_use]
     pub fn new(kind: MicrofacetKind, alpha_x: f32, alpha_y: f32, fresnel: Conductor) -> Self {
@@ -300,7 +304,7 @@ impl RoughConductor {
     }
 
     pub fn from_props(p: &Props) -> Result<Self> {
-        let core = MicrofacetConductor::from_props(p, &Self::PARAMS)?;
+        let core = MicrofacetConductor::from_props(p, &MicrofacetParams::MITSUBA)?;
         if !p.bool("energy_compensation", false)? {
             return Ok(RoughConductor(core));
         }

@@ -60,7 +60,7 @@ use super::{BsdfFlags, BsdfModel, BsdfSample};
 use crate::error::{Error, Result};
 use crate::fresnel::{fresnel_dielectric, reflect, refract_about};
 use crate::math::{Vec2, Vec3};
-use crate::microfacet::{MicrofacetDistribution, MicrofacetKind, Shadowing};
+use crate::microfacet::{MicrofacetDistribution, Shadowing};
 use crate::props::Props;
 use crate::spectrum::Rgb;
 
@@ -93,14 +93,6 @@ struct HalfVector {
 }
 
 impl RoughDielectric {
-    const PARAMS: MicrofacetParams = MicrofacetParams {
-        kinds: &[MicrofacetKind::Beckmann, MicrofacetKind::Ggx],
-        default_kind: MicrofacetKind::Beckmann,
-        default_alpha: 0.1,
-        shadowing: None,
-        exponent: false,
-    };
-
     /// A white rough dielectric of relative index `eta` (≠ 1), sampling visible normals.
     #[must_use]
     pub fn new(distribution: MicrofacetDistribution, eta: f32) -> Self {
@@ -109,7 +101,7 @@ impl RoughDielectric {
     }
 
     pub fn from_props(p: &Props) -> Result<Self> {
-        let distribution = read_distribution(p, &Self::PARAMS)?;
+        let distribution = read_distribution(p, &MicrofacetParams::MITSUBA)?;
         let eta = relative_ior(p)?;
         // η = 1 makes every microfacet refract straight through: a Dirac delta no rough lobe can represent.
         if eta == 1.0 {
@@ -371,6 +363,7 @@ impl crate::bsdf::Examples for RoughDielectric {
 mod tests {
     use super::*;
     use crate::bsdf::Bsdf;
+    use crate::microfacet::MicrofacetKind;
     use crate::verify::energy;
 
     #[test]

@@ -140,14 +140,6 @@ pub struct RoughPlastic {
 }
 
 impl RoughPlastic {
-    const PARAMS: MicrofacetParams = MicrofacetParams {
-        kinds: &[MicrofacetKind::Beckmann, MicrofacetKind::Ggx],
-        default_kind: MicrofacetKind::Beckmann,
-        default_alpha: 0.1,
-        shadowing: None,
-        exponent: false,
-    };
-
     /// A rough plastic with a coating of `distribution` (isotropic) and relative index `eta` (≠ 1) over a
     /// base of albedo `rho`.
     #[must_use]
@@ -162,7 +154,7 @@ impl RoughPlastic {
     }
 
     pub fn from_props(p: &Props) -> Result<Self> {
-        let distribution = read_distribution(p, &Self::PARAMS)?;
+        let distribution = read_distribution(p, &MicrofacetParams::MITSUBA)?;
         if distribution.is_anisotropic() {
             return Err(Error::spec(p.at(), "`roughplastic` is isotropic: give `alpha`, not `alpha_u` ≠ `alpha_v`".to_string()));
         }

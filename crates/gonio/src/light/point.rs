@@ -22,16 +22,25 @@ pub struct PointLight {
 impl PointLight {
     #[must_use]
     pub fn sample_li(&self, p: Vec3, n: Vec3) -> Option<LightSample> {
-        let d = self.position - p;
-        let dist2 = d.length_squared();
-        if !(dist2 > 0.0) {
-            return None;
-        }
-        let shadow = if n == Vec3::ZERO {
-            crate::geometry::Ray::new(p, d / dist2.sqrt(), dist2.sqrt() * (1.0 - 1e-5))
-        } else {
-            spawn_ray_to(p, n, self.position, Vec3::ZERO)
-        };
-        Some(LightSample { wi: d / dist2.sqrt(), li: self.intensity / dist2, pdf: 1.0, delta: true, shadow })
+        sample_point_source(self.position, self.intensity, p, n)
     }
+}
+
+/// Light from an isotropic point source of `intensity` at `position` arriving at `p` (normal `n`, or zero
+/// in a medium): inverse-square radiance, a delta sample, and the shadow ray to the source. Shared by
+/// [`PointLight`] and [`super::spot::SpotLight`] (which scales it by its falloff).
+#[must_use]
+pub(crate) fn sample_point_source(position: Vec3, intensity: Rgb, p: Vec3, n: Vec3) -> Option<LightSample> {
+    let d = position - p;
+    let dist2 = d.length_squared();
+    if !(dist2 > 0.0) {
+        return None;
+    }
+    let wi = d / dist2.sqrt();
+    let shadow = if n == Vec3::ZERO {
+        crate::geometry::Ray::new(p, wi, dist2.sqrt() * (1.0 - 1e-5))
+    } else {
+        spawn_ray_to(p, n, position, Vec3::ZERO)
+    };
+    Some(LightSample { wi, li: intensity / dist2, pdf: 1.0, delta: true, shadow })
 }

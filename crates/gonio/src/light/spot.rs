@@ -14,8 +14,6 @@
 
 use super::LightSample;
 use crate::error::{Error, Result};
-use crate::geometry::ray::spawn_ray_to;
-use crate::geometry::Ray;
 use crate::math::Transform;
 use crate::props::Props;
 use crate::spectrum::Rgb;
@@ -80,21 +78,16 @@ impl SpotLight {
         }
     }
 
+    /// The point source's sample ([`super::point::sample_point_source`]) scaled by the falloff.
     #[must_use]
     pub fn sample_li(&self, p: Vec3, n: Vec3) -> Option<LightSample> {
-        let d = self.position - p;
-        let dist2 = d.length_squared();
-        if !(dist2 > 0.0) {
-            return None;
-        }
-        let wi = d / dist2.sqrt();
-        let falloff = self.falloff(self.to_local.vector(-wi));
+        let mut s = super::point::sample_point_source(self.position, self.intensity, p, n)?;
+        let falloff = self.falloff(self.to_local.vector(-s.wi));
         if falloff <= 0.0 {
             return None;
         }
-        let shadow =
-            if n == Vec3::ZERO { Ray::new(p, wi, dist2.sqrt() * (1.0 - 1e-5)) } else { spawn_ray_to(p, n, self.position, Vec3::ZERO) };
-        Some(LightSample { wi, li: self.intensity * (falloff / dist2), pdf: 1.0, delta: true, shadow })
+        s.li *= falloff;
+        Some(s)
     }
 }
 
