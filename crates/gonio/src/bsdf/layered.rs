@@ -242,7 +242,7 @@ impl Layered {
                     }
                     let wn = sample_hg(self.g, w, rng.next_vec2());
                     let phase_pdf = hg(self.g, w.dot(wn));
-                    beta = beta * self.albedo;
+                    beta *= self.albedo;
                     w = wn;
                     z = zp;
                     if w.z > 0.0 && !top_delta {
@@ -260,7 +260,7 @@ impl Layered {
                 }
                 z = zp.clamp(0.0, thick);
             } else {
-                beta = beta * tr(thick, w.z);
+                beta *= tr(thick, w.z);
                 z = if w.z > 0.0 { thick } else { 0.0 };
             }
             // Which interface the walk reached: the direction of travel says (z alone cannot when the
@@ -271,7 +271,7 @@ impl Layered {
                 if s.wi.z >= 0.0 {
                     break;
                 }
-                beta = beta * s.weight;
+                beta *= s.weight;
                 w = s.wi;
             } else {
                 // At the base: connect to ωi through the sampled exit direction, then sample the base.
@@ -285,7 +285,7 @@ impl Layered {
                 if s.wi.z <= 0.0 {
                     break;
                 }
-                beta = beta * s.weight;
+                beta *= s.weight;
                 w = s.wi;
                 if !top_delta {
                     let fe = self.coating.f(-w, wi);
@@ -306,7 +306,7 @@ impl Layered {
 impl Layered {
     /// `samples` walks from `wo` to `wi` (both above), averaged, plus the coating's own reflection.
     fn estimate(&self, wo: Vec3, wi: Vec3, seed: u64) -> Rgb {
-        let mut rng = Pcg32::new(seed, 0x6c61_7965_7265_64);
+        let mut rng = Pcg32::new(seed, 0x006c_6179_6572_6564);
         let mut sum = Rgb::ZERO;
         for _ in 0..self.samples {
             sum += self.walk(wo, wi, &mut rng);

@@ -190,7 +190,7 @@ impl Measured {
     /// Map both directions into the tables; `None` below the horizon or for non-finite input.
     fn locate(&self, wo: Vec3, wi: Vec3) -> Option<Located> {
         let t = &*self.tables;
-        if !(wo.z > 0.0 && wi.z > 0.0) || !wo.is_finite() || !wi.is_finite() {
+        if !(wo.z > 0.0 && wi.z > 0.0 && wo.is_finite() && wi.is_finite()) {
             return None;
         }
         let (wo, wi) = t.fold(wo, wi);
@@ -515,7 +515,7 @@ mod tests {
         let mut rng = Pcg32::new(5, 1);
         let mut n = 0;
         for _ in 0..20_000 {
-            let wo = direction(rng.next_f32().max(0.02), rng.next_f32() * 6.28);
+            let wo = direction(rng.next_f32().max(0.02), rng.next_f32() * std::f32::consts::TAU);
             let Some(s) = m.sample(wo, 0.5, rng.next_vec2()) else { continue };
             n += 1;
             assert!(s.wi.z > 0.0 && s.pdf > 0.0 && s.weight.is_finite());

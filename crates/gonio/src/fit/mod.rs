@@ -243,7 +243,7 @@ pub fn fit(model: &'static FitModel, pairs: &[Pair]) -> Result<Fit> {
     residuals_of(&spec, pairs, &mut r);
     let signal: f64 = pairs.iter().map(|p| p.weight * p.target.iter().map(|t| t * t).sum::<f64>()).sum();
     let error = r.iter().map(|v| v * v).sum::<f64>().sqrt();
-    let mut bands = vec![(0.0, 0.0); 8];
+    let mut bands = [(0.0, 0.0); 8];
     for (k, p) in pairs.iter().enumerate() {
         let band = ((f64::from(p.wi.z).acos().to_degrees() / 10.0) as usize).min(7);
         bands[band].0 += (0..3).map(|c| r[3 * k + c] * r[3 * k + c]).sum::<f64>();

@@ -253,7 +253,7 @@ impl TensorFile {
             let mut elements: u64 = 1;
             for _ in 0..rank {
                 let n = r.u64(&what)?;
-                elements = elements.checked_mul(n).unwrap_or(u64::MAX);
+                elements = elements.saturating_mul(n);
                 shape.push(n);
             }
             // Every size check in u64 before converting: a corrupt shape must not overflow usize.
