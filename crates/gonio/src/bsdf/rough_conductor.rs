@@ -320,43 +320,6 @@ impl RoughConductor {
 
 forward_bsdf_model!(RoughConductor => 0);
 
-/// The harness on lobes too narrow for its chi-square cell integrals: every check but chi-square must
-/// pass; the chi-square is rerun with 24 (instead of 6) Gauss–Legendre points per cell and axis and must
-/// pass where α ≥ 0.1 along both axes. Below that the sampled normals are chi-square tested on a
-/// lobe-following grid in [`crate::microfacet`] instead.
-#[cfg(test)]
-pub(crate) fn narrow_lobes_report(specs: &[&str]) {
-    use crate::bsdf::Bsdf;
-    use crate::verify::chi2::{chi2_bsdf, Chi2Config};
-    use crate::verify::{check_named, test_directions, CheckConfig};
-    let mut failed = Vec::new();
-    for spec in specs {
-        let b = Bsdf::from_json(spec).unwrap();
-        let report = check_named(&b, spec, &CheckConfig::default());
-        eprintln!("{}", report.to_table());
-        if report.rows.iter().any(|r| !r.passed && !r.check.starts_with("chi2")) {
-            failed.push(report.to_table());
-        }
-        let m = match &b {
-            Bsdf::RoughConductor(RoughConductor(m)) | Bsdf::TorranceSparrow(super::TorranceSparrow(m)) => m,
-            _ => unreachable!(),
-        };
-        if m.distribution.alpha_x.min(m.distribution.alpha_y) < 0.1 {
-            continue;
-        }
-        let dirs = test_directions(&b);
-        let cfg = Chi2Config { integration_res: 24, tests: dirs.len(), ..Chi2Config::default() };
-        for wo in dirs {
-            let r = chi2_bsdf(&b, wo, &cfg);
-            eprintln!("  fine chi2 cosθo={:+.2}: p = {:.3e} {}", wo.z, r.p_value, r.message);
-            if !r.passed {
-                failed.push(format!("{spec}: fine chi2 at cosθo={}: {}", wo.z, r.message));
-            }
-        }
-    }
-    assert!(failed.is_empty(), "{}", failed.join("\n"));
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
