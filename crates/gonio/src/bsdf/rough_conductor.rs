@@ -308,12 +308,7 @@ impl RoughConductor {
         if !p.bool("energy_compensation", false)? {
             return Ok(RoughConductor(core));
         }
-        if core.distribution.is_anisotropic() {
-            return Err(Error::spec(
-                p.at(),
-                "`roughconductor`: `energy_compensation` needs an isotropic roughness (`alpha`, not `alpha_u` ≠ `alpha_v`): its albedo tables are functions of cos θo alone".to_string(),
-            ));
-        }
+        super::rough_dielectric::check_isotropic_for_compensation(p, &core.distribution)?;
         Ok(RoughConductor(core.with_energy_compensation()))
     }
 }
