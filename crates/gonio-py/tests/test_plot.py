@@ -107,7 +107,8 @@ def test_plot_draws_every_kind(tmp_path):
         fig = gonio.plot([paint, gold], kind, theta_o=30, labels=["paint", "gold"], log=(kind == "slice"), samples=256)
         fig.savefig(tmp_path / f"{kind}.png")
         assert (tmp_path / f"{kind}.png").stat().st_size > 5000
-        texts = [t.get_text() for ax in fig.axes for t in (ax.get_legend().get_texts() if ax.get_legend() else [])]
+        legends = [ax.get_legend() for ax in fig.axes] + list(fig.legends)
+        texts = [t.get_text() for lg in legends if lg is not None for t in lg.get_texts()]
         titles = [ax.get_title() for ax in fig.axes]
         if kind == "slice":
             assert "paint" in titles and "gold" in titles

@@ -10,6 +10,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.colors import LogNorm, Normalize
 from matplotlib.patches import Patch
+from matplotlib.ticker import MaxNLocator
 
 from . import Bsdf, albedo_data, load_bsdf, lobe_data, slice_data
 
@@ -100,11 +101,15 @@ def _polar(models, names, theta_o, c, log, suffix):
             ax.set_rticks(ticks)
             ax.set_yticklabels([f"1e{hi - LOG_DECADES + t}" for t in ticks])
             ax.set_rlim(0, LOG_DECADES)
+        else:
+            ax.yaxis.set_major_locator(MaxNLocator(4))
+        ax.tick_params(axis="y", labelsize=8)
         if key == "incidence":
             ax.plot([np.radians(theta_o)] * 2, [0, ax.get_rmax()], "k--", lw=1)
             ax.annotate("ωo", (np.radians(theta_o), ax.get_rmax()))
         ax.set_title(title, fontsize=11)
-    fig.axes[-1].legend(loc="upper right", bbox_to_anchor=(1.35, 1.1))
+    handles, texts = fig.axes[0].get_legend_handles_labels()
+    fig.legend(handles, texts, loc="lower center", ncol=min(len(texts), 4))
     return fig
 
 
