@@ -137,7 +137,7 @@ def _lobe3d(models, names, theta_o, c, log, suffix):
     ax.set_ylabel("y")
     ax.set_zlabel("z")
     # Surfaces have no legend handle of their own in every matplotlib version: patches stand in.
-    ax.legend(handles=[Patch(color=f"C{k}", label=name) for k, name in enumerate(names)])
+    ax.legend(handles=[Patch(color=f"C{k}", label=name) for k, name in enumerate(names)], loc="upper left")
     return fig
 
 
