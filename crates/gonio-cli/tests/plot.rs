@@ -1,7 +1,7 @@
 //! `gonio plot` end to end: figures that decode and are not blank, legends, the numbers behind them,
 //! measured files through the shared loader, and bad input with exit code 2.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 fn gonio(args: &[&str]) -> Output {
@@ -24,7 +24,7 @@ const GGX: &str = r#"{"type": "roughconductor", "distribution": "ggx", "alpha": 
 
 /// Decoded PNG: size, and checks that it is a drawing (many colours, text in the title band, the first
 /// model's blue curve, or the colours of a heat map).
-fn assert_png_is_a_figure(path: &PathBuf, width: usize, curve: bool) {
+fn assert_png_is_a_figure(path: &Path, width: usize, curve: bool) {
     let img = gonio::image::read_image(path).expect("a PNG gonio can decode");
     assert_eq!(img.width, width, "{}", path.display());
     assert!(img.height > 300, "{}", img.height);

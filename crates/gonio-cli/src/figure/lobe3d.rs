@@ -37,6 +37,14 @@ impl Camera {
     }
 }
 
+/// One shaded quad of a lobe, in screen coordinates, with its depth along the view direction.
+struct Quad {
+    depth: f64,
+    corners: [(f64, f64); 4],
+    fill: String,
+    opacity: f64,
+}
+
 fn hex(c: &str) -> DVec3 {
     let v = u32::from_str_radix(c.trim_start_matches('#'), 16).unwrap_or(0);
     DVec3::new(f64::from((v >> 16) & 255), f64::from((v >> 8) & 255), f64::from(v & 255))
@@ -71,7 +79,7 @@ pub fn draw(lobes: &[LobeData], labels: &[String], channel: Channel, log: bool) 
         svg.text(b.0, b.1 + 14.0, name, 12.0, Anchor::Middle, 0.0);
     }
     // Quads of every model, far ones first.
-    let mut quads: Vec<(f64, [(f64, f64); 4], String, f64)> = Vec::new();
+    let mut quads: Vec<Quad> = Vec::new();
     let light = (cam.towards + DVec3::new(0.0, 0.0, 0.6)).normalize();
     for (k, lobe) in lobes.iter().enumerate() {
         let g = &lobe.grid;
@@ -95,13 +103,13 @@ pub fn draw(lobes: &[LobeData], labels: &[String], channel: Channel, log: bool) 
                 let rgb = base * shade + DVec3::splat(255.0) * (1.0 - shade) * 0.25;
                 let fill = format!("#{:02x}{:02x}{:02x}", rgb.x.min(255.0) as u8, rgb.y.min(255.0) as u8, rgb.z.min(255.0) as u8);
                 let depth = c.iter().map(|p| p.dot(cam.towards)).sum::<f64>() / 4.0;
-                quads.push((depth, c.map(|p| cam.project(p)), fill, if lobes.len() > 1 { 0.7 } else { 0.95 }));
+                quads.push(Quad { depth, corners: c.map(|p| cam.project(p)), fill, opacity: if lobes.len() > 1 { 0.7 } else { 0.95 } });
             }
         }
     }
-    quads.sort_by(|a, b| a.0.total_cmp(&b.0));
-    for (_, pts, fill, opacity) in &quads {
-        svg.polygon(pts, fill, *opacity, Some((fill, 0.4)));
+    quads.sort_by(|a, b| a.depth.total_cmp(&b.depth));
+    for q in &quads {
+        svg.polygon(&q.corners, &q.fill, q.opacity, Some((&q.fill, 0.4)));
     }
     // The normal and the viewing direction, on top.
     let t = theta_o.to_radians();

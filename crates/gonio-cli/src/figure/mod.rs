@@ -39,7 +39,8 @@ impl Scale {
     /// to show: a model made only of delta lobes, say).
     pub fn fit(values: impl IntoIterator<Item = f64>, log: bool) -> Option<Scale> {
         let max = values.into_iter().filter(|v| v.is_finite()).fold(0.0f64, f64::max);
-        if !(max > 0.0) {
+        // max is finite and ≥ 0 (the fold starts at 0 and skips NaN).
+        if max <= 0.0 {
             return None;
         }
         Some(if log {
@@ -71,7 +72,7 @@ impl Scale {
                 if v.is_nan() {
                     return f64::NAN;
                 }
-                if !(v > 0.0) {
+                if v <= 0.0 {
                     return 0.0;
                 }
                 ((v.log10() - f64::from(lo)) / f64::from(hi - lo)).clamp(0.0, 1.0)
@@ -173,7 +174,8 @@ mod tests {
         assert_eq!(nice_step(0.03), 0.05);
         assert_eq!(nice_step(0.2), 0.2);
         assert_eq!(nice_step(7.0), 10.0);
-        assert_eq!(nice_ceiling(0.159), 0.16);
+        assert_eq!(nice_ceiling(0.159), 0.2);
+        assert_eq!(nice_ceiling(1.7), 2.0);
         assert_eq!(nice_ceiling(1.0), 1.0);
         assert_eq!(format_tick(0.25, 0.25), "0.25");
         assert_eq!(format_tick(2.0, 1.0), "2");
@@ -186,8 +188,8 @@ mod tests {
     fn scales_map_and_tick() {
         let lin = Scale::fit([0.0, 0.3, f64::NAN, 0.15], false).unwrap();
         assert!(matches!(lin, Scale::Linear { max } if (max - 0.3).abs() < 1e-12));
-        assert_eq!(lin.map(0.15), 0.5);
-        assert_eq!(lin.ticks().last().unwrap().1, "0.30");
+        assert!((lin.map(0.15) - 0.5).abs() < 1e-12);
+        assert_eq!(lin.ticks().iter().map(|t| t.1.as_str()).collect::<Vec<_>>(), ["0.0", "0.1", "0.2", "0.3"]);
         let log = Scale::fit([5.0, 0.01], true).unwrap();
         assert!(matches!(log, Scale::Log { lo: -3, hi: 1 }));
         assert_eq!(log.map(10.0), 1.0);
@@ -195,6 +197,6 @@ mod tests {
         assert_eq!(log.ticks().len(), 5);
         assert!(Scale::fit([0.0, f64::NAN], false).is_none());
         let values: Vec<f64> = (1..=1000).map(f64::from).chain([1e9]).collect();
-        assert!(matches!(Scale::fit_quantile(values, false, 0.99), Scale::Linear { max } if max == 1000.0));
+        assert!(matches!(Scale::fit_quantile(values, false, 0.99), Some(Scale::Linear { max }) if max == 1000.0));
     }
 }

@@ -40,7 +40,8 @@ impl Svg {
         svg
     }
 
-    /// A straight line.
+    /// A straight line: two end points and the pen.
+    #[allow(clippy::too_many_arguments)]
     pub fn line(&mut self, x0: f64, y0: f64, x1: f64, y1: f64, stroke: &str, width: f64, dash: Option<&str>) {
         let dash = dash.map(|d| format!(r#" stroke-dasharray="{d}""#)).unwrap_or_default();
         let _ = writeln!(
