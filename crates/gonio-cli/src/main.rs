@@ -3,6 +3,7 @@
 //! Exit codes: 0 success, 1 a check failed, 2 bad input (the message names the file or parameter).
 
 mod cmd;
+mod figure;
 mod spec;
 
 use clap::{Parser, Subcommand};
@@ -27,6 +28,8 @@ enum Command {
     Measure(cmd::measure::Args),
     /// Fit an analytic model to a measured BSDF and write it as a Mitsuba <bsdf>.
     Fit(cmd::fit::Args),
+    /// Plot BSDFs: polar lobes, 3-D lobes, θh × θd slices or albedo curves, overlaid, to PNG, SVG or CSV.
+    Plot(cmd::plot::Args),
 }
 
 fn main() -> ExitCode {
@@ -37,6 +40,7 @@ fn main() -> ExitCode {
         Command::Render(args) => cmd::render::run(args),
         Command::Measure(args) => cmd::measure::run(args),
         Command::Fit(args) => cmd::fit::run(args),
+        Command::Plot(args) => cmd::plot::run(args),
     };
     match result {
         Ok(code) => code,

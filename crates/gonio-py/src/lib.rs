@@ -23,6 +23,7 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 
 mod batch;
 mod image;
+mod plot;
 mod scene;
 mod verify;
 
@@ -428,6 +429,7 @@ fn _gonio(m: &Bound<'_, PyModule>) -> PyResult<()> {
     verify::register(m)?;
     scene::register(m)?;
     image::register(m)?;
+    plot::register(m)?;
     for (name, bit) in [
         ("FLAG_REFLECTION", BsdfFlags::REFLECTION),
         ("FLAG_TRANSMISSION", BsdfFlags::TRANSMISSION),

@@ -28,14 +28,17 @@ from __future__ import annotations
 
 import enum
 import json
-from typing import Any, Mapping, Union
+from typing import Any, Mapping, Optional, Sequence, Union
 
 from . import _gonio, verify
 from ._gonio import (
+    AlbedoData,
     Bsdf,
     BsdfSample,
+    LobeData,
     Scene,
     SceneError,
+    SliceData,
     SpecError,
     examples,
     load_dict,
@@ -49,20 +52,27 @@ from ._gonio import (
 __version__: str = _gonio.__version__
 
 __all__ = [
+    "AlbedoData",
     "Bsdf",
     "BsdfFlags",
     "BsdfSample",
+    "LobeData",
     "Scene",
     "SceneError",
+    "SliceData",
     "SpecError",
     "__version__",
+    "albedo_data",
     "examples",
     "load_bsdf",
     "load_dict",
     "load_scene",
+    "lobe_data",
     "look_at",
+    "plot",
     "plugins",
     "read_image",
+    "slice_data",
     "verify",
     "write_image",
 ]
@@ -119,3 +129,79 @@ def _to_json(value: Any) -> Any:
     if isinstance(value, (tuple, set)):
         return list(value)
     raise TypeError(f"{type(value).__name__} is not a number, string, list or dict")
+
+
+# ---------------------------------------------------------------------------------------------------------
+# Plot data (gonio::plot, the numbers `gonio plot` draws) and gonio.plot (matplotlib, optional).
+
+ModelLike = Union[Bsdf, str, bytes, Mapping[str, Any]]
+
+
+def _as_bsdf(model: ModelLike) -> Bsdf:
+    return model if isinstance(model, Bsdf) else load_bsdf(model)
+
+
+def lobe_data(bsdf: ModelLike, theta_o: float, *, samples: int = 721, grid_theta: int = 31, grid_phi: int = 72) -> LobeData:
+    """The lobe of a model seen from θo (degrees, in [0, 90)): f·|cos θi| in sr⁻¹.
+
+    ωo = (sin θo, 0, cos θo) lies in the xz-plane. ``angles`` (``samples`` values, degrees, evenly over
+    [−180°, 180°]) parameterise two planes:
+
+    - ``incidence``: the plane of incidence, ωi = (sin a, 0, cos a); a is the signed polar angle of ωi,
+      the mirror direction ωr is at a = −θo, |a| > 90° is below the surface;
+    - ``perpendicular``: the plane through ωr perpendicular to it, ωi = cos a·ωr + sin a·ŷ (a is the
+      angle from ωr; there cos θi = cos a·cos θo).
+
+    ``grid`` (shape ``(grid_theta, grid_phi, 4)``) covers ωi = (sin θ cos φ, sin θ sin φ, cos θ) with θ in
+    ``grid_theta`` (0°…90°, or 0°…180° for models that transmit) and φ in ``grid_phi`` ([0°, 360°)); 0 for
+    either count skips the grid. Value arrays are float32 with a last axis of four channels: r, g, b and
+    the Rec. 709 luminance. A Lambertian surface of albedo ρ gives ρ/π·cos a in the plane of incidence.
+    ``bsdf`` is a ``Bsdf`` or anything ``load_bsdf`` accepts. Bad arguments raise ``ValueError``.
+    """
+    return _gonio.lobe_data(_as_bsdf(bsdf), theta_o, samples=samples, grid_theta=grid_theta, grid_phi=grid_phi)
+
+
+def slice_data(bsdf: ModelLike, phi_d: float = 90.0, *, theta_h: int = 90, theta_d: int = 90) -> SliceData:
+    """f (sr⁻¹) on MERL's θh × θd grid at one φd (degrees, in [0, 360)): the image slices of the MERL
+    papers and of Disney's BRDF Explorer, in Rusinkiewicz's half/difference angles.
+
+    Column i has θh = 90°·((i + ½)/theta_h)² (square-root spacing), row j has θd = 90°·(j + ½)/theta_d;
+    at 90 × 90 these are the centres of a MERL table's cells, and the directions are built exactly as
+    ``gonio measure`` builds them, so the slice of a MERL table at φd = k + ½ reads its entries.
+    ``values`` has shape ``(theta_d, theta_h, 4)`` (channels r, g, b, lum), NaN where ωo or ωi would be
+    below the horizon.
+    """
+    return _gonio.slice_data(_as_bsdf(bsdf), phi_d, theta_h=theta_h, theta_d=theta_d)
+
+
+def albedo_data(bsdf: ModelLike, *, angles: int = 30, samples: int = 16_384, seed: int = 0) -> AlbedoData:
+    """The directional albedo ∫ f |cos θi| dωi against θo, by gonio's energy check (the model's own
+    sampling, stratified; transmitted energy counted).
+
+    ``theta_o`` holds ``angles`` midpoints 90°·(k + ½)/angles (degrees), ``albedo`` has shape
+    ``(angles, 4)`` (channels r, g, b, lum); the k-th angle uses ``samples`` samples and seed ``seed + k``,
+    so the result equals ``gonio plot --kind albedo -o data.csv`` for the same numbers.
+    """
+    return _gonio.albedo_data(_as_bsdf(bsdf), angles=angles, samples=samples, seed=seed)
+
+
+def plot(bsdfs: Any, kind: str = "polar", theta_o: Optional[float] = None, *, log: bool = False, channel: str = "lum",
+         labels: Optional[Sequence[str]] = None, phi_d: float = 90.0, angles: int = 30, samples: int = 16_384) -> Any:
+    """Draw one or more models with matplotlib, from the same numbers as ``gonio plot``; returns the figure.
+
+    ``bsdfs`` is one model or a list (``Bsdf`` objects or anything ``load_bsdf`` accepts); ``kind`` is
+
+    - ``"polar"``: f·cos θi in the plane of incidence and the perpendicular plane (``theta_o`` required);
+    - ``"3d"``: the lobe f·cos θi over all incident directions (``theta_o`` required);
+    - ``"slice"``: f on the θh × θd grid at ``phi_d``, one panel per model;
+    - ``"albedo"``: the directional albedo against θo (``angles``, ``samples``; ``theta_o`` is marked).
+
+    ``log`` uses a logarithmic scale (four decades, like the CLI); ``channel`` is ``"r"``, ``"g"``, ``"b"``
+    or ``"lum"``; ``labels`` name the models in the legend (default: their plugin names).
+    Needs matplotlib (``pip install matplotlib``); without it this raises ``ImportError`` saying so.
+    """
+    try:
+        from . import _plot
+    except ImportError as e:  # matplotlib (or one of its parts) is missing
+        raise ImportError(f"gonio.plot needs matplotlib, which could not be imported ({e}); install it with `pip install matplotlib`") from e
+    return _plot.plot(bsdfs, kind, theta_o, log=log, channel=channel, labels=labels, phi_d=phi_d, angles=angles, samples=samples)

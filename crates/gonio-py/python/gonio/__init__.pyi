@@ -2,7 +2,7 @@
 
 import enum
 import os
-from typing import Any, List, Mapping, Optional, Tuple, Union
+from typing import Any, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -142,3 +142,81 @@ def write_image(path: PathLike, array: npt.ArrayLike) -> None:
 
     `array`: float32/float64 of shape (height, width, 3) or (height, width). Raises ValueError for another
     shape, dtype or extension, FileNotFoundError when the directory does not exist."""
+
+# Plot data: the numbers `gonio plot` draws. Value arrays are float32 with a last axis of 4 channels
+# (r, g, b, Rec. 709 luminance); angles are float64 degrees.
+
+ModelLike = Union[Bsdf, str, bytes, Mapping[str, Any]]
+
+class LobeData:
+    """f·|cos θi| (sr⁻¹) of a model seen from θo; see `lobe_data`."""
+
+    @property
+    def theta_o(self) -> float: ...
+    @property
+    def angles(self) -> npt.NDArray[np.float64]:
+        """(samples,): the angle a of both planes, degrees, evenly over [−180°, 180°]."""
+    @property
+    def incidence(self) -> npt.NDArray[np.float32]:
+        """(samples, 4): in the plane of incidence, ωi = (sin a, 0, cos a)."""
+    @property
+    def perpendicular(self) -> npt.NDArray[np.float32]:
+        """(samples, 4): in the perpendicular plane, ωi = cos a·ωr + sin a·ŷ."""
+    @property
+    def grid_theta(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def grid_phi(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def grid(self) -> npt.NDArray[np.float32]:
+        """(grid_theta, grid_phi, 4): over ωi = (sin θ cos φ, sin θ sin φ, cos θ)."""
+
+class SliceData:
+    """f (sr⁻¹) on MERL's θh × θd grid at one φd; see `slice_data`."""
+
+    @property
+    def phi_d(self) -> float: ...
+    @property
+    def theta_h(self) -> npt.NDArray[np.float64]:
+        """(n_h,): 90°·((i + ½)/n_h)², square-root spacing."""
+    @property
+    def theta_d(self) -> npt.NDArray[np.float64]:
+        """(n_d,): 90°·(j + ½)/n_d."""
+    @property
+    def values(self) -> npt.NDArray[np.float32]:
+        """(n_d, n_h, 4); NaN where ωo or ωi is below the horizon."""
+
+class AlbedoData:
+    """The directional albedo against θo; see `albedo_data`."""
+
+    @property
+    def theta_o(self) -> npt.NDArray[np.float64]:
+        """(angles,): 90°·(k + ½)/angles."""
+    @property
+    def albedo(self) -> npt.NDArray[np.float32]:
+        """(angles, 4): ∫ f |cos θi| dωi."""
+
+def lobe_data(bsdf: ModelLike, theta_o: float, *, samples: int = 721, grid_theta: int = 31, grid_phi: int = 72) -> LobeData:
+    """The lobe f·|cos θi| seen from θo (degrees, in [0, 90)), ωo = (sin θo, 0, cos θo): in the plane of
+    incidence (mirror direction at a = −θo), in the perpendicular plane through the mirror direction, and
+    on a θ × φ grid (0 for either count: no grid). Raises ValueError for bad arguments."""
+
+def slice_data(bsdf: ModelLike, phi_d: float = 90.0, *, theta_h: int = 90, theta_d: int = 90) -> SliceData:
+    """f on MERL's θh × θd grid at φd (degrees, in [0, 360)); at 90 × 90 the cell centres of a MERL table."""
+
+def albedo_data(bsdf: ModelLike, *, angles: int = 30, samples: int = 16_384, seed: int = 0) -> AlbedoData:
+    """The directional albedo at θo = 90°·(k + ½)/angles, by gonio's energy check (seed + k per angle)."""
+
+def plot(
+    bsdfs: Union[ModelLike, Sequence[ModelLike]],
+    kind: str = "polar",
+    theta_o: Optional[float] = None,
+    *,
+    log: bool = False,
+    channel: str = "lum",
+    labels: Optional[Sequence[str]] = None,
+    phi_d: float = 90.0,
+    angles: int = 30,
+    samples: int = 16_384,
+) -> Any:
+    """Draw models with matplotlib (kind: "polar", "3d", "slice" or "albedo"), from the same numbers as
+    `gonio plot`; returns the matplotlib Figure. Raises ImportError naming matplotlib when it is missing."""

@@ -21,7 +21,20 @@
 use super::merl_file::{directions_at, MerlTable, CELLS, RES_PHI_D, RES_THETA_D};
 use crate::bsdf::BsdfModel;
 use crate::error::Result;
+use crate::math::Vec3;
 use rayon::prelude::*;
+
+/// The `f32` directions (ωo, ωi) a gonioreflectometer can measure at index coordinates (xθh, xθd, xφd)
+/// (see [`directions_at`]); `None` when either is at or below the horizon.
+#[must_use]
+pub fn configuration(x_h: f64, x_d: f64, x_p: f64) -> Option<(Vec3, Vec3)> {
+    let (wo, wi) = directions_at(x_h, x_d, x_p);
+    // 2026-11: 1e-7 keeps f32 directions strictly above the horizon.
+    if wo.z <= 1e-7 || wi.z <= 1e-7 {
+        return None;
+    }
+    Some((wo.normalize().as_vec3(), wi.normalize().as_vec3()))
+}
 
 /// Tabulate `bsdf` with `k³` points per cell (`k ≥ 1`); `name` names the table in messages.
 pub fn measure<M: BsdfModel + Sync + ?Sized>(bsdf: &M, k: usize, name: &str) -> Result<MerlTable> {
@@ -37,12 +50,8 @@ pub fn measure<M: BsdfModel + Sync + ?Sized>(bsdf: &M, k: usize, name: &str) -> 
                     for b in 0..k {
                         for c in 0..k {
                             let at = |i: usize, s: usize| i as f64 + (s as f64 + 0.5) / k as f64;
-                            let (wo, wi) = directions_at(at(ih, a), at(id, b), at(ip, c));
-                            // 2026-11: 1e-7 keeps f32 directions strictly above the horizon.
-                            if wo.z <= 1e-7 || wi.z <= 1e-7 {
-                                continue;
-                            }
-                            let f = bsdf.f(wo.normalize().as_vec3(), wi.normalize().as_vec3());
+                            let Some((wo, wi)) = configuration(at(ih, a), at(id, b), at(ip, c)) else { continue };
+                            let f = bsdf.f(wo, wi);
                             for (s, v) in sum.iter_mut().zip(f.0) {
                                 *s += f64::from(v);
                             }
