@@ -55,7 +55,8 @@ test-python:
 # and the Python package's batched f/sample against Mitsuba's bsdf.eval (bench/python_bsdf_vs_mitsuba.py).
 bench: cli python
 	$(CARGO) bench -p gonio
-	$(VPY) bench/render_vs_mitsuba.py
+	$(CARGO) build --profile dist -p gonio-cli
+	GONIO_BIN=target/dist/gonio $(VPY) bench/render_vs_mitsuba.py
 	$(VPY) bench/python_bsdf_vs_mitsuba.py
 
 fmt:

@@ -19,7 +19,9 @@ On a shared machine wall time depends on the other processes: the CPU-time ratio
 there, wall time on an idle machine. The load average is printed with each table.
 
 Usage: python bench/render_vs_mitsuba.py [--spp 64] [--ref-spp 2048] [--repeats 2] [--skip-compare] [--skip-scaling]
-(GONIO_BIN overrides the gonio binary, target/release/gonio by default.)
+                                        [--baseline OTHER_GONIO]
+(GONIO_BIN overrides the gonio binary, target/release/gonio by default; --baseline adds rows for another
+gonio build, e.g. one from before a change, timed in the same run.)
 """
 
 from __future__ import annotations
@@ -109,10 +111,10 @@ def children_cpu() -> float:
     return r.ru_utime + r.ru_stime
 
 
-def run_gonio(scene: Path, spp: int, defines: dict[str, str], out: Path, extra: list[str] | None = None) -> dict:
-    """Render with the CLI; returns wall (the render loop, as gonio reports it), cpu (the whole process:
-    loading is milliseconds for these scenes), load and bvh (seconds)."""
-    cmd = [str(GONIO), "render", str(scene), "-o", str(out), "--spp", str(spp)]
+def run_gonio(scene: Path, spp: int, defines: dict[str, str], out: Path, extra: list[str] | None = None, binary: Path | None = None) -> dict:
+    """Render with the CLI (`binary`, GONIO by default); returns wall (the render loop, as gonio reports
+    it), cpu (the whole process, scene loading included), load and bvh (seconds)."""
+    cmd = [str(binary or GONIO), "render", str(scene), "-o", str(out), "--spp", str(spp)]
     for k, v in defines.items():
         cmd += ["-D", f"{k}={v}"]
     cmd += extra or []
@@ -172,7 +174,7 @@ def load_note() -> str:
 # 1. gonio vs Mitsuba
 
 
-def compare(spp: int, ref_spp: int, repeats: int, tmp: Path) -> None:
+def compare(spp: int, ref_spp: int, repeats: int, tmp: Path, baseline: Path | None = None) -> None:
     llvm = llvm_library()
     variants = list(VARIANTS)
     if llvm is None:
@@ -189,6 +191,10 @@ def compare(spp: int, ref_spp: int, repeats: int, tmp: Path) -> None:
         rows = []
         g = best_of(repeats, lambda: run_gonio(scene, spp, {}, tmp / f"{name}.exr"))
         rows.append(("gonio", g, mse(read_exr(tmp / f"{name}.exr"), ref)))
+        if baseline is not None:
+            # Another gonio build (e.g. before a change), timed in the same run as the others.
+            b = best_of(repeats, lambda: run_gonio(scene, spp, {}, tmp / f"{name}-baseline.exr", binary=baseline))
+            rows.append(("gonio baseline", b, mse(read_exr(tmp / f"{name}-baseline.exr"), ref)))
         for v in variants:
             try:
                 t, img = best_of(repeats, lambda v=v: run_mitsuba(v, scene, spp, {}, llvm))
@@ -297,6 +303,7 @@ def main() -> None:
     ap.add_argument("--repeats", type=int, default=2)
     ap.add_argument("--skip-compare", action="store_true")
     ap.add_argument("--skip-scaling", action="store_true")
+    ap.add_argument("--baseline", type=Path, help="another gonio binary to time in the same run (e.g. a build before a change)")
     args = ap.parse_args()
     if not GONIO.exists():
         sys.exit(f"{GONIO} not found: run `cargo build --release -p gonio-cli` (or `make cli`) first")
@@ -307,7 +314,7 @@ def main() -> None:
     tmp = Path(tempfile.mkdtemp(prefix="gonio-bench-"))
     try:
         if not args.skip_compare:
-            compare(args.spp, args.ref_spp, args.repeats, tmp)
+            compare(args.spp, args.ref_spp, args.repeats, tmp, args.baseline)
         if not args.skip_scaling:
             scaling_work(args.repeats, tmp)
             scaling_triangles(args.repeats, tmp)

@@ -19,6 +19,13 @@
 //! Traversal is geometry-agnostic: the caller passes a closure that intersects the primitives of one
 //! leaf (a range of slots) with the ray, as obvhs does. Children are visited nearest first (by box entry
 //! distance); farther ones are culled when a closer hit has been found by the time they are popped.
+//!
+//! # Against a crate (2026-11)
+//! `bench/bvh_compare` (a standalone crate, run by hand) sets this BVH against obvhs 0.4 (compressed 8-wide
+//! BVH, PLOC build) on the same triangles and rays, single-threaded: on the Cornell box and on spheres of
+//! 10³…10⁶ triangles this one answered closest-hit queries (interaction included) 1.25–2.2× and occlusion
+//! queries 1.2–2.2× faster, and built 10⁵–10⁶ triangles in about 0.8× obvhs' time, with the same hits. So
+//! gonio keeps its own: its leaves test four triangles at once and store them inline in leaf order.
 
 use super::{Bounds3, Ray};
 use glam::{Vec3, Vec4};

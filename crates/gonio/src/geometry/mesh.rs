@@ -33,6 +33,10 @@ pub struct Mesh {
     area: f32,
     /// Unit geometric normal of each triangle (after `flip_normals`; zero for degenerate triangles).
     tri_normals: Vec<Vec3>,
+    /// For a flat-shaded mesh with texture coordinates (the built-in `rectangle` and `cube`): each
+    /// triangle's shading frame, which is then constant over the triangle (2026-11: computing it at every
+    /// hit was a tenth of a Cornell box's intersection cost). Empty otherwise.
+    flat_frames: Vec<Frame>,
 }
 
 impl Mesh {
@@ -52,6 +56,7 @@ impl Mesh {
         let mut mesh = Mesh::new(positions, normals, uvs, indices, to_world, face_normals, flip_normals, at)?;
         if !face_normals && mesh.normals.is_none() {
             mesh.normals = Some(angle_weighted_normals(&mesh.positions, &mesh.indices));
+            mesh.update_flat_frames();
         }
         Ok(mesh)
     }
@@ -105,7 +110,33 @@ impl Mesh {
         let sign = if flip_normals { -1.0 } else { 1.0 };
         let tri_normals = crosses.iter().map(|c| c.normalize_or_zero() * sign).collect();
         let area = tri_areas.iter().map(|&a| f64::from(a)).sum::<f64>() as f32;
-        Ok(Mesh { positions, normals, uvs, indices, flip_normals, areas: Distribution1D::new(&tri_areas), area, tri_normals })
+        let mut mesh = Mesh {
+            positions,
+            normals,
+            uvs,
+            indices,
+            flip_normals,
+            areas: Distribution1D::new(&tri_areas),
+            area,
+            tri_normals,
+            flat_frames: Vec::new(),
+        };
+        mesh.update_flat_frames();
+        Ok(mesh)
+    }
+
+    /// Fill [`Mesh::flat_frames`] when the mesh is flat-shaded and has texture coordinates, else empty it.
+    fn update_flat_frames(&mut self) {
+        self.flat_frames = if self.normals.is_none() && self.uvs.is_some() {
+            // Degenerate triangles (zero normal) are never hit nor sampled: any frame stands for theirs.
+            let frame = |t: usize| match self.tri_normals[t] {
+                Vec3::ZERO => Frame::from_normal(Vec3::Z),
+                ng => self.shading_frame(t as u32, ng),
+            };
+            (0..self.indices.len()).map(frame).collect()
+        } else {
+            Vec::new()
+        };
     }
 
     #[must_use]
@@ -178,7 +209,11 @@ impl Mesh {
         let p = p0 * (1.0 - b.x - b.y) + p1 * b.x + p2 * b.y;
         let (ng, ns, uv) = self.surface_at(tri, b);
         let _ = ray;
-        SurfaceInteraction { t: hit.t, p, n: ng, shading: self.shading_frame(tri, ns), uv, shape: 0, prim: tri }
+        let shading = match self.flat_frames.get(tri as usize) {
+            Some(&f) => f,
+            None => self.shading_frame(tri, ns),
+        };
+        SurfaceInteraction { t: hit.t, p, n: ng, shading, uv, shape: 0, prim: tri }
     }
 
     /// The shading frame around `ns`, oriented as Mitsuba 3 orients it (`SurfaceInteraction::
@@ -212,7 +247,14 @@ impl Mesh {
         let b = Vec2::new(1.0 - su, u.y * su);
         let [p0, p1, p2] = self.vertices(tri);
         let p = p0 * (1.0 - b.x - b.y) + p1 * b.x + p2 * b.y;
-        let (ng, ns, _) = self.surface_at(tri, b);
+        // The texture coordinates are not needed here: flat meshes skip their interpolation.
+        let (ng, ns) = if self.normals.is_none() {
+            let ng = self.tri_normals[tri as usize];
+            (ng, ng)
+        } else {
+            let (ng, ns, _) = self.surface_at(tri, b);
+            (ng, ns)
+        };
         PositionSample { p, n: ns, ng, pdf_area: 1.0 / self.area }
     }
 }
