@@ -287,9 +287,6 @@ impl crate::bsdf::Examples for RoughPlastic {
         r#"{"type": "roughplastic", "distribution": "beckmann", "alpha": 1.0, "sample_visible": false}"#,
         r#"{"type": "roughplastic", "distribution": "ggx", "alpha": 0.5, "int_ior": 1.0, "ext_ior": 1.5}"#,
         r#"{"type": "roughplastic", "distribution": "ggx", "alpha": 0.3, "int_ior": 1.01}"#,
-        r#"{"type": "roughplastic", "distribution": "ggx", "alpha": 0.05, "energy_compensation": true}"#,
-        r#"{"type": "roughplastic", "alpha": 0.3, "diffuse_reflectance": [0.9, 0.4, 0.1], "energy_compensation": true}"#,
-        r#"{"type": "roughplastic", "distribution": "ggx", "alpha": 1.0, "diffuse_reflectance": 1.0, "energy_compensation": true}"#,
     ];
 }
 
