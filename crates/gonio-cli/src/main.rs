@@ -27,6 +27,8 @@ enum Command {
     Measure(cmd::measure::Args),
     /// Fit an analytic model to a measured BSDF and write it as a Mitsuba <bsdf>.
     Fit(cmd::fit::Args),
+    /// Render lit spheres of BSDFs with the path tracer (side by side, or a sweep of one parameter).
+    Preview(cmd::preview::Args),
 }
 
 fn main() -> ExitCode {
@@ -37,6 +39,7 @@ fn main() -> ExitCode {
         Command::Render(args) => cmd::render::run(args),
         Command::Measure(args) => cmd::measure::run(args),
         Command::Fit(args) => cmd::fit::run(args),
+        Command::Preview(args) => cmd::preview::run(args),
     };
     match result {
         Ok(code) => code,

@@ -31,6 +31,7 @@ pub mod light;
 pub mod math;
 pub mod measured;
 pub mod microfacet;
+pub mod preview;
 pub mod props;
 pub mod render;
 pub mod sampling;

@@ -2,4 +2,5 @@ pub mod albedo;
 pub mod check;
 pub mod fit;
 pub mod measure;
+pub mod preview;
 pub mod render;
