@@ -139,15 +139,15 @@ pic 06_masking.png "GGX with Smith masking–shadowing (top) and without it (bot
 
 # 7 ------------------------------------------------------------------------------------------------------------
 md "## 7. Phong's energy gain in the white furnace" ""
-pic 07_furnace.png "White furnace (uniform radiance 1, exposure −1 so that radiance 1 is the background's grey): unnormalised Phong (k_s = 1, n = 1), Phong's original form (÷ cos θi, normalised, n = 10), normalised Blinn–Phong (k_s = 1, e = 10), GGX metal with F = 1 (α = 0.3). A sphere brighter than the background creates energy; the last two stay at or below it (GGX loses a little to single scattering)." \
+pic 07_furnace.png "White furnace (uniform radiance 1, exposure −1 so that radiance 1 is the background's grey): unnormalised Phong (k_s = 1, n = 1: albedo up to 2π/3 ≈ 2.1), Phong's original form (÷ cos θi, normalised, n = 1: albedo (n+2)/(n+1) = 1.5 at normal incidence), normalised Blinn–Phong (k_s = 1, e = 10), GGX metal with F = 1 (α = 0.3). A sphere brighter than the background creates energy; the last two stay at or below it (GGX loses a little to single scattering)." \
     "$GONIO" preview '{"type": "phong", "diffuse_reflectance": 0, "specular_reflectance": 1, "exponent": 1, "normalization": "none"}' \
-    '{"type": "phong", "diffuse_reflectance": 0, "specular_reflectance": 1, "exponent": 10, "form": "original"}' \
+    '{"type": "phong", "diffuse_reflectance": 0, "specular_reflectance": 1, "exponent": 1, "form": "original"}' \
     '{"type": "blinn_phong", "diffuse_reflectance": 0, "specular_reflectance": 1, "exponent": 10}' \
     '{"type": "roughconductor", "distribution": "ggx", "alpha": 0.3}' \
     --env constant --exposure -1 --spp 32 --size 192 -o $OUT/07_furnace.png
 pic 07_albedo.png "Directional albedo against θo for the same four models: above 1 means energy gain." \
     "$GONIO" plot '{"type": "phong", "diffuse_reflectance": 0, "specular_reflectance": 1, "exponent": 1, "normalization": "none"}' \
-    '{"type": "phong", "diffuse_reflectance": 0, "specular_reflectance": 1, "exponent": 10, "form": "original"}' \
+    '{"type": "phong", "diffuse_reflectance": 0, "specular_reflectance": 1, "exponent": 1, "form": "original"}' \
     '{"type": "blinn_phong", "diffuse_reflectance": 0, "specular_reflectance": 1, "exponent": 10}' \
     '{"type": "roughconductor", "distribution": "ggx", "alpha": 0.3}' --theta-o 0 --kind albedo -o $OUT/07_albedo.png
 
@@ -173,9 +173,9 @@ pic 10_textured.png "Textures over the sphere's (u, v): copper whose GGX roughne
 
 # 11 -----------------------------------------------------------------------------------------------------------
 md "## 11. Measured materials and their analytic twins" ""
-md "The seven RGL materials (Dupuy & Jakob 2018) as measured (left of each pair) and the best of the fitted analytic" \
-    "models written by \`gonio fit\` (right; the XML files are in [fits/](fits/), each with the command that made it)." ""
-FIT_MODELS=(--model ggx+diffuse --model roughplastic)
+md "The seven RGL materials (Dupuy & Jakob 2018) as measured (left of each pair) and the analytic" \
+    "model written by \`gonio fit\` (Lambertian + GGX metal, right; the XML files are in [fits/](fits/), each with the command that made it)." ""
+FIT_MODELS=(--model ggx+diffuse)
 if [ -d "$RGL" ]; then
     for f in "$RGL"/*.bsdf; do
         name=$(basename "$f" .bsdf)
@@ -192,7 +192,8 @@ if [ -d "$RGL" ]; then
             rm -f "$OUT/.fit"
         fi
         md "Fit: \`$(show "$GONIO" fit "$f" "${FIT_MODELS[@]}" -o "$fit")\`" ""
-        pic "11_$name.png" "$name: measured (left), fitted (right)." \
+        err=$(grep -o 'relative error [0-9.]*' "$fit" 2>/dev/null | head -1)
+        pic "11_$name.png" "$name: measured (left), fitted Lambertian + GGX (right; ${err:-no fit})." \
             "$GONIO" preview "$f" "$fit" "${ENV[@]}" --spp 32 --size 160 -o "$OUT/11_$name.png"
     done
 else

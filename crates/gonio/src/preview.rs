@@ -7,11 +7,17 @@
 //! | [`Lighting::Environment`] | a lat-long image (EXR/HDR/PNG) as an importance-sampled `envmap`          |
 //! | [`Lighting::GradientSky`] | the built-in sky of [`gradient_sky`]: blue zenith, pale horizon, brown ground, a small sun |
 //! | [`Lighting::Constant`]    | uniform radiance L from every direction (L = 1: the white furnace)        |
-//! | [`Lighting::Directional`] | a directional light of irradiance π (a white Lambertian surface facing it has radiance 1) plus a dim uniform ambient of [`AMBIENT`] |
+//! | [`Lighting::Directional`] | a directional light of irradiance π (a white Lambertian surface facing it has radiance 1) plus a uniform ambient (the CLI uses [`AMBIENT`]) |
+//!
+//! [`render_preview`] renders a directional light and its ambient as two images and adds them (light
+//! transport is linear in the emitters): in one scene the integrator would pick one of the two lights per
+//! sample, and the dim ambient would cost half the samples of the bright light — binary noise on the lit side.
 //!
 //! ## Geometry
 //! World +y is up, +x to the right of the image, +z towards the camera (the camera sits at (0, 0, 5) and
-//! looks at the origin; the sphere of radius 1 fills the central ~90 % of the frame). In an environment map
+//! looks at the origin; the sphere of radius 1 fills the central ~90 % of the frame). The sphere is turned
+//! so that its poles (Mitsuba's sphere has them on its local z axis) point up and down: textures wrap it
+//! like a globe's map and an anisotropic model's tangent follows the lines of latitude. In an environment map
 //! +y is up and the image's centre column faces −z (Mitsuba's `envmap` mapping), so the camera sees the
 //! centre of the map behind the sphere and the sphere reflects the map's edges.
 //!
@@ -31,11 +37,13 @@ use crate::geometry::Shape;
 use crate::image::{read_image, Image};
 use crate::light::{ConstantLight, DirectionalLight, EnvMap, Light};
 use crate::math::Transform;
+use crate::render::render;
 use crate::scene::{IntegratorKind, Material, SamplerSpec, Scene};
 use crate::spectrum::Rgb;
 use glam::Vec3;
 use std::f32::consts::PI;
 use std::path::PathBuf;
+use std::sync::atomic::AtomicBool;
 
 /// Radiance of the uniform ambient that accompanies a directional light (the unlit side is not pure black).
 pub const AMBIENT: f32 = 0.04;
@@ -55,8 +63,9 @@ pub enum Lighting {
     GradientSky,
     /// Uniform radiance from every direction.
     Constant(Rgb),
-    /// A directional light shining from `towards_light` (world space, need not be unit), plus [`AMBIENT`].
-    Directional { towards_light: Vec3 },
+    /// A directional light shining from `towards_light` (world space, need not be unit), plus a uniform
+    /// `ambient` radiance (0 for none).
+    Directional { towards_light: Vec3, ambient: f32 },
 }
 
 /// The sun of the built-in sky: its direction (towards it), angular radius and radiance.
@@ -119,17 +128,23 @@ pub fn preview_scene(material: Material, lighting: &Lighting, size: u32) -> Resu
             lights.push(Light::EnvMap(EnvMap::new(&gradient_sky(512, 256), 1.0, Transform::IDENTITY, "the built-in sky")?));
         }
         Lighting::Constant(radiance) => lights.push(Light::Constant(ConstantLight { radiance: *radiance })),
-        Lighting::Directional { towards_light } => {
+        Lighting::Directional { towards_light, ambient } => {
             let direction = towards_light
                 .try_normalize()
                 .filter(|d| d.is_finite())
                 .ok_or_else(|| Error::spec("preview", format!("the light direction must be a non-zero vector, got {towards_light}")))?;
+            if !(ambient.is_finite() && *ambient >= 0.0) {
+                return Err(Error::spec("preview", format!("the ambient radiance must be finite and ≥ 0, got {ambient}")));
+            }
             lights.push(Light::Directional(DirectionalLight { direction: -direction, irradiance: Rgb::splat(PI) }));
-            lights.push(Light::Constant(ConstantLight { radiance: Rgb::splat(AMBIENT) }));
+            if *ambient > 0.0 {
+                lights.push(Light::Constant(ConstantLight { radiance: Rgb::splat(*ambient) }));
+            }
         }
     }
-    let sphere =
-        Sphere::new(Vec3::ZERO, 1.0, Transform::IDENTITY, false).ok_or_else(|| Error::spec("preview", "cannot build the sphere"))?;
+    // The sphere's poles (its local ±z, where uv textures converge) point up and down, like a globe's.
+    let globe = Transform::rotate(Vec3::X, -90.0).ok_or_else(|| Error::spec("preview", "cannot turn the sphere"))?;
+    let sphere = Sphere::new(Vec3::ZERO, 1.0, globe, false).ok_or_else(|| Error::spec("preview", "cannot build the sphere"))?;
     let to_world = Transform::look_at(Vec3::new(0.0, 0.0, CAMERA_DISTANCE), Vec3::ZERO, Vec3::Y)
         .ok_or_else(|| Error::spec("preview", "cannot place the camera"))?;
     // The sphere subtends a half-angle asin(1/d); widen the view so that it fills FILL of the frame.
@@ -146,6 +161,53 @@ pub fn preview_scene(material: Material, lighting: &Lighting, size: u32) -> Resu
         IntegratorKind::Path { max_depth: -1, rr_depth: 5, hide_emitters: false },
         Vec::new(),
     ))
+}
+
+/// A rendered lit sphere.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PreviewImage {
+    pub image: Image,
+    /// Samples that were NaN or infinite, dropped (counted as black).
+    pub nonfinite: u64,
+}
+
+/// Render the lit sphere of [`preview_scene`] with `spp` samples per pixel. `material` builds the material
+/// (called once per rendered part: a directional light and its ambient are rendered apart and added, see
+/// the module docs). `cancel` stops the render between tiles.
+///
+/// # Errors
+/// Those of `material` and [`preview_scene`].
+pub fn render_preview(
+    material: &dyn Fn() -> Result<Material>,
+    lighting: &Lighting,
+    size: u32,
+    spp: u32,
+    seed: u64,
+    cancel: &AtomicBool,
+) -> Result<PreviewImage> {
+    let parts = match lighting {
+        Lighting::Directional { towards_light, ambient } if *ambient > 0.0 => {
+            vec![Lighting::Directional { towards_light: *towards_light, ambient: 0.0 }, Lighting::Constant(Rgb::splat(*ambient))]
+        }
+        other => vec![other.clone()],
+    };
+    let mut sum: Option<Image> = None;
+    let mut nonfinite = 0;
+    for part in &parts {
+        let scene = preview_scene(material()?, part, size)?;
+        let out = render(&scene, spp, seed, cancel, &|_| {});
+        nonfinite += out.nonfinite;
+        let image = Image { width: out.width as usize, height: out.height as usize, data: out.data };
+        sum = Some(match sum {
+            None => image,
+            Some(mut acc) => {
+                acc.data.iter_mut().zip(&image.data).for_each(|(a, b)| *a += b);
+                acc
+            }
+        });
+    }
+    let image = sum.ok_or_else(|| Error::spec("preview", "nothing to render"))?;
+    Ok(PreviewImage { image, nonfinite })
 }
 
 /// Tiles laid out in a grid of `columns` (row-major; all tiles the same size), separated by `gap` pixels of
@@ -181,8 +243,6 @@ pub fn tile(tiles: &[Image], columns: usize, gap: usize, gap_colour: Rgb) -> Res
 mod tests {
     use super::*;
     use crate::bsdf::Bsdf;
-    use crate::render::render;
-    use std::sync::atomic::AtomicBool;
 
     fn render_mean_of_centre(bsdf: &str, lighting: &Lighting, size: u32, spp: u32) -> (Image, Rgb) {
         let material = Material::Fixed(Bsdf::from_json(bsdf).unwrap());
@@ -215,11 +275,9 @@ mod tests {
 
     #[test]
     fn directional_light_lights_the_side_facing_it() {
-        let lighting = Lighting::Directional { towards_light: Vec3::new(1.0, 0.0, 0.0) };
-        let material = Material::Fixed(Bsdf::from_json(r#"{"type": "diffuse", "reflectance": 0.8}"#).unwrap());
-        let scene = preview_scene(material, &lighting, 32).unwrap();
-        let out = render(&scene, 4, 1, &AtomicBool::new(false), &|_| {});
-        let image = Image { width: 32, height: 32, data: out.data };
+        let lighting = Lighting::Directional { towards_light: Vec3::new(1.0, 0.0, 0.0), ambient: AMBIENT };
+        let material = || Ok(Material::Fixed(Bsdf::from_json(r#"{"type": "diffuse", "reflectance": 0.8}"#)?));
+        let image = render_preview(&material, &lighting, 32, 4, 1, &AtomicBool::new(false)).unwrap().image;
         // +x is the image's right: the right edge of the sphere faces the light (radiance ≈ ρ · cos θ + ambient),
         // the left edge sees only the ambient (ρ · AMBIENT = 0.032 in expectation; one pixel at 4 spp is noisy).
         let (left, right) = (image.get(5, 16), image.get(26, 16));
@@ -242,7 +300,8 @@ mod tests {
     #[test]
     fn bad_lighting_and_size_are_errors() {
         let m = || Material::Fixed(Bsdf::from_json(r#"{"type": "diffuse"}"#).unwrap());
-        assert!(preview_scene(m(), &Lighting::Directional { towards_light: Vec3::ZERO }, 8).is_err());
+        assert!(preview_scene(m(), &Lighting::Directional { towards_light: Vec3::ZERO, ambient: 0.0 }, 8).is_err());
+        assert!(preview_scene(m(), &Lighting::Directional { towards_light: Vec3::Y, ambient: f32::NAN }, 8).is_err());
         assert!(preview_scene(m(), &Lighting::Constant(Rgb::ONE), 0).is_err());
         let e = preview_scene(m(), &Lighting::Environment("/no/such/sky.hdr".into()), 8).unwrap_err();
         assert!(e.to_string().contains("/no/such/sky.hdr"), "{e}");

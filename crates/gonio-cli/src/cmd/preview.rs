@@ -7,10 +7,9 @@
 
 use crate::spec::{in_json_file, load_props};
 use glam::Vec3;
-use gonio::image::{write_image, Image};
-use gonio::preview::{preview_scene, tile, Lighting};
-use gonio::props::Value;
-use gonio::render::render;
+use gonio::image::write_image;
+use gonio::preview::{render_preview, tile, Lighting, AMBIENT};
+use gonio::props::{Props, Value};
 use gonio::scene::Material;
 use gonio::{Error, Rgb};
 use std::path::{Path, PathBuf};
@@ -107,7 +106,7 @@ fn parse_direction(arg: &str) -> Result<Vec3, Error> {
 
 fn lighting(args: &Args) -> Result<Lighting, Error> {
     if let Some(l) = &args.light {
-        return Ok(Lighting::Directional { towards_light: parse_direction(l)? });
+        return Ok(Lighting::Directional { towards_light: parse_direction(l)?, ambient: AMBIENT });
     }
     Ok(match args.env.as_deref() {
         Some("gradient") => Lighting::GradientSky,
@@ -127,21 +126,27 @@ fn lighting(args: &Args) -> Result<Lighting, Error> {
     })
 }
 
-/// The materials to render, row by row: each BSDF argument, once per grid value.
-fn materials(args: &Args) -> Result<(Vec<Material>, usize), Error> {
+/// The materials to render, row by row: each BSDF argument (its argument and description), once per grid
+/// value. Each is built once here, so that every error shows before the first render.
+fn materials(args: &Args) -> Result<(Vec<(&str, Props)>, usize), Error> {
     let grid = args.grid.as_deref().map(parse_grid).transpose()?;
     let mut out = Vec::new();
     for arg in &args.bsdfs {
         let props = load_props(arg)?;
-        match &grid {
-            None => out.push(Material::from_props(&props).map_err(|e| in_json_file(arg, e))?),
-            Some((name, values)) => {
-                for v in values {
+        let variants = match &grid {
+            None => vec![props],
+            Some((name, values)) => values
+                .iter()
+                .map(|v| {
                     let mut p = props.clone();
                     p.set(name, grid_value(v), &format!("--grid {name}={v}"));
-                    out.push(Material::from_props(&p).map_err(|e| in_json_file(arg, e))?);
-                }
-            }
+                    p
+                })
+                .collect(),
+        };
+        for p in variants {
+            Material::from_props(&p).map_err(|e| in_json_file(arg, e))?;
+            out.push((arg.as_str(), p));
         }
     }
     let columns = grid.as_ref().map_or(args.bsdfs.len(), |(_, values)| values.len());
@@ -164,23 +169,22 @@ pub fn run(args: Args) -> Result<ExitCode, Error> {
     }
     let lighting = lighting(&args)?;
     let (materials, columns) = materials(&args)?;
-    let mut pool = rayon::ThreadPoolBuilder::new();
     if let Some(n) = args.threads {
-        pool = pool.num_threads(n);
+        // The global pool: a material description is not `Sync`, so the render cannot be moved into a pool.
+        rayon::ThreadPoolBuilder::new().num_threads(n).build_global().map_err(|e| arg_error(format!("--threads: {e}")))?;
     }
-    let pool = pool.build().map_err(|e| arg_error(format!("--threads: {e}")))?;
 
     let start = std::time::Instant::now();
     let cancel = AtomicBool::new(false);
     let scale = args.exposure.exp2();
     let mut tiles = Vec::with_capacity(materials.len());
     let mut nonfinite = 0;
-    for material in materials {
-        let scene = preview_scene(material, &lighting, args.size)?;
-        let out = pool.install(|| render(&scene, args.spp, args.seed, &cancel, &|_| {}));
+    for (arg, props) in &materials {
+        let material = || Material::from_props(props).map_err(|e| in_json_file(arg, e));
+        let mut out = render_preview(&material, &lighting, args.size, args.spp, args.seed, &cancel)?;
         nonfinite += out.nonfinite;
-        let data = out.data.into_iter().map(|v| v * scale).collect();
-        tiles.push(Image { width: out.width as usize, height: out.height as usize, data });
+        out.image.data.iter_mut().for_each(|v| *v *= scale);
+        tiles.push(out.image);
     }
     let count = tiles.len();
     let image = tile(&tiles, columns, (args.size as usize / 64).max(1), Rgb::splat(0.02))?;
@@ -193,7 +197,7 @@ pub fn run(args: Args) -> Result<ExitCode, Error> {
             Lighting::Environment(p) => format!("environment {}", p.display()),
             Lighting::GradientSky => "the built-in sky".into(),
             Lighting::Constant(_) => "a uniform white environment".into(),
-            Lighting::Directional { towards_light } => format!("a directional light from {towards_light}"),
+            Lighting::Directional { towards_light, .. } => format!("a directional light from {towards_light}"),
         };
         eprintln!(
             "gonio: {count} sphere(s), {0}×{0} px, {1} spp, lit by {light}, in {2:.2} s → {3}",
