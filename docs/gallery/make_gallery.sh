@@ -117,7 +117,7 @@ pic 04_fresnel.png "Left: \`fresnel = false\` (reflection fixed at F(0) = 4 %, t
 md "## 5. Torrance–Sparrow beside Blinn–Phong" ""
 TS='{"type": "torrance_sparrow", "distribution": "blinn", "shadowing": "vcavity", "exponent": 60}'
 BP='{"type": "blinn_phong", "diffuse_reflectance": 0, "specular_reflectance": 1, "exponent": 60}'
-pic 05_ts_vs_blinn_phong.png "Torrance–Sparrow (Blinn D, V-cavity G, F = 1; left) and normalised Blinn–Phong (right), both with exponent 60, under a light from the upper right: qualitatively similar highlights; they part at grazing angles, where G and the 1/(4 cos θo cos θi) factor act." \
+pic 05_ts_vs_blinn_phong.png "Torrance–Sparrow (Blinn D, V-cavity G, F = 1; left) and normalised Blinn–Phong (right), both with exponent 60, under a light from the upper right: qualitatively similar highlights; they part at grazing angles, where G and the 1/(4 cos θo cos θi) factor act. Under the dim ambient the Torrance–Sparrow body (F = 1) reflects almost everything and merges with the background; normalised Blinn–Phong's albedo falls towards the rim, so its body shows dark." \
     "$GONIO" preview "$TS" "$BP" --light 1,1,1 --spp 32 --size 192 -o $OUT/05_ts_vs_blinn_phong.png
 pic 05_ts_vs_blinn_phong_grazing.png "The same pair lit from behind the sphere's rim (grazing light): Torrance–Sparrow's highlight brightens towards the rim." \
     "$GONIO" preview "$TS" "$BP" --light 1,0.3,-1 --spp 32 --size 192 -o $OUT/05_ts_vs_blinn_phong_grazing.png
