@@ -6,7 +6,8 @@
 # at the end. `gonio plot` lines are skipped loudly (exit 0) when this build has no `plot` command yet.
 #
 # Environment: GONIO (default ./target/release/gonio), REFIT=1 to re-run `gonio fit` for figure 11 even when
-# docs/gallery/fits/*.xml exist. Budget: under 10 minutes on 2 cores.
+# docs/gallery/fits/*.xml exist, ONLY=PREFIX to re-render only the pictures whose file name starts with PREFIX
+# (e.g. ONLY=08) and keep the existing others. Budget: under 10 minutes on 2 cores.
 set -u -o pipefail
 
 cd "$(dirname "$0")/../.."
@@ -55,6 +56,11 @@ pic() {
         echo "make_gallery: !!! SKIPPED $file: this gonio has no \`plot\` command yet (the plot branch is not merged): $line" >&2
         SKIPPED+=("$file")
         md "**$file: not generated** — this build has no \`gonio plot\` yet. ${caption}" "" '```sh' "$line" '```' ""
+        return
+    fi
+    if [ -n "${ONLY:-}" ] && [[ "$file" != $ONLY* ]] && [ -f "$OUT/$file" ]; then
+        # ONLY=prefix re-renders matching pictures and keeps the others (their commands are unchanged).
+        md "![$caption]($file)" "" "$caption" "" '```sh' "$line" '```' ""
         return
     fi
     t0=$(date +%s%N)
@@ -153,11 +159,11 @@ pic 07_albedo.png "Directional albedo against θo for the same four models: abov
 
 # 8 ------------------------------------------------------------------------------------------------------------
 md "## 8. Layered materials: diffuse base, glossy coat" ""
-pic 08_layered.png "The diffuse base alone (ρ = 0.5, red); Ashikhmin–Shirley (energy-coupled diffuse + anisotropic Phong-like gloss, n_u = 20, n_v = 400); \`plastic\` (a smooth coat over the base); \`layered\` (a rough GGX coat, α = 0.1, over the same base, by random walk)." \
+pic 08_layered.png "The diffuse base alone (ρ = 0.6, red); Ashikhmin–Shirley (energy-coupled diffuse + anisotropic Phong-like gloss, n_u = 20, n_v = 400); \`plastic\` (a smooth coat, n = 1.49, over the same base; \`nonlinear = true\` so that ρ is the base's albedo — Mitsuba's default linear mode treats ρ as roughly the coated surface's albedo, 0.62 instead of 0.41 here); \`layered\` (a rough GGX coat, α = 0.1, over the same base with no medium, by random walk: noisier, as its f is itself a Monte Carlo estimate). The coat darkens and saturates the base (light bounces inside it) and adds a highlight." \
     "$GONIO" preview '{"type": "diffuse", "reflectance": [0.6, 0.08, 0.05]}' \
     '{"type": "ashikhmin_shirley", "rd": [0.6, 0.08, 0.05], "rs": 0.05, "nu": 20, "nv": 400}' \
-    '{"type": "plastic", "diffuse_reflectance": [0.6, 0.08, 0.05]}' \
-    '{"type": "layered", "coating": {"type": "roughdielectric", "distribution": "ggx", "alpha": 0.1, "int_ior": 1.5}, "base": {"type": "diffuse", "reflectance": [0.6, 0.08, 0.05]}}' \
+    '{"type": "plastic", "diffuse_reflectance": [0.6, 0.08, 0.05], "nonlinear": true}' \
+    '{"type": "layered", "thickness": 0, "coating": {"type": "roughdielectric", "distribution": "ggx", "alpha": 0.1, "int_ior": 1.49}, "base": {"type": "diffuse", "reflectance": [0.6, 0.08, 0.05]}}' \
     "${ENV[@]}" --spp 48 --size 192 -o $OUT/08_layered.png
 
 # 9 ------------------------------------------------------------------------------------------------------------
