@@ -168,7 +168,7 @@ pic 08_layered.png "The diffuse base alone (ρ = 0.6, red); Ashikhmin–Shirley 
 
 # 9 ------------------------------------------------------------------------------------------------------------
 md "## 9. Retro-reflection: the full moon" ""
-pic 09_moon.png "Lit from the viewer's direction: the Lambertian sphere (σ = 0, left) darkens towards its rim; Oren–Nayar (full model) with σ = 15°, 30°, 45° grows flatter — the full moon looks like a flat disk." \
+pic 09_moon.png "Lit from the viewer's direction: the Lambertian sphere (σ = 0, left) darkens towards its rim; Oren–Nayar (full model) with σ = 15°, 30°, 45° grows flatter — the full moon looks like a flat disk. (The Lambertian rim is not black: from the camera's distance of 5 radii the silhouette's normals make cos θ = 0.2 with the light, and sRGB lifts dark tones; the rendered radiance matches 0.8 cos θ + ambient to 0.5 %.)" \
     "$GONIO" preview '{"type": "oren_nayar", "reflectance": 0.8, "full": true}' --grid sigma=0,15,30,45 \
     --light 0,0,1 --spp 16 --size 192 -o $OUT/09_moon.png
 
