@@ -126,9 +126,15 @@ fn lighting(args: &Args) -> Result<Lighting, Error> {
     })
 }
 
-/// The materials to render, row by row: each BSDF argument (its argument and description), once per grid
-/// value. Each is built once here, so that every error shows before the first render.
-fn materials(args: &Args) -> Result<(Vec<(&str, Props)>, usize), Error> {
+/// One sphere to render: the BSDF argument it came from (for messages) and its description.
+struct Sphere<'a> {
+    arg: &'a str,
+    props: Props,
+}
+
+/// The materials to render, row by row: each BSDF argument, once per grid value, and the number of columns.
+/// Each is built once here, so that every error shows before the first render.
+fn materials(args: &Args) -> Result<(Vec<Sphere<'_>>, usize), Error> {
     let grid = args.grid.as_deref().map(parse_grid).transpose()?;
     let mut out = Vec::new();
     for arg in &args.bsdfs {
@@ -146,7 +152,7 @@ fn materials(args: &Args) -> Result<(Vec<(&str, Props)>, usize), Error> {
         };
         for p in variants {
             Material::from_props(&p).map_err(|e| in_json_file(arg, e))?;
-            out.push((arg.as_str(), p));
+            out.push(Sphere { arg: arg.as_str(), props: p });
         }
     }
     let columns = grid.as_ref().map_or(args.bsdfs.len(), |(_, values)| values.len());
@@ -179,7 +185,7 @@ pub fn run(args: Args) -> Result<ExitCode, Error> {
     let scale = args.exposure.exp2();
     let mut tiles = Vec::with_capacity(materials.len());
     let mut nonfinite = 0;
-    for (arg, props) in &materials {
+    for Sphere { arg, props } in &materials {
         let material = || Material::from_props(props).map_err(|e| in_json_file(arg, e));
         let mut out = render_preview(&material, &lighting, args.size, args.spp, args.seed, &cancel)?;
         nonfinite += out.nonfinite;
