@@ -2,13 +2,14 @@
 #   make demo   build, render scenes/demo.xml to out/demo.png, then prove every model's physics with `gonio check --all`
 #   make test   build, then run the Rust tests and the Python tests (incl. the Mitsuba 3 cross-checks)
 #   make bench  criterion benchmarks, and gonio vs Mitsuba 3 timings, errors and scaling tables
+#   make gallery  regenerate docs/gallery/*.png and docs/gallery/README.md (the lecture's figures, < 10 min on 2 cores)
 
 PYTHON ?= python3
 VENV   := .venv
 VPY    := $(VENV)/bin/python
 CARGO  ?= cargo
 
-.PHONY: all build cli venv python demo test test-rust test-python bench fmt lint clean
+.PHONY: all build cli venv python demo test test-rust test-python bench gallery fmt lint clean
 
 all: build
 
@@ -58,6 +59,11 @@ bench: cli python
 	$(CARGO) build --profile dist -p gonio-cli
 	GONIO_BIN=target/dist/gonio $(VPY) bench/render_vs_mitsuba.py
 	$(VPY) bench/python_bsdf_vs_mitsuba.py
+
+# The gallery: every picture with the command that made it (docs/gallery/make_gallery.sh; REFIT=1 re-runs
+# `gonio fit` for the measured materials instead of using docs/gallery/fits/*.xml).
+gallery: cli
+	docs/gallery/make_gallery.sh
 
 fmt:
 	$(CARGO) fmt --all

@@ -30,6 +30,8 @@ enum Command {
     Fit(cmd::fit::Args),
     /// Plot BSDFs: polar lobes, 3-D lobes, θh × θd slices or albedo curves, overlaid, to PNG, SVG or CSV.
     Plot(cmd::plot::Args),
+    /// Render lit spheres of BSDFs with the path tracer (side by side, or a sweep of one parameter).
+    Preview(cmd::preview::Args),
 }
 
 fn main() -> ExitCode {
@@ -41,6 +43,7 @@ fn main() -> ExitCode {
         Command::Measure(args) => cmd::measure::run(args),
         Command::Fit(args) => cmd::fit::run(args),
         Command::Plot(args) => cmd::plot::run(args),
+        Command::Preview(args) => cmd::preview::run(args),
     };
     match result {
         Ok(code) => code,

@@ -32,6 +32,7 @@ pub mod math;
 pub mod measured;
 pub mod microfacet;
 pub mod plot;
+pub mod preview;
 pub mod props;
 pub mod render;
 pub mod sampling;

@@ -3,4 +3,5 @@ pub mod check;
 pub mod fit;
 pub mod measure;
 pub mod plot;
+pub mod preview;
 pub mod render;
