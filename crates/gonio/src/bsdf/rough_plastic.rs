@@ -48,7 +48,7 @@
 
 use super::plastic::{coated_diffuse, specular_probability, specular_sampling_weight, CoatingParams};
 use super::rough_conductor::{read_distribution, MicrofacetParams};
-use super::{BsdfFlags, BsdfModel, BsdfSample, RoughDielectric};
+use super::{f_each, pdf_each, sample_each, BsdfFlags, BsdfModel, BsdfSample, RoughDielectric, SampleColumns};
 use crate::error::{Error, Result};
 use crate::math::{Vec2, Vec3};
 use crate::microfacet::{MicrofacetDistribution, MicrofacetKind};
@@ -65,8 +65,8 @@ const TABLE_SIZE: usize = 64;
 /// The rough interface's transmittance T(μ) and internal hemispherical reflectance R̄ᵢ.
 #[derive(Debug, PartialEq)]
 pub struct CoatingTables {
-    /// T(k/63), k = 0..64.
-    pub transmittance: Vec<f32>,
+    /// T(k/63), k = 0..64 (an array: its fixed length lets lookups go without bounds checks).
+    pub transmittance: [f32; TABLE_SIZE],
     /// R̄ᵢ.
     pub internal_reflectance: f32,
 }
@@ -76,14 +76,12 @@ impl CoatingTables {
     #[must_use]
     pub fn compute(distribution: MicrofacetDistribution, eta: f32) -> Self {
         let interface = RoughDielectric::new(distribution, eta);
-        let transmittance = (0..TABLE_SIZE)
-            .map(|k| {
-                // T(0) is the limit μ → 0, which is not 0: tilted microfacets still let light in. The horizon
-                // itself is degenerate; μ = 1e-6 stands for it (2026-11: as Mitsuba does).
-                let mu = (k as f32 / (TABLE_SIZE - 1) as f32).max(1e-6);
-                interface.energy_split(direction(mu, 0.0), 128).transmitted as f32
-            })
-            .collect();
+        let transmittance = std::array::from_fn(|k| {
+            // T(0) is the limit μ → 0, which is not 0: tilted microfacets still let light in. The horizon
+            // itself is degenerate; μ = 1e-6 stands for it (2026-11: as Mitsuba does).
+            let mu = (k as f32 / (TABLE_SIZE - 1) as f32).max(1e-6);
+            interface.energy_split(direction(mu, 0.0), 128).transmitted as f32
+        });
         // R̄ᵢ = 2 ∫ Rᵢ(μ) μ dμ, light arriving from inside (wo below the surface). Rᵢ turns steeply at the
         // smooth interface's critical angle μc = √(1 − 1/η²) (η > 1): integrate either side of it.
         let (nodes, weights) = crate::verify::chi2::gauss_legendre(48);
@@ -105,6 +103,7 @@ impl CoatingTables {
 
     /// T(μ) by linear interpolation in the table.
     #[must_use]
+    #[inline(always)]
     pub fn transmittance(&self, mu: f32) -> f32 {
         let x = mu.clamp(0.0, 1.0) * (TABLE_SIZE - 1) as f32;
         let k = (x as usize).min(TABLE_SIZE - 2);
@@ -168,6 +167,7 @@ impl RoughPlastic {
         Ok(b)
     }
 
+    #[inline(always)]
     fn specular_probability(&self, cos_theta_o: f32) -> f32 {
         let w = specular_sampling_weight(self.diffuse_reflectance, self.coating.specular_reflectance);
         specular_probability(1.0 - self.tables.transmittance(cos_theta_o), w)
@@ -179,6 +179,7 @@ impl BsdfModel for RoughPlastic {
         BsdfFlags::GLOSSY_REFLECTION | BsdfFlags::DIFFUSE_REFLECTION
     }
 
+    #[inline(always)]
     fn f(&self, wo: Vec3, wi: Vec3) -> Rgb {
         if !(wo.z > 0.0 && wi.z > 0.0) {
             return Rgb::ZERO;
@@ -192,9 +193,10 @@ impl BsdfModel for RoughPlastic {
             t.internal_reflectance,
             self.nonlinear,
         );
-        self.coating.f(wo, wi) + diffuse
+        self.coating.reflection(wo, wi) + diffuse
     }
 
+    #[inline(always)]
     fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
         if !(wo.z > 0.0) {
             return None;
@@ -212,12 +214,63 @@ impl BsdfModel for RoughPlastic {
         s.weight.is_finite().then_some(s)
     }
 
+    #[inline(always)]
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         if !(wo.z > 0.0 && wi.z > 0.0) {
             return 0.0;
         }
         let p = self.specular_probability(wo.z);
         p * self.coating.reflection_pdf(wo, wi) + (1.0 - p) * cosine_hemisphere_pdf(wi)
+    }
+
+    #[inline(always)]
+    fn f_batch(&self, wo: &[Vec3], wi: &[Vec3], out: &mut [Rgb]) {
+        // Two calls rather than a closure: each loop is inlined with its own constants.
+        match self.constant_choices() {
+            Some(m) => f_each(&m, wo, wi, out),
+            None => f_each(self, wo, wi, out),
+        }
+    }
+
+    #[inline(always)]
+    fn pdf_batch(&self, wo: &[Vec3], wi: &[Vec3], out: &mut [f32]) {
+        // Two calls rather than a closure: each loop is inlined with its own constants.
+        match self.constant_choices() {
+            Some(m) => pdf_each(&m, wo, wi, out),
+            None => pdf_each(self, wo, wi, out),
+        }
+    }
+
+    #[inline(always)]
+    fn sample_batch(&self, wo: &[Vec3], uc: &[f32], u: &[Vec2], out: &mut SampleColumns<'_>) {
+        // Two calls rather than a closure: each loop is inlined with its own constants.
+        match self.constant_choices() {
+            Some(m) => sample_each(&m, wo, uc, u, out),
+            None => sample_each(self, wo, uc, u, out),
+        }
+    }
+}
+
+impl RoughPlastic {
+    /// For GGX with visible-normal sampling, a copy whose distribution and sampling choice are constants (see
+    /// `MicrofacetConductor::constant_choices`); `None` otherwise.
+    #[inline(always)]
+    fn constant_choices(&self) -> Option<RoughPlastic> {
+        let c = &self.coating;
+        if !(c.distribution.kind == MicrofacetKind::Ggx && c.sample_visible) {
+            return None;
+        }
+        let coating = RoughDielectric {
+            distribution: MicrofacetDistribution { kind: MicrofacetKind::Ggx, ..c.distribution },
+            sample_visible: true,
+            ..*c
+        };
+        Some(RoughPlastic {
+            coating,
+            diffuse_reflectance: self.diffuse_reflectance,
+            nonlinear: self.nonlinear,
+            tables: self.tables.clone(),
+        })
     }
 }
 
