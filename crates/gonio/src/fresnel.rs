@@ -169,7 +169,10 @@ pub fn fresnel_conductor(cos_theta_i: f32, eta: f32, k: f32) -> f32 {
 #[inline(always)]
 #[must_use]
 pub fn fresnel_conductor_rgb(cos_theta_i: f32, eta: Rgb, k: Rgb) -> Rgb {
-    Rgb(std::array::from_fn(|i| fresnel_conductor(cos_theta_i, eta.0[i], k.0[i])))
+    // Written out, not `array::from_fn`: that one is not always inlined, and a call in a batch loop keeps it
+    // from being vectorised.
+    let channel = |i: usize| fresnel_conductor(cos_theta_i, eta.0[i], k.0[i]);
+    Rgb([channel(0), channel(1), channel(2)])
 }
 
 #[cfg(test)]
