@@ -1,16 +1,20 @@
 //! The batched loops behind `Bsdf.f`, `pdf` and `sample`: arguments are read in place from numpy
-//! (contiguous float32 or float64 arrays are not copied), rows are checked and evaluated in one pass,
-//! in parallel over chunks of rows on rayon's threads, and results are written straight into freshly
-//! allocated numpy arrays. Everything in the loop runs without the GIL.
+//! (contiguous float32 rows are used as `Vec3`/`Vec2` slices without a copy; float64 and broadcast rows
+//! are converted per chunk), checked in one tight pass, and handed a chunk at a time to the model's batch
+//! methods ([`gonio::bsdf::BsdfModel::f_batch`] and friends: one `match` on the model per chunk, loops
+//! compiled for AVX2 + FMA where the CPU has them), which write straight into freshly allocated numpy
+//! arrays. Chunks run in parallel on rayon's threads, without the GIL.
 
-use gonio::math::Vec3;
+use gonio::math::{Vec2, Vec3};
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use rayon::prelude::*;
+use std::ops::Range;
 
-/// Rows per parallel task: large enough to amortise scheduling, small enough to balance 2–64 cores.
-const CHUNK: usize = 8192;
+/// Rows per parallel task: large enough to amortise scheduling, small enough to balance 2–64 cores and
+/// for a task's inputs, outputs and `sample`'s buffer of results (about 60 bytes a row) to stay in cache.
+const CHUNK: usize = 4096;
 
 /// An array argument's numbers: borrowed from numpy when possible, else converted.
 enum Numbers<'py> {
@@ -106,38 +110,81 @@ impl Column<'_> {
         [self.get(i, 0), self.get(i, 1), self.get(i, 2)]
     }
 
-    /// Rows `rows` as directions (see [`crate::to_direction`]) into `out` (cleared first); false when
-    /// any is not acceptable. One tight loop per storage type, without per-row dispatch, so that the
-    /// check of a million rows costs about what reading them does.
-    pub(crate) fn directions(&self, rows: std::ops::Range<usize>, normalize: bool, out: &mut Vec<Vec3>) -> bool {
-        out.clear();
+    /// Rows `rows` as directions (see [`crate::to_direction`]), or `None` when any is not acceptable.
+    /// Unit float32 rows are read in place (a numpy row of three float32 is laid out as a `Vec3`); other
+    /// storage is converted into `buf`. One tight loop per storage type, without per-row dispatch, so that
+    /// the check of a million rows costs about what reading them does.
+    pub(crate) fn directions<'b>(&'b self, rows: Range<usize>, normalize: bool, buf: &'b mut Vec<Vec3>) -> Option<&'b [Vec3]> {
+        buf.clear();
         if normalize || self.single {
             // Rare or cheap: the general path.
             for i in rows {
-                match crate::to_direction(self.row3(i), normalize) {
-                    Some(w) => out.push(w),
-                    None => return false,
-                }
+                buf.push(crate::to_direction(self.row3(i), normalize)?);
             }
-            return true;
+            return Some(buf);
         }
-        let mut ok = true;
         match self.data {
             Slice::F32(s) => {
-                for w in s[3 * rows.start..3 * rows.end].chunks_exact(3) {
-                    let (x, y, z) = (f64::from(w[0]), f64::from(w[1]), f64::from(w[2]));
-                    ok &= crate::is_unit(x, y, z);
-                    out.push(Vec3::new(w[0], w[1], w[2]));
-                }
+                let s = &s[3 * rows.start..3 * rows.end];
+                let ok = s.chunks_exact(3).fold(true, |ok, w| ok & crate::is_unit(f64::from(w[0]), f64::from(w[1]), f64::from(w[2])));
+                // SAFETY: `Vec3` is `#[repr(C)]` of three `f32` (size 12, alignment 4), and `s` holds
+                // exactly 3·len floats, so it is `len` `Vec3`s; the borrow keeps the array alive and unchanged.
+                ok.then(|| unsafe { std::slice::from_raw_parts(s.as_ptr().cast::<Vec3>(), rows.len()) })
             }
             Slice::F64(s) => {
+                let mut ok = true;
                 for w in s[3 * rows.start..3 * rows.end].chunks_exact(3) {
                     ok &= crate::is_unit(w[0], w[1], w[2]);
-                    out.push(Vec3::new(w[0] as f32, w[1] as f32, w[2] as f32));
+                    buf.push(Vec3::new(w[0] as f32, w[1] as f32, w[2] as f32));
                 }
+                ok.then_some(&buf[..])
             }
         }
-        ok
+    }
+
+    /// Rows `rows` of a width-1 argument as `f32`, or `None` when any is outside [0, 1] (checked before
+    /// rounding to `f32`). Float32 arrays are read in place.
+    pub(crate) fn unit_numbers<'b>(&'b self, rows: Range<usize>, buf: &'b mut Vec<f32>) -> Option<&'b [f32]> {
+        match self.data {
+            Slice::F32(s) if !self.single => {
+                let s = &s[rows];
+                s.iter().fold(true, |ok, v| ok & (0.0..=1.0).contains(v)).then_some(s)
+            }
+            _ => {
+                buf.clear();
+                for i in rows {
+                    let v = self.get(i, 0);
+                    if !(0.0..=1.0).contains(&v) {
+                        return None;
+                    }
+                    buf.push(v as f32);
+                }
+                Some(buf)
+            }
+        }
+    }
+
+    /// Rows `rows` of a width-2 argument as `Vec2`s, each number in [0, 1] (see [`Self::unit_numbers`]).
+    pub(crate) fn unit_pairs<'b>(&'b self, rows: Range<usize>, buf: &'b mut Vec<Vec2>) -> Option<&'b [Vec2]> {
+        match self.data {
+            Slice::F32(s) if !self.single => {
+                let s = &s[2 * rows.start..2 * rows.end];
+                let ok = s.iter().fold(true, |ok, v| ok & (0.0..=1.0).contains(v));
+                // SAFETY: `Vec2` is `#[repr(C)]` of two `f32`; `s` holds 2·len floats (see `directions`).
+                ok.then(|| unsafe { std::slice::from_raw_parts(s.as_ptr().cast::<Vec2>(), rows.len()) })
+            }
+            _ => {
+                buf.clear();
+                for i in rows {
+                    let (a, b) = (self.get(i, 0), self.get(i, 1));
+                    if !((0.0..=1.0).contains(&a) && (0.0..=1.0).contains(&b)) {
+                        return None;
+                    }
+                    buf.push(Vec2::new(a as f32, b as f32));
+                }
+                Some(buf)
+            }
+        }
     }
 }
 
@@ -163,7 +210,7 @@ pub(crate) fn broadcast(args: &[&Arg<'_>]) -> PyResult<(usize, bool)> {
 
 /// Run `chunk(rows)` over consecutive ranges of rows covering `0..n`, in parallel when there are many;
 /// true when every chunk succeeded (the caller then finds and reports the first failing row).
-pub(crate) fn for_chunks(n: usize, chunk: impl Fn(std::ops::Range<usize>) -> bool + Sync) -> bool {
+pub(crate) fn for_chunks(n: usize, chunk: impl Fn(Range<usize>) -> bool + Sync) -> bool {
     let range = |c: usize| c * CHUNK..n.min((c + 1) * CHUNK);
     if n <= CHUNK {
         chunk(0..n)
@@ -181,13 +228,13 @@ unsafe impl<T: Send> Send for Out<T> {}
 unsafe impl<T: Send> Sync for Out<T> {}
 
 impl<T> Out<T> {
-    /// Write `v` at index `i`.
+    /// Elements `start..start + len`, to be overwritten (they may be uninitialised: never read them first).
     ///
     /// # Safety
-    /// `i` is within the array and no other task writes index `i`.
+    /// The range is within the array and no other task touches it while the slice lives.
     #[inline]
-    pub(crate) unsafe fn write(self, i: usize, v: T) {
-        self.0.add(i).write(v);
+    pub(crate) unsafe fn slice<'a>(self, start: usize, len: usize) -> &'a mut [T] {
+        std::slice::from_raw_parts_mut(self.0.add(start), len)
     }
 }
 

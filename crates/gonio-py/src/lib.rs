@@ -9,9 +9,9 @@
 //! bad arrays raise `ValueError` naming the offending row. A panic inside gonio (a bug) is caught and
 //! raised as `RuntimeError` rather than unwinding into the interpreter.
 
-use batch::{broadcast, finish, for_chunks, output, Arg};
-use gonio::bsdf::{Bsdf, BsdfFlags, BsdfModel, BsdfSample, PLUGINS};
-use gonio::math::{Vec2, Vec3};
+use batch::{broadcast, finish, for_chunks, output, Arg, Out};
+use gonio::bsdf::{Bsdf, BsdfFlags, BsdfModel, SampleColumns, PLUGINS};
+use gonio::math::Vec3;
 use gonio::Rgb;
 use numpy::{PyArray1, PyArrayDyn, PyUntypedArrayMethods};
 use pyo3::create_exception;
@@ -139,6 +139,51 @@ fn first_bad_row(directions: &[&Arg<'_>], unit_numbers: &[&Arg<'_>], normalize: 
     PyRuntimeError::new_err("internal error in gonio: a row was rejected but every row is valid")
 }
 
+/// The skeleton of every batched method: `chunk(rows)` over consecutive ranges of rows covering `0..n`, in
+/// parallel and without the GIL; a chunk returns false when one of its rows is unacceptable, and the error
+/// then names the first such row of `directions` (unit vectors) or `unit_numbers` (in [0, 1]).
+fn over_rows(
+    py: Python<'_>,
+    n: usize,
+    directions: &[&Arg<'_>],
+    unit_numbers: &[&Arg<'_>],
+    normalize: bool,
+    chunk: impl Fn(std::ops::Range<usize>) -> bool + Sync + Send,
+) -> PyResult<()> {
+    if run_released(py, || for_chunks(n, chunk))? {
+        Ok(())
+    } else {
+        Err(first_bad_row(directions, unit_numbers, normalize))
+    }
+}
+
+/// `f` and `pdf`: `eval(wo, wi, out)` on each chunk of the broadcast pairs, writing `width` numbers per pair
+/// straight into the result array; shaped (N, width), or the single row for unbatched arguments.
+fn over_pairs<'py>(
+    py: Python<'py>,
+    wo: &Bound<'py, PyAny>,
+    wi: &Bound<'py, PyAny>,
+    normalize: bool,
+    width: usize,
+    eval: impl Fn(&[Vec3], &[Vec3], &mut [f32]) + Sync + Send,
+) -> PyResult<Bound<'py, PyAny>> {
+    let (ao, ai) = (Arg::read(wo, "wo", 3)?, Arg::read(wi, "wi", 3)?);
+    let (n, batched) = broadcast(&[&ao, &ai])?;
+    let (out, ptr) = output::<f32>(py, width * n);
+    let (co, ci) = (ao.column(), ai.column());
+    over_rows(py, n, &[&ao, &ai], &[], normalize, |rows| {
+        let (mut bo, mut bi) = (Vec::new(), Vec::new());
+        let (Some(wo), Some(wi)) = (co.directions(rows.clone(), normalize, &mut bo), ci.directions(rows.clone(), normalize, &mut bi))
+        else {
+            return false;
+        };
+        // SAFETY: rows `rows` of the output are this task's own and within the array.
+        eval(wo, wi, unsafe { ptr.slice(width * rows.start, width * rows.len()) });
+        true
+    })?;
+    finish(out, width, batched)
+}
+
 /// A reflection model. Build one with `gonio.load_bsdf`; evaluate it with `f`, `pdf`, `sample`, `albedo`.
 ///
 /// Directions `wo` (towards the viewer) and `wi` (towards the light) point away from the surface and are
@@ -157,55 +202,20 @@ impl PyBsdf {
     /// directions have shape (3,). Zero for delta lobes (see `sample`).
     #[pyo3(signature = (wo, wi, *, normalize = false))]
     fn f<'py>(&self, py: Python<'py>, wo: &Bound<'py, PyAny>, wi: &Bound<'py, PyAny>, normalize: bool) -> PyResult<Bound<'py, PyAny>> {
-        let (ao, ai) = (Arg::read(wo, "wo", 3)?, Arg::read(wi, "wi", 3)?);
-        let (n, batched) = broadcast(&[&ao, &ai])?;
-        let (out, ptr) = output::<f32>(py, 3 * n);
-        let (co, ci, bsdf) = (ao.column(), ai.column(), &self.bsdf);
-        let ok = run_released(py, || {
-            for_chunks(n, |rows| {
-                let (mut wo, mut wi) = (Vec::with_capacity(rows.len()), Vec::with_capacity(rows.len()));
-                if !(co.directions(rows.clone(), normalize, &mut wo) && ci.directions(rows.clone(), normalize, &mut wi)) {
-                    return false;
-                }
-                for (j, i) in rows.enumerate() {
-                    let c = bsdf.f(wo[j], wi[j]);
-                    // SAFETY: row i is written by this task only; 3i + 2 < 3n.
-                    unsafe { (0..3).for_each(|k| ptr.write(3 * i + k, c.0[k])) };
-                }
-                true
-            })
-        })?;
-        if !ok {
-            return Err(first_bad_row(&[&ao, &ai], &[], normalize));
-        }
-        finish(out, 3, batched)
+        let bsdf = &self.bsdf;
+        over_pairs(py, wo, wi, normalize, 3, |wo, wi, out: &mut [f32]| {
+            // SAFETY: `Rgb` is `#[repr(transparent)]` over `[f32; 3]` and `out` holds 3 floats per pair.
+            let out = unsafe { std::slice::from_raw_parts_mut(out.as_mut_ptr().cast::<Rgb>(), wo.len()) };
+            bsdf.f_batch(wo, wi, out);
+        })
     }
 
     /// The solid-angle density with which `sample` produces `wi` from `wo` (smooth lobes only), float32 of
     /// shape (N,), or a scalar when both directions have shape (3,).
     #[pyo3(signature = (wo, wi, *, normalize = false))]
     fn pdf<'py>(&self, py: Python<'py>, wo: &Bound<'py, PyAny>, wi: &Bound<'py, PyAny>, normalize: bool) -> PyResult<Bound<'py, PyAny>> {
-        let (ao, ai) = (Arg::read(wo, "wo", 3)?, Arg::read(wi, "wi", 3)?);
-        let (n, batched) = broadcast(&[&ao, &ai])?;
-        let (out, ptr) = output::<f32>(py, n);
-        let (co, ci, bsdf) = (ao.column(), ai.column(), &self.bsdf);
-        let ok = run_released(py, || {
-            for_chunks(n, |rows| {
-                let (mut wo, mut wi) = (Vec::with_capacity(rows.len()), Vec::with_capacity(rows.len()));
-                if !(co.directions(rows.clone(), normalize, &mut wo) && ci.directions(rows.clone(), normalize, &mut wi)) {
-                    return false;
-                }
-                for (j, i) in rows.enumerate() {
-                    // SAFETY: index i is written by this task only.
-                    unsafe { ptr.write(i, bsdf.pdf(wo[j], wi[j])) };
-                }
-                true
-            })
-        })?;
-        if !ok {
-            return Err(first_bad_row(&[&ao, &ai], &[], normalize));
-        }
-        finish(out, 1, batched)
+        let bsdf = &self.bsdf;
+        over_pairs(py, wo, wi, normalize, 1, |wo, wi, out: &mut [f32]| bsdf.pdf_batch(wo, wi, out))
     }
 
     /// Sample `wi` given `wo` (shape (3,) or (N, 3)), `uc` (lobe choice; a number or shape (N,)) and `u`
@@ -230,41 +240,34 @@ impl PyBsdf {
         let (eta_out, eta_ptr) = output::<f32>(py, n);
         let (valid_out, valid_ptr) = output::<bool>(py, n);
         let (co, cuc, cu, bsdf) = (ao.column(), auc.column(), au.column(), &self.bsdf);
-        let in_unit = |v: f64| (0.0..=1.0).contains(&v);
-        let sample_row = |wo: Vec3, i: usize| {
-            let (uc, u0, u1) = (cuc.get(i, 0), cu.get(i, 0), cu.get(i, 1));
-            if !(in_unit(uc) && in_unit(u0) && in_unit(u1)) {
+        over_rows(py, n, &[&ao], &[&auc, &au], normalize, |rows| {
+            let (mut wo_buf, mut uc_buf, mut u_buf) = (Vec::new(), Vec::new(), Vec::new());
+            let (Some(wo), Some(uc), Some(u)) = (
+                co.directions(rows.clone(), normalize, &mut wo_buf),
+                cuc.unit_numbers(rows.clone(), &mut uc_buf),
+                cu.unit_pairs(rows.clone(), &mut u_buf),
+            ) else {
                 return false;
-            }
-            let s = bsdf.sample(wo, uc as f32, Vec2::new(u0 as f32, u1 as f32));
-            let valid = s.is_some();
-            let s = s.unwrap_or(BsdfSample { wi: Vec3::ZERO, f: Rgb::ZERO, pdf: 0.0, weight: Rgb::ZERO, flags: BsdfFlags::NONE, eta: 0.0 });
-            // SAFETY: row i is written by this task only; every index is below the array's length.
-            unsafe {
-                for (k, wi) in s.wi.to_array().into_iter().enumerate() {
-                    wi_ptr.write(3 * i + k, wi);
-                    f_ptr.write(3 * i + k, s.f.0[k]);
-                    weight_ptr.write(3 * i + k, s.weight.0[k]);
+            };
+            let (start, len) = (rows.start, rows.len());
+            // SAFETY: rows `rows` of every output are this task's own and within the arrays; `Vec3` is
+            // `#[repr(C)]` of three `f32` and `Rgb` `#[repr(transparent)]` over `[f32; 3]`, so 3·len floats
+            // are `len` of either.
+            let mut columns = unsafe {
+                let rows3 = |p: Out<f32>| p.slice(3 * start, 3 * len).as_mut_ptr();
+                SampleColumns {
+                    wi: std::slice::from_raw_parts_mut(rows3(wi_ptr).cast::<Vec3>(), len),
+                    f: std::slice::from_raw_parts_mut(rows3(f_ptr).cast::<Rgb>(), len),
+                    pdf: pdf_ptr.slice(start, len),
+                    weight: std::slice::from_raw_parts_mut(rows3(weight_ptr).cast::<Rgb>(), len),
+                    flags: flags_ptr.slice(start, len),
+                    eta: eta_ptr.slice(start, len),
+                    valid: valid_ptr.slice(start, len),
                 }
-                pdf_ptr.write(i, s.pdf);
-                flags_ptr.write(i, s.flags.0);
-                eta_ptr.write(i, s.eta);
-                valid_ptr.write(i, valid);
-            }
+            };
+            bsdf.sample_batch(wo, uc, u, &mut columns);
             true
-        };
-        let ok = run_released(py, || {
-            for_chunks(n, |rows| {
-                let mut wo = Vec::with_capacity(rows.len());
-                if !co.directions(rows.clone(), normalize, &mut wo) {
-                    return false;
-                }
-                rows.enumerate().all(|(j, i)| sample_row(wo[j], i))
-            })
         })?;
-        if !ok {
-            return Err(first_bad_row(&[&ao], &[&auc, &au], normalize));
-        }
         Ok(PySample {
             wi: finish(wi_out, 3, batched)?.unbind(),
             f: finish(f_out, 3, batched)?.unbind(),

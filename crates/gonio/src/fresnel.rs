@@ -10,7 +10,7 @@ use crate::math::Vec3;
 use crate::spectrum::Rgb;
 
 /// Mirror `w` about the normal `n`: 2 (w·n) n − w. Both point away from the surface.
-#[inline]
+#[inline(always)]
 #[must_use]
 pub fn reflect(w: Vec3, n: Vec3) -> Vec3 {
     2.0 * w.dot(n) * n - w
@@ -62,7 +62,7 @@ fn cos2_transmitted(cos_i: f32, eta: f32) -> f32 {
 
 /// Fresnel reflectances (Rₛ, Rₚ) of s- and p-polarised light at a dielectric interface.
 /// `cos_theta_i` is signed (negative: arriving from inside). Both are 1 under total internal reflection.
-#[inline]
+#[inline(always)]
 #[must_use]
 pub fn fresnel_dielectric_sp(cos_theta_i: f32, eta: f32) -> (f32, f32) {
     let (eta, cos_i) = if cos_theta_i < 0.0 { (1.0 / eta, -cos_theta_i) } else { (eta, cos_theta_i) };
@@ -83,7 +83,7 @@ pub fn fresnel_dielectric_sp(cos_theta_i: f32, eta: f32) -> (f32, f32) {
 }
 
 /// Unpolarised Fresnel reflectance (Rₛ + Rₚ)/2 of a dielectric interface.
-#[inline]
+#[inline(always)]
 #[must_use]
 pub fn fresnel_dielectric(cos_theta_i: f32, eta: f32) -> f32 {
     let (rs, rp) = fresnel_dielectric_sp(cos_theta_i, eta);
@@ -148,7 +148,7 @@ fn conductor_cos_t(eta_k2: f32, eta_k: f32, sin2_i: f32) -> (f32, f32) {
 /// cos θ ∈ [0, 1] (49 × 50 × 257 grid; worst near η ≈ 1, k ≈ 0 at Brewster's angle, where Rₚ ≈ 0); the
 /// f32 complex-arithmetic version it replaced (2026-11) reached 6.2e-6 on the same grid. Test:
 /// `conductor_sweep_matches_f64`.
-#[inline]
+#[inline(always)]
 #[must_use]
 pub fn fresnel_conductor(cos_theta_i: f32, eta: f32, k: f32) -> f32 {
     let c = cos_theta_i.clamp(0.0, 1.0);
@@ -166,10 +166,13 @@ pub fn fresnel_conductor(cos_theta_i: f32, eta: f32, k: f32) -> f32 {
 
 /// [`fresnel_conductor`] per RGB channel: the three channels are independent lanes of the same
 /// straight-line arithmetic (no branches besides selects), which the compiler keeps in SIMD registers.
-#[inline]
+#[inline(always)]
 #[must_use]
 pub fn fresnel_conductor_rgb(cos_theta_i: f32, eta: Rgb, k: Rgb) -> Rgb {
-    Rgb(std::array::from_fn(|i| fresnel_conductor(cos_theta_i, eta.0[i], k.0[i])))
+    // Written out, not `array::from_fn`: that one is not always inlined, and a call in a batch loop keeps it
+    // from being vectorised.
+    let channel = |i: usize| fresnel_conductor(cos_theta_i, eta.0[i], k.0[i]);
+    Rgb([channel(0), channel(1), channel(2)])
 }
 
 #[cfg(test)]

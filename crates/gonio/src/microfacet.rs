@@ -56,6 +56,7 @@
 //! assert!(ggx.g(wo, wo, Vec3::Z, Shadowing::VCavity) == 1.0);
 //! ```
 
+use crate::math::trig::sin_cos_turn;
 use crate::math::{Vec2, Vec3};
 use std::f32::consts::PI;
 use std::f64::consts::PI as PI64;
@@ -174,7 +175,7 @@ impl MicrofacetDistribution {
     }
 
     /// The squared slope s² = (x/αx)² + (y/αy)² of `wm`, i.e. tan²θm (cos²φ/αx² + sin²φ/αy²) · cos²θm.
-    #[inline]
+    #[inline(always)]
     fn stretched_slope2(&self, wm: Vec3) -> f32 {
         let (x, y) = (wm.x / self.alpha_x, wm.y / self.alpha_y);
         x * x + y * y
@@ -182,6 +183,7 @@ impl MicrofacetDistribution {
 
     /// The normal distribution D(ωm) in sr⁻¹ (zero below the surface). ∫ D(ωm) cos θm dωm = 1.
     #[must_use]
+    #[inline(always)]
     pub fn d(&self, wm: Vec3) -> f32 {
         let z = wm.z;
         if z <= 0.0 {
@@ -231,6 +233,7 @@ impl MicrofacetDistribution {
     }
 
     /// Λ of the upper-hemisphere direction (x, y, z ≥ 0).
+    #[inline(always)]
     fn lambda_upper(&self, x: f32, y: f32, z: f32) -> f32 {
         // α(φ)² sin²θ = αx² x² + αy² y² (the projected roughness of the anisotropic case, times sin²θ).
         let (ax, ay) = (self.alpha_x * x, self.alpha_y * y);
@@ -257,6 +260,7 @@ impl MicrofacetDistribution {
     /// Smith masking G1(ω, ωm) = χ⁺(ω·ωm) / (1 + Λ(ω)) (Heitz 2014 eq. 43), for ω on either side
     /// (seen from its own side).
     #[must_use]
+    #[inline(always)]
     pub fn g1(&self, w: Vec3, wm: Vec3) -> f32 {
         if w.dot(wm) * w.z <= 0.0 {
             return 0.0;
@@ -266,6 +270,7 @@ impl MicrofacetDistribution {
 
     /// Masking–shadowing G(ωo, ωi, ωm) of the chosen form, for reflection (ωo, ωi on the side of ωm).
     #[must_use]
+    #[inline(always)]
     pub fn g(&self, wo: Vec3, wi: Vec3, wm: Vec3, shadowing: Shadowing) -> f32 {
         let (o_m, i_m) = (wo.dot(wm), wi.dot(wm));
         if o_m * wo.z <= 0.0 || i_m * wi.z <= 0.0 {
@@ -287,6 +292,7 @@ impl MicrofacetDistribution {
 
     /// Whether visible normals are sampled when `visible` is asked for: Blinn has no visible-normal
     /// sampler and falls back to D·cos (see the module doc).
+    #[inline(always)]
     fn samples_visible(&self, visible: bool) -> bool {
         visible && self.kind != MicrofacetKind::Blinn
     }
@@ -294,6 +300,7 @@ impl MicrofacetDistribution {
     /// Sample a microfacet normal: of D(ωm) cos θm, or (`visible`, needs `wo.z > 0`) of the normals
     /// visible from `wo`. The density is [`pdf_wm`](Self::pdf_wm).
     #[must_use]
+    #[inline(always)]
     pub fn sample_wm(&self, wo: Vec3, u: Vec2, visible: bool) -> Vec3 {
         if !self.samples_visible(visible) {
             return self.sample_d_cos(u);
@@ -307,6 +314,7 @@ impl MicrofacetDistribution {
 
     /// The solid-angle density of [`sample_wm`](Self::sample_wm) at `wm`.
     #[must_use]
+    #[inline(always)]
     pub fn pdf_wm(&self, wo: Vec3, wm: Vec3, visible: bool) -> f32 {
         if !self.samples_visible(visible) {
             return self.d(wm) * wm.z.max(0.0);
@@ -321,6 +329,7 @@ impl MicrofacetDistribution {
     /// The solid-angle density of ωi = reflect(ωo, ωm) when ωm is drawn by [`sample_wm`](Self::sample_wm):
     /// pdf(ωm) / (4 |ωo·ωm|) (Walter 2007 eq. 14).
     #[must_use]
+    #[inline(always)]
     pub fn pdf_reflected(&self, wo: Vec3, wm: Vec3, visible: bool) -> f32 {
         scattered_density(self.pdf_wm(wo, wm, visible), 1.0 / (4.0 * wo.dot(wm).abs()))
     }
@@ -364,6 +373,7 @@ impl MicrofacetDistribution {
 
     /// Heitz 2018, JCGT 7(4): stretch ωo to the α = 1 configuration, sample the projected hemisphere of
     /// its visible half-disk, reproject, unstretch.
+    #[inline(always)]
     fn sample_visible_ggx(&self, wo: Vec3, u: Vec2) -> Vec3 {
         let vh = Vec3::new(self.alpha_x * wo.x, self.alpha_y * wo.y, wo.z).normalize();
         // Orthonormal basis around vh (T1 is horizontal; degenerate at normal incidence).
@@ -373,10 +383,11 @@ impl MicrofacetDistribution {
         // A uniform point on the unit disk, squeezed onto the visible half: p2 blends towards the
         // half-disk's straight edge by s = (1 + cos θv)/2.
         let r = u.x.sqrt();
-        let phi = 2.0 * PI * u.y;
-        let p1 = r * phi.cos();
+        // φ = 2π u.y; the polynomial sine and cosine keep the loops over samples vectorisable.
+        let (sin_phi, cos_phi) = sin_cos_turn(u.y);
+        let p1 = r * cos_phi;
         let s = 0.5 * (1.0 + vh.z);
-        let p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * r * phi.sin();
+        let p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * r * sin_phi;
         // Project onto the hemisphere around vh.
         let nh = p1 * t1 + p2 * t2 + (1.0 - p1 * p1 - p2 * p2).max(0.0).sqrt() * vh;
         // Unstretch (the normal transforms with the inverse transpose).
@@ -516,7 +527,7 @@ fn sample_beckmann_visible_slope_x(sin_theta: f64, cos_theta: f64, u: f64) -> f6
 /// is not finite. Within f32 underflow of the horizon (ωo·ωm → 0, or ωo + η ωi → 0 for refraction) the
 /// Jacobian overflows while the direction has no measurable density (2026-11: one guard for every
 /// microfacet BSDF, which used to repeat it).
-#[inline]
+#[inline(always)]
 fn scattered_density(pdf_wm: f32, jacobian: f32) -> f32 {
     let pdf = pdf_wm * jacobian;
     if pdf.is_finite() {

@@ -77,6 +77,7 @@ impl Conductor {
 
     /// Fresnel reflectance times `specular_reflectance` at incidence cosine `cos_theta_i` ≥ 0.
     #[must_use]
+    #[inline(always)]
     pub fn reflectance(&self, cos_theta_i: f32) -> Rgb {
         let fresnel = match self.eta_k {
             Some((eta, k)) => fresnel_conductor_rgb(cos_theta_i, eta, k),

@@ -53,6 +53,7 @@ impl BsdfModel for Diffuse {
         BsdfFlags::DIFFUSE_REFLECTION
     }
 
+    #[inline(always)]
     fn f(&self, wo: Vec3, wi: Vec3) -> Rgb {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return Rgb::ZERO;
@@ -60,6 +61,7 @@ impl BsdfModel for Diffuse {
         self.reflectance * FRAC_1_PI
     }
 
+    #[inline(always)]
     fn sample(&self, wo: Vec3, _uc: f32, u: Vec2) -> Option<BsdfSample> {
         if wo.z <= 0.0 {
             return None;
@@ -73,6 +75,7 @@ impl BsdfModel for Diffuse {
         Some(s)
     }
 
+    #[inline(always)]
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         if wo.z <= 0.0 {
             return 0.0;

@@ -76,6 +76,7 @@ pub(crate) const POLYPROPYLENE: f32 = 1.49;
 /// transmittances at θo and θi (1 − F for a smooth coating, a table for a rough one). Shared by
 /// `plastic` and `roughplastic`.
 #[must_use]
+#[inline(always)]
 pub(crate) fn coated_diffuse(rho: Rgb, t_o: f32, t_i: f32, eta: f32, internal_reflectance: f32, nonlinear: bool) -> Rgb {
     let scale = t_o * t_i * FRAC_1_PI / (eta * eta);
     rho.map(|r| {
@@ -86,6 +87,7 @@ pub(crate) fn coated_diffuse(rho: Rgb, t_o: f32, t_i: f32, eta: f32, internal_re
 
 /// Mitsuba's steering weight w = s̄/(d̄ + s̄) of the specular lobe, from the mean reflectances.
 #[must_use]
+#[inline(always)]
 pub(crate) fn specular_sampling_weight(diffuse: Rgb, specular: Rgb) -> f32 {
     let (d, s) = ((diffuse.r() + diffuse.g() + diffuse.b()) / 3.0, (specular.r() + specular.g() + specular.b()) / 3.0);
     if d + s > 0.0 {
@@ -98,6 +100,7 @@ pub(crate) fn specular_sampling_weight(diffuse: Rgb, specular: Rgb) -> f32 {
 /// The probability of sampling the specular lobe when a fraction `r` of the light is reflected by the
 /// coating and the steering weight is `w`: r w / (r w + (1 − r)(1 − w)).
 #[must_use]
+#[inline(always)]
 pub(crate) fn specular_probability(r: f32, w: f32) -> f32 {
     let (s, d) = (r * w, (1.0 - r) * (1.0 - w));
     // Both lobes carry nothing (e.g. a black specular multiplier and total reflection): pick either.

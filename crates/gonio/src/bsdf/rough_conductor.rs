@@ -43,7 +43,7 @@
 //! ```
 
 use super::energy_compensation::ConductorCompensation;
-use super::{BsdfFlags, BsdfModel, BsdfSample, Conductor};
+use super::{f_each, pdf_each, sample_each, BsdfFlags, BsdfModel, BsdfSample, Conductor, SampleColumns};
 use crate::error::{Error, Result};
 use crate::fresnel::reflect;
 use crate::math::{Vec2, Vec3};
@@ -129,6 +129,7 @@ impl MicrofacetConductor {
 
     /// f = F(ωo·ωh) D(ωh) G(ωo, ωi, ωh) / (4 cos θo cos θi) for both directions above the surface.
     #[must_use]
+    #[inline(always)]
     pub fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return Rgb::ZERO;
@@ -152,6 +153,7 @@ impl MicrofacetConductor {
 
     /// The solid-angle density of [`sample_lobe`](Self::sample_lobe): pdf(ωh) / (4 ωo·ωh).
     #[must_use]
+    #[inline(always)]
     pub fn pdf_lobe(&self, wo: Vec3, wi: Vec3) -> f32 {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return 0.0;
@@ -162,6 +164,7 @@ impl MicrofacetConductor {
 
     /// Sample ωh, reflect ωo about it; `f` and `pdf` are those of the returned ωi.
     #[must_use]
+    #[inline(always)]
     pub fn sample_lobe(&self, wo: Vec3, u: Vec2) -> Option<BsdfSample> {
         if wo.z <= 0.0 {
             return None;
@@ -175,6 +178,22 @@ impl MicrofacetConductor {
         // Far out in the tails f and pdf are both subnormal and f·cos/pdf overflows; such a direction
         // carries no measurable energy (2026-11: seen at u = 0 with normal incidence in the NaN sweep).
         s.weight.is_finite().then_some(s)
+    }
+}
+
+impl MicrofacetConductor {
+    /// For the common configuration (GGX, Smith, visible normals, no compensation), a copy of this model whose
+    /// choices are constants: inlined into a batch loop they fold away, and what is left is branch-free
+    /// arithmetic the compiler vectorises. The copy computes the same values. `None` for the others.
+    #[inline(always)]
+    fn constant_choices(&self) -> Option<MicrofacetConductor> {
+        let d = self.distribution;
+        if !(d.kind == MicrofacetKind::Ggx && self.shadowing == Shadowing::Smith && self.sample_visible && self.compensation.is_none()) {
+            return None;
+        }
+        let fresnel = Conductor { eta_k: self.fresnel.eta_k, specular_reflectance: self.fresnel.specular_reflectance };
+        let distribution = MicrofacetDistribution { kind: MicrofacetKind::Ggx, ..d };
+        Some(MicrofacetConductor { distribution, shadowing: Shadowing::Smith, sample_visible: true, fresnel, compensation: None })
     }
 }
 
@@ -252,6 +271,7 @@ impl BsdfModel for MicrofacetConductor {
         }
     }
 
+    #[inline(always)]
     fn f(&self, wo: Vec3, wi: Vec3) -> Rgb {
         let single = self.eval(wo, wi);
         match &self.compensation {
@@ -262,6 +282,7 @@ impl BsdfModel for MicrofacetConductor {
 
     /// The glossy lobe; with compensation, a direction of the multiple-scattering lobe with probability
     /// 1 − E(μo) instead.
+    #[inline(always)]
     fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
         let Some(ms) = &self.compensation else { return self.sample_lobe(wo, u) };
         if !(wo.z > 0.0) {
@@ -279,6 +300,7 @@ impl BsdfModel for MicrofacetConductor {
         s.weight.is_finite().then_some(s)
     }
 
+    #[inline(always)]
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         let lobe = self.pdf_lobe(wo, wi);
         match &self.compensation {
@@ -287,6 +309,33 @@ impl BsdfModel for MicrofacetConductor {
                 (1.0 - p) * lobe + p * ms.pdf(wi)
             }
             _ => lobe,
+        }
+    }
+
+    #[inline(always)]
+    fn f_batch(&self, wo: &[Vec3], wi: &[Vec3], out: &mut [Rgb]) {
+        // Two calls rather than a closure: each loop is inlined with its own constants.
+        match self.constant_choices() {
+            Some(m) => f_each(&m, wo, wi, out),
+            None => f_each(self, wo, wi, out),
+        }
+    }
+
+    #[inline(always)]
+    fn pdf_batch(&self, wo: &[Vec3], wi: &[Vec3], out: &mut [f32]) {
+        // Two calls rather than a closure: each loop is inlined with its own constants.
+        match self.constant_choices() {
+            Some(m) => pdf_each(&m, wo, wi, out),
+            None => pdf_each(self, wo, wi, out),
+        }
+    }
+
+    #[inline(always)]
+    fn sample_batch(&self, wo: &[Vec3], uc: &[f32], u: &[Vec2], out: &mut SampleColumns<'_>) {
+        // Two calls rather than a closure: each loop is inlined with its own constants.
+        match self.constant_choices() {
+            Some(m) => sample_each(&m, wo, uc, u, out),
+            None => sample_each(self, wo, uc, u, out),
         }
     }
 }

@@ -149,7 +149,7 @@ impl RoughDielectric {
 
     /// The relative index ηi/ηo seen from `wo` (η above the surface, 1/η below), and `wo`, `wi` turned so
     /// that `wo` is above (see the module doc).
-    #[inline]
+    #[inline(always)]
     fn upper(&self, wo: Vec3, wi: Vec3) -> (Vec3, Vec3, f32) {
         if wo.z < 0.0 {
             (-wo, -wi, 1.0 / self.eta)
@@ -160,7 +160,7 @@ impl RoughDielectric {
 
     /// The half vector of a pair with `wo` above and index ratio `eta` (eqs. 13 and 16), on the +z side.
     /// `None` when it is undefined (a direction on the horizon, or ωo + η ωi = 0).
-    #[inline]
+    #[inline(always)]
     fn half_vector(wo: Vec3, wi: Vec3, eta: f32) -> Option<HalfVector> {
         if wo.z <= 0.0 || wi.z == 0.0 {
             return None;
@@ -176,6 +176,7 @@ impl RoughDielectric {
     }
 
     /// The reflection lobe for `wo` above with index ratio `eta`: Walter 2007 eq. 20.
+    #[inline(always)]
     fn reflection_upper(&self, wo: Vec3, wi: Vec3, eta: f32) -> Rgb {
         let Some(HalfVector { wm, reflection: true }) = Self::half_vector(wo, wi, eta) else { return Rgb::ZERO };
         let d = self.distribution.d(wm);
@@ -222,6 +223,7 @@ impl RoughDielectric {
     }
 
     /// f for either side: reflection through the upper frame, transmission from the symmetric form.
+    #[inline(always)]
     fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
         if wo.z * wi.z > 0.0 {
             let inside = wo.z < 0.0;
@@ -253,10 +255,28 @@ impl RoughDielectric {
         }
     }
 
+    /// The reflection lobe for `wo` and `wi` both above the surface: what `f` is there (the specular lobe of
+    /// `roughplastic`, with compensation its multiply scattered reflection too), without the transmission cases.
+    #[inline(always)]
+    #[must_use]
+    pub fn reflection(&self, wo: Vec3, wi: Vec3) -> Rgb {
+        debug_assert!(wo.z > 0.0 && wi.z > 0.0);
+        // As in `eval`: a product that underflows to 0 counts as the horizon.
+        if !(wo.z * wi.z > 0.0) {
+            return Rgb::ZERO;
+        }
+        let single = self.reflection_upper(wo, wi, self.eta);
+        match &self.compensation {
+            Some(ms) => single + self.specular_reflectance * ms.reflection(wo.z, wi.z, false),
+            None => single,
+        }
+    }
+
     /// The density of reflecting `wo` (above) into `wi` (above) about a sampled microfacet, before the
     /// choice between reflection and refraction: pdf(ωm) / (4 ωo·ωm) (eq. 14). The specular lobe of
     /// `roughplastic`.
     #[must_use]
+    #[inline(always)]
     pub fn reflection_pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return 0.0;
@@ -272,6 +292,7 @@ impl RoughDielectric {
     /// Reflect `wo` (above) about a sampled microfacet normal: the specular lobe of `roughplastic`, whose
     /// density is [`reflection_pdf`](Self::reflection_pdf). `None` below the horizon.
     #[must_use]
+    #[inline(always)]
     pub fn sample_reflection(&self, wo: Vec3, u: Vec2) -> Option<Vec3> {
         let wm = self.distribution.sample_wm(wo, u, self.sample_visible);
         if !(wo.dot(wm) > 0.0) {

@@ -57,7 +57,7 @@
 
 use super::plastic::{coated_diffuse, specular_probability, specular_sampling_weight, CoatingParams};
 use super::rough_conductor::{read_distribution, MicrofacetParams};
-use super::{BsdfFlags, BsdfModel, BsdfSample, RoughDielectric};
+use super::{f_each, pdf_each, sample_each, BsdfFlags, BsdfModel, BsdfSample, RoughDielectric, SampleColumns};
 use crate::error::{Error, Result};
 use crate::math::{Vec2, Vec3};
 use crate::microfacet::{MicrofacetDistribution, MicrofacetKind};
@@ -75,8 +75,8 @@ const TABLE_SIZE: usize = 64;
 /// The rough interface's transmittance T(μ) and internal hemispherical reflectance R̄ᵢ.
 #[derive(Debug, PartialEq)]
 pub struct CoatingTables {
-    /// T(k/63), k = 0..64.
-    pub transmittance: Vec<f32>,
+    /// T(k/63), k = 0..64 (an array: its fixed length lets lookups go without bounds checks).
+    pub transmittance: [f32; TABLE_SIZE],
     /// R̄ᵢ.
     pub internal_reflectance: f32,
 }
@@ -107,13 +107,14 @@ impl CoatingTables {
         let wos: Vec<Vec3> =
             table_mu.map(|mu| direction(mu, 0.0)).chain(inside.iter().map(|&(mu, _)| direction(-(mu as f32), 0.0))).collect();
         let splits: Vec<_> = wos.par_iter().map(|&wo| interface.energy_split_with(wo, &gl_x, &gl_w)).collect();
-        let transmittance = splits[..TABLE_SIZE].iter().map(|s| s.transmitted as f32).collect();
+        let transmittance = std::array::from_fn(|k| splits[k].transmitted as f32);
         let internal: f64 = splits[TABLE_SIZE..].iter().zip(&inside).map(|(s, &(mu, w))| w * 2.0 * s.reflected * mu).sum();
         CoatingTables { transmittance, internal_reflectance: internal as f32 }
     }
 
     /// T(μ) by linear interpolation in the table.
     #[must_use]
+    #[inline(always)]
     pub fn transmittance(&self, mu: f32) -> f32 {
         let x = mu.clamp(0.0, 1.0) * (TABLE_SIZE - 1) as f32;
         let k = (x as usize).min(TABLE_SIZE - 2);
@@ -195,6 +196,7 @@ impl RoughPlastic {
     }
 
     /// The probability of sampling the coating's reflection (rather than the base) at cos θo.
+    #[inline(always)]
     fn specular_probability(&self, cos_theta_o: f32) -> f32 {
         let w = specular_sampling_weight(self.diffuse_reflectance, self.coating.specular_reflectance);
         specular_probability(1.0 - self.transmittance(cos_theta_o), w)
@@ -222,6 +224,7 @@ impl BsdfModel for RoughPlastic {
         BsdfFlags::GLOSSY_REFLECTION | BsdfFlags::DIFFUSE_REFLECTION
     }
 
+    #[inline(always)]
     fn f(&self, wo: Vec3, wi: Vec3) -> Rgb {
         if !(wo.z > 0.0 && wi.z > 0.0) {
             return Rgb::ZERO;
@@ -234,10 +237,11 @@ impl BsdfModel for RoughPlastic {
             self.internal_reflectance(),
             self.nonlinear,
         );
-        // With compensation the coating's f includes its multiply scattered reflection.
-        self.coating.f(wo, wi) + diffuse
+        // With compensation the coating's reflection includes its multiply scattered part.
+        self.coating.reflection(wo, wi) + diffuse
     }
 
+    #[inline(always)]
     fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
         if !(wo.z > 0.0) {
             return None;
@@ -260,6 +264,7 @@ impl BsdfModel for RoughPlastic {
         s.weight.is_finite().then_some(s)
     }
 
+    #[inline(always)]
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         if !(wo.z > 0.0 && wi.z > 0.0) {
             return 0.0;
@@ -273,6 +278,56 @@ impl BsdfModel for RoughPlastic {
             None => self.coating.reflection_pdf(wo, wi),
         };
         p * specular + (1.0 - p) * cosine_hemisphere_pdf(wi)
+    }
+
+    #[inline(always)]
+    fn f_batch(&self, wo: &[Vec3], wi: &[Vec3], out: &mut [Rgb]) {
+        // Two calls rather than a closure: each loop is inlined with its own constants.
+        match self.constant_choices() {
+            Some(m) => f_each(&m, wo, wi, out),
+            None => f_each(self, wo, wi, out),
+        }
+    }
+
+    #[inline(always)]
+    fn pdf_batch(&self, wo: &[Vec3], wi: &[Vec3], out: &mut [f32]) {
+        // Two calls rather than a closure: each loop is inlined with its own constants.
+        match self.constant_choices() {
+            Some(m) => pdf_each(&m, wo, wi, out),
+            None => pdf_each(self, wo, wi, out),
+        }
+    }
+
+    #[inline(always)]
+    fn sample_batch(&self, wo: &[Vec3], uc: &[f32], u: &[Vec2], out: &mut SampleColumns<'_>) {
+        // Two calls rather than a closure: each loop is inlined with its own constants.
+        match self.constant_choices() {
+            Some(m) => sample_each(&m, wo, uc, u, out),
+            None => sample_each(self, wo, uc, u, out),
+        }
+    }
+}
+
+impl RoughPlastic {
+    /// For GGX with visible-normal sampling, a copy whose distribution and sampling choice are constants (see
+    /// `MicrofacetConductor::constant_choices`); `None` otherwise.
+    #[inline(always)]
+    fn constant_choices(&self) -> Option<RoughPlastic> {
+        let c = &self.coating;
+        if !(c.distribution.kind == MicrofacetKind::Ggx && c.sample_visible && c.compensation.is_none()) {
+            return None;
+        }
+        let coating = RoughDielectric {
+            distribution: MicrofacetDistribution { kind: MicrofacetKind::Ggx, ..c.distribution },
+            sample_visible: true,
+            ..c.clone()
+        };
+        Some(RoughPlastic {
+            coating,
+            diffuse_reflectance: self.diffuse_reflectance,
+            nonlinear: self.nonlinear,
+            tables: self.tables.clone(),
+        })
     }
 }
 

@@ -13,7 +13,7 @@ const INV_2PI: f32 = 0.5 * FRAC_1_PI;
 const INV_4PI: f32 = 0.25 * FRAC_1_PI;
 
 /// Shirley & Chiu 1997, "A Low Distortion Map Between Disk and Square": concentric square → unit disk.
-#[inline]
+#[inline(always)]
 #[must_use]
 pub fn sample_uniform_disk_concentric(u: Vec2) -> Vec2 {
     let o = 2.0 * u - Vec2::ONE;
@@ -65,7 +65,7 @@ pub fn invert_uniform_disk_concentric(p: Vec2) -> Vec2 {
 }
 
 /// Malley's method: the concentric disk projected up to the hemisphere gives density cos θ / π.
-#[inline]
+#[inline(always)]
 #[must_use]
 pub fn sample_cosine_hemisphere(u: Vec2) -> Vec3 {
     let d = sample_uniform_disk_concentric(u);
@@ -74,7 +74,7 @@ pub fn sample_cosine_hemisphere(u: Vec2) -> Vec3 {
 }
 
 /// Density of [`sample_cosine_hemisphere`]: cos θ / π above the horizon, 0 below.
-#[inline]
+#[inline(always)]
 #[must_use]
 pub fn cosine_hemisphere_pdf(w: Vec3) -> f32 {
     if w.z > 0.0 {

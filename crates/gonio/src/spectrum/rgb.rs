@@ -5,8 +5,9 @@
 
 use std::ops::{Add, AddAssign, Div, Mul, MulAssign, Sub};
 
-/// A linear RGB triple.
+/// A linear RGB triple (laid out as `[f32; 3]`, so a slice of them is a slice of floats).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[repr(transparent)]
 pub struct Rgb(pub [f32; 3]);
 
 impl Rgb {
