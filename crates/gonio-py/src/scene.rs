@@ -225,7 +225,7 @@ impl PyScene {
         let out = out.map_err(panic_error)?;
         if out.nonfinite > 0 {
             let warn = py.import("warnings")?.getattr("warn")?;
-            let message = format!("dropped {} non-finite samples (counted as black)", out.nonfinite);
+            let message = format!("{} non-finite samples dropped (counted as black)", out.nonfinite);
             warn.call1((message, py.get_type::<pyo3::exceptions::PyRuntimeWarning>(), 2))?;
         }
         let image = PyArray1::from_vec(py, out.data).reshape([h as usize, w as usize, 3])?;

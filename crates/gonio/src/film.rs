@@ -2,7 +2,7 @@
 //!
 //! | parameter          | type    | default | meaning                                           |
 //! |--------------------|---------|---------|---------------------------------------------------|
-//! | `width`, `height`  | integer | 768, 576| resolution                                        |
+//! | `width`, `height`  | integer | 768, 576| resolution: each in [1, 65536], at most 2²⁶ pixels |
 //! | `pixel_format`     | string  | rgb     | accepted (gonio writes RGB)                       |
 //! | `component_format` | string  | float16 | accepted (the output format follows the file name) |
 //! | nested `rfilter`   | plugin  | box     | `box`; others are rendered with a box and a warning |
@@ -13,6 +13,11 @@
 use crate::error::{Error, Result};
 use crate::props::Props;
 use crate::spectrum::Rgb;
+
+/// The most pixels a film may have: 2²⁶ (8192 × 8192), whose sums take 1.5 GiB and the image 0.75 GiB.
+/// Larger films are refused when the scene is read, before anything is allocated for them, rather than
+/// aborting on a failed allocation midway (2026-11).
+pub const MAX_PIXELS: u64 = 1 << 26;
 
 /// The film's size, read from an `hdrfilm` description.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -29,6 +34,12 @@ impl FilmSpec {
         }
         let width = p.integer_in("width", 768, 1, 1 << 16)? as u32;
         let height = p.integer_in("height", 576, 1, 1 << 16)? as u32;
+        if u64::from(width) * u64::from(height) > MAX_PIXELS {
+            return Err(Error::spec(
+                p.at(),
+                format!("a {width}×{height} film has more than {MAX_PIXELS} pixels (e.g. 8192×8192), the most gonio renders"),
+            ));
+        }
         let _ = p.string("pixel_format")?;
         let _ = p.string("component_format")?;
         for f in p.nested_of("rfilter") {

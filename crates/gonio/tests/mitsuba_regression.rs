@@ -79,9 +79,10 @@ fn z_test_scene(name: &str) -> f64 {
     let fraction = passed as f64 / img.len() as f64;
     let (px, ch) = (worst.1 / 3, worst.1 % 3);
     println!(
-        "{name}: {:.4} % of pixel-channels pass (need 99.75 %), {spp} spp in {:.1} s; min p = {:.2e} at pixel ({}, {}) {} = {:.4} vs ref {:.4}",
+        "{name}: {:.4} % of pixel-channels pass (need 99.75 %), {spp} spp in {:.1} s, {} non-finite samples; min p = {:.2e} at pixel ({}, {}) {} = {:.4} vs ref {:.4}",
         100.0 * fraction,
         out.seconds,
+        out.nonfinite,
         worst.0,
         px % scene.film.width as usize,
         px / scene.film.width as usize,

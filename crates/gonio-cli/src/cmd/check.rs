@@ -1,7 +1,7 @@
 //! `gonio check BSDF` and `gonio check --all`.
 
 use crate::spec::load_bsdf;
-use gonio::verify::{check_named, expect_violation, test_directions, CheckConfig, Report};
+use gonio::verify::{check_named, expect_violation, sweep::sweep, test_directions, CheckConfig, Report};
 use gonio::{Bsdf, Error};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -24,6 +24,10 @@ pub struct Args {
     /// Queries in the NaN/Inf sweep.
     #[arg(long, default_value_t = 1_000_000)]
     sweep: usize,
+    /// Run only the NaN/Inf sweep (e.g. `gonio check --all --sweep-only --sweep 10000000`); with --all it
+    /// also covers the non-physical models, which must be finite too.
+    #[arg(long)]
+    sweep_only: bool,
     /// Random seed.
     #[arg(long, default_value_t = 0)]
     seed: u64,
@@ -58,6 +62,10 @@ pub fn run(args: Args) -> Result<ExitCode, Error> {
     cfg.sidak_family = Some(
         models.iter().map(|(_, b)| test_directions(b)).chain(violations.iter().map(|(_, b, _)| test_directions(b))).map(|d| d.len()).sum(),
     );
+
+    if args.sweep_only {
+        return Ok(sweep_only(models.iter().map(|(n, b)| (n, b)).chain(violations.iter().map(|(n, b, _)| (n, b))), &cfg, args.json));
+    }
 
     let reports: Vec<Report> = models
         .iter()
@@ -115,4 +123,36 @@ pub fn run(args: Args) -> Result<ExitCode, Error> {
         }
     }
     Ok(if failed == 0 && missed == 0 { ExitCode::SUCCESS } else { ExitCode::from(1) })
+}
+
+/// `--sweep-only`: the NaN/Inf sweep of every model, one line each, and the totals.
+fn sweep_only<'a>(models: impl Iterator<Item = (&'a String, &'a Bsdf)>, cfg: &CheckConfig, json: bool) -> ExitCode {
+    let (mut queries, mut bad, mut failed, mut count) = (0usize, 0usize, 0usize, 0usize);
+    let mut all = Vec::new();
+    for (name, bsdf) in models {
+        let start = std::time::Instant::now();
+        let r = sweep(bsdf, cfg.sweep_queries, cfg.seed);
+        let seconds = start.elapsed().as_secs_f64();
+        count += 1;
+        queries += r.queries;
+        bad += r.bad;
+        failed += usize::from(r.bad > 0);
+        if json {
+            all.push(serde_json::json!({ "name": name, "queries": r.queries, "bad": r.bad, "first_bad": r.first_bad, "seconds": seconds }));
+        } else {
+            let detail = r.first_bad.map(|d| format!("  ({d})")).unwrap_or_default();
+            println!("{:>10} queries {:>8} bad {seconds:>7.1} s  {name}{detail}", r.queries, r.bad);
+        }
+    }
+    if json {
+        let v = serde_json::json!({ "sweeps": all, "models": count, "queries": queries, "bad": bad });
+        println!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
+    } else {
+        println!("NaN/Inf sweep: {count} models, {queries} queries, {bad} non-finite or negative; {failed} models failed");
+    }
+    if failed == 0 {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    }
 }

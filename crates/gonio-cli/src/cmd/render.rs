@@ -1,11 +1,20 @@
 //! `gonio render SCENE.xml`: render a Mitsuba 3 XML scene with gonio's path tracer.
 //!
 //! The image goes to `-o FILE` (`.exr`: float32 linear RGB; `.png`: 8-bit sRGB), by default next to the
-//! scene with the extension replaced by `.exr` (as Mitsuba's `mitsuba scene.xml` does). Ctrl-C stops the
-//! render after the current pass; the image so far is written (every pixel with the same number of
-//! samples, reported) and the exit code is 130.
+//! scene with the extension replaced by `.exr` (as Mitsuba's `mitsuba scene.xml` does), atomically: a
+//! failure never leaves a partial file, and a file already there survives any error. The output path is
+//! checked before the scene is loaded, so an unwritable one fails at once.
+//!
+//! Ctrl-C, SIGTERM or SIGHUP stop the render after the current pass; the image so far is written (every
+//! pixel with the same number of samples), stderr says how many, and the exit code is 130. A second signal
+//! exits at once, writing nothing. If no pass had finished, nothing is written (an older file stays).
+//! EXR output carries the notes `gonio.spp` (samples per pixel written), `gonio.spp_requested`,
+//! `gonio.interrupted`, `gonio.nonfinite_samples` and `gonio.seed` as header attributes.
+//!
+//! Non-finite samples (NaN or Inf radiance, e.g. from overflow) are dropped and counted as black; when
+//! there are any, stderr says "N non-finite samples dropped".
 
-use gonio::image::{write_image, Image};
+use gonio::image::{check_writable, write_image_with_notes, Image};
 use gonio::render::render;
 use gonio::scene::Scene;
 use gonio::Error;
@@ -54,6 +63,7 @@ pub fn run(args: Args) -> Result<ExitCode, Error> {
         })
         .collect::<Result<Vec<_>, _>>()?;
     let output = args.output.clone().unwrap_or_else(|| args.scene.with_extension("exr"));
+    check_writable(&output)?;
     let load_start = std::time::Instant::now();
     let scene = Scene::load(&args.scene, &overrides)?;
     for w in &scene.warnings {
@@ -73,7 +83,7 @@ pub fn run(args: Args) -> Result<ExitCode, Error> {
     let cancel = Arc::new(AtomicBool::new(false));
     {
         let cancel = cancel.clone();
-        // A second Ctrl-C exits at once.
+        // SIGINT, SIGTERM and SIGHUP (ctrlc's `termination` feature); a second one exits at once.
         let _ = ctrlc::set_handler(move || {
             if cancel.swap(true, Ordering::SeqCst) {
                 std::process::exit(130);
@@ -96,11 +106,23 @@ pub fn run(args: Args) -> Result<ExitCode, Error> {
     let out = pool.install(|| render(&scene, spp, seed, &cancel, &|done| bar.set_position(done)));
     bar.finish_and_clear();
 
-    let image = Image { width: out.width as usize, height: out.height as usize, data: out.data };
-    write_image(&output, &image)?;
     if out.nonfinite > 0 {
-        eprintln!("gonio: warning: dropped {} non-finite samples (counted as black)", out.nonfinite);
+        eprintln!("gonio: warning: {} non-finite samples dropped (counted as black)", out.nonfinite);
     }
+    if out.spp_done == 0 {
+        let kept = if output.exists() { format!("; {} is unchanged", output.display()) } else { String::new() };
+        eprintln!("gonio: interrupted before the first pass finished: nothing written{kept}");
+        return Ok(ExitCode::from(130));
+    }
+    let notes = [
+        ("gonio.spp", out.spp_done.to_string()),
+        ("gonio.spp_requested", out.spp_requested.to_string()),
+        ("gonio.interrupted", out.cancelled.to_string()),
+        ("gonio.nonfinite_samples", out.nonfinite.to_string()),
+        ("gonio.seed", seed.to_string()),
+    ];
+    let image = Image { width: out.width as usize, height: out.height as usize, data: out.data };
+    write_image_with_notes(&output, &image, &notes)?;
     if !args.quiet {
         let rate = f64::from(out.spp_done) * f64::from(w) * f64::from(h) / out.seconds.max(1e-9);
         eprintln!(

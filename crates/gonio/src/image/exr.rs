@@ -77,14 +77,40 @@ pub(super) fn decode(path: &Path, bytes: &[u8]) -> Result<Image> {
     Ok(img)
 }
 
-pub(super) fn encode(path: &Path, img: &Image) -> Result<Vec<u8>> {
+/// Encodes `img`, with each note as a string attribute of the layer header (names and values must be
+/// representable as EXR text: Latin-1, no longer than the format allows).
+pub(super) fn encode(path: &Path, img: &Image, notes: &[(&str, String)]) -> Result<Vec<u8>> {
     let width = img.width;
     let channels = x::SpecificChannels::rgb(|p: x::Vec2<usize>| {
         let i = 3 * (p.y() * width + p.x());
         (img.data[i], img.data[i + 1], img.data[i + 2])
     });
-    let image = x::Image::from_channels((img.width, img.height), channels);
+    let mut image = x::Image::from_channels((img.width, img.height), channels);
+    for (name, value) in notes {
+        let (Some(n), Some(v)) = (x::Text::new_or_none(name), x::Text::new_or_none(value)) else {
+            return Err(Error::format(path, "OpenEXR encoding", format!("the note `{name}` = `{value}` is not EXR text")));
+        };
+        image.layer_data.attributes.other.insert(n, ::exr::meta::attribute::AttributeValue::Text(v));
+    }
     let mut out = Cursor::new(Vec::new());
     image.write().non_parallel().to_buffered(&mut out).map_err(|e| Error::format(path, "OpenEXR encoding", e.to_string()))?;
     Ok(out.into_inner())
+}
+
+/// The string attributes of the first header, other than the ones the format defines.
+pub(super) fn notes(path: &Path, bytes: &[u8]) -> Result<Vec<(String, String)>> {
+    let meta = ::exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), false)
+        .map_err(|e| Error::format(path, "OpenEXR data", e.to_string()))?;
+    let mut notes: Vec<(String, String)> = meta
+        .headers
+        .iter()
+        .take(1)
+        .flat_map(|h| h.own_attributes.other.iter().chain(h.shared_attributes.other.iter()))
+        .filter_map(|(k, v)| match v {
+            ::exr::meta::attribute::AttributeValue::Text(t) => Some((k.to_string(), t.to_string())),
+            _ => None,
+        })
+        .collect();
+    notes.sort();
+    Ok(notes)
 }

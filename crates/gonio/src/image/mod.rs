@@ -156,19 +156,54 @@ pub fn read_image(path: &Path) -> Result<Image> {
 /// Writes `img` to `path`, atomically (see the module docs): `.exr` as float32 linear RGB, `.png` as
 /// 8-bit sRGB, `.hdr` as RGBE.
 pub fn write_image(path: &Path, img: &Image) -> Result<()> {
-    let format = format_from_extension(path)
-        .ok_or_else(|| Error::format(path, "file name", format!("cannot write this extension; accepted: {WRITE_EXTENSIONS}")))?;
+    write_image_with_notes(path, img, &[])
+}
+
+/// [`write_image`] with text notes (name, value) kept where the format has room for them: string
+/// attributes in an EXR header (read back with [`read_notes`]); other formats drop them. `gonio render`
+/// notes the samples per pixel written, those requested and whether the render was interrupted.
+pub fn write_image_with_notes(path: &Path, img: &Image, notes: &[(&str, String)]) -> Result<()> {
+    let format = writable_format(path)?;
     img.check_shape(path)?;
     if img.width == 0 || img.height == 0 {
         return Err(Error::format(path, "image", "cannot write an image with no pixels"));
     }
     let bytes = guard(path, || match format {
-        Format::Exr => exr::encode(path, img),
+        Format::Exr => exr::encode(path, img, notes),
         Format::Png => ldr::encode_png(path, img),
         Format::Hdr => ldr::encode_hdr(path, img),
         Format::Jpeg => Err(Error::format(path, "file name", format!("cannot write this extension; accepted: {WRITE_EXTENSIONS}"))),
     })?;
     write_atomically(path, &bytes)
+}
+
+/// The text notes of an EXR file's header (its string attributes other than the required ones), sorted
+/// by name; empty for other formats.
+pub fn read_notes(path: &Path) -> Result<Vec<(String, String)>> {
+    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    if format_from_magic(&bytes) != Some(Format::Exr) {
+        return Ok(Vec::new());
+    }
+    guard(path, || exr::notes(path, &bytes))
+}
+
+/// The format `path`'s extension asks for, or an error listing the extensions gonio writes.
+fn writable_format(path: &Path) -> Result<Format> {
+    format_from_extension(path)
+        .filter(|f| *f != Format::Jpeg)
+        .ok_or_else(|| Error::format(path, "file name", format!("cannot write this extension; accepted: {WRITE_EXTENSIONS}")))
+}
+
+/// Whether an image can be written to `path`: its extension is one gonio writes and a file can be created
+/// in its directory (tried with the temporary name [`write_atomically`] uses, removed at once). Call it
+/// before a long computation so that a typo in the output path fails in a second, not after the render.
+/// `path` itself is not touched.
+pub fn check_writable(path: &Path) -> Result<()> {
+    writable_format(path)?;
+    let tmp = temporary_path(path);
+    std::fs::File::create(&tmp).map_err(|e| Error::io(path, e))?;
+    let _ = std::fs::remove_file(&tmp);
+    Ok(())
 }
 
 /// Runs a third-party decoder or encoder, turning a panic inside it into an error that names the file:
@@ -389,6 +424,35 @@ mod tests {
         std::fs::write(&txt, "hello").unwrap();
         assert!(read_image(&txt).unwrap_err().to_string().contains(".exr"));
         assert!(matches!(read_image(&dir.join("missing.exr")), Err(Error::Io { .. })));
+    }
+
+    #[test]
+    fn exr_notes_round_trip_and_other_formats_have_none() {
+        let dir = scratch_dir("notes");
+        let path = dir.join("noted.exr");
+        let notes = [("gonio.spp", "12".to_string()), ("gonio.interrupted", "true".to_string())];
+        write_image_with_notes(&path, &test_pattern(3, 2), &notes).unwrap();
+        assert_eq!(read_image(&path).unwrap(), test_pattern(3, 2));
+        let back = read_notes(&path).unwrap();
+        assert_eq!(back, [("gonio.interrupted".to_string(), "true".to_string()), ("gonio.spp".to_string(), "12".to_string())]);
+        let png = dir.join("noted.png");
+        write_image_with_notes(&png, &test_pattern(3, 2), &notes).unwrap();
+        assert!(read_notes(&png).unwrap().is_empty());
+        let err = write_image_with_notes(&dir.join("bad.exr"), &test_pattern(1, 1), &[("x", "\u{1F600}".to_string())]).unwrap_err();
+        assert!(err.to_string().contains("bad.exr"), "{err}");
+    }
+
+    #[test]
+    fn check_writable_catches_bad_paths_and_leaves_nothing() {
+        let dir = scratch_dir("writable");
+        check_writable(&dir.join("ok.exr")).unwrap();
+        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 0, "the probe file was left behind");
+        assert!(check_writable(&dir.join("x.jpg")).unwrap_err().to_string().contains(".exr, .png"));
+        assert!(matches!(check_writable(&dir.join("no/such/dir/out.exr")), Err(Error::Io { .. })));
+        // A regular file where a directory should be: an error even for root.
+        std::fs::write(dir.join("file"), "x").unwrap();
+        let err = check_writable(&dir.join("file/out.exr")).unwrap_err();
+        assert!(err.to_string().contains("file/out.exr"), "{err}");
     }
 
     #[test]

@@ -69,7 +69,8 @@ impl Loader {
             return Err(Error::spec(included_at.unwrap_or("?"), format!("`{}` includes itself", path.display())));
         }
         self.stack.push(canonical);
-        let dir = path.parent().map_or_else(|| PathBuf::from("."), Path::to_path_buf);
+        // A bare file name has the parent "", which would print as an empty search path.
+        let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).map_or_else(|| PathBuf::from("."), Path::to_path_buf);
         let result = self.document(&text, &path.display().to_string(), &dir);
         self.stack.pop();
         result

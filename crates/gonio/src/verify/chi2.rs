@@ -197,11 +197,9 @@ impl Chi2Result {
     /// plt.show()
     /// ```
     pub fn write_histograms(&self, path: &Path) -> std::io::Result<()> {
-        let mut tmp = path.as_os_str().to_owned();
-        tmp.push(".tmp");
-        let tmp = std::path::PathBuf::from(tmp);
+        // Written in memory, then atomically (gonio::image::write_atomically).
+        let mut out = Vec::new();
         {
-            let mut out = std::io::BufWriter::new(std::fs::File::create(&tmp)?);
             writeln!(out, "# gonio chi-square histograms: observed and expected sample counts per cell")?;
             writeln!(out, "# domain: {}", self.domain)?;
             writeln!(out, "# {self}")?;
@@ -221,9 +219,11 @@ impl Chi2Result {
                     writeln!(out, "{}", line.join(" "))?;
                 }
             }
-            out.flush()?;
         }
-        std::fs::rename(&tmp, path)
+        crate::image::write_atomically(path, &out).map_err(|e| match e {
+            crate::Error::Io { source, .. } => source,
+            other => std::io::Error::other(other.to_string()),
+        })
     }
 }
 

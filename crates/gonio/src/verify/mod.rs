@@ -276,17 +276,20 @@ pub fn check_named<M: BsdfModel + Sync + ?Sized>(bsdf: &M, name: &str, cfg: &Che
         });
     }
 
-    // NaN/Inf sweep.
+    rows.push(sweep_row(bsdf, cfg));
+    Report { name: name.to_string(), rows }
+}
+
+/// The sweep's row of a report: `cfg.sweep_queries` queries, passing with zero bad ones.
+fn sweep_row<M: BsdfModel + Sync + ?Sized>(bsdf: &M, cfg: &CheckConfig) -> CheckRow {
     let s = sweep::sweep(bsdf, cfg.sweep_queries, cfg.seed);
-    rows.push(CheckRow {
+    CheckRow {
         check: format!("NaN/Inf sweep ({} queries)", s.queries),
         measured: s.bad as f64,
         limit: "= 0".into(),
         passed: s.bad == 0,
         detail: s.first_bad.unwrap_or_default(),
-    });
-
-    Report { name: name.to_string(), rows }
+    }
 }
 
 /// Whether `report` shows the violation `row_kind` a non-physical model is kept to teach: some row whose

@@ -1,6 +1,14 @@
-//! NaN/Inf sweep: query `f`, `pdf` and `sample` with random and degenerate inputs — directions on the
-//! horizon, exactly on the poles, wi = −wo, wi = wo, denormal components, lengths off by 1e-6, sample
-//! coordinates at 0 and just below 1 — and demand finite, non-negative answers everywhere.
+//! NaN/Inf sweep: query `f`, `pdf` and `sample` with random and degenerate inputs and demand finite,
+//! non-negative answers everywhere (in release builds too, where debug assertions are off).
+//!
+//! A quarter of the queries are degenerate: `wo` from a list of directions that break careless code —
+//! exactly on the horizon (z = 0), grazing from above and just below it (|z| = 1e-7 … 1e-3), exactly on the
+//! poles (±normal), within f32 precision of the poles (sin θ underflowing), denormal and subnormal-squared
+//! components, lengths off by 1e-6 — and `wi` one of −wo, wo, its mirror image about the normal, its
+//! image through the surface, another listed direction or a random one; the sample coordinates are 0,
+//! ½, the smallest positive float or just below 1. In these queries the sampled `wi` is fed back to `f`
+//! and `pdf` in both argument orders, which reaches the exact refraction and half-vector-degenerate
+//! directions of each model. A sampled direction must also be of unit length (within 1e-3).
 
 use super::random_direction;
 use crate::bsdf::BsdfModel;
@@ -40,6 +48,24 @@ fn degenerate_directions() -> Vec<Vec3> {
         Vec3::new(0.6, 0.0, -0.8) * (1.0 - 1e-6),
         Vec3::new(s, 0.0, s),
         Vec3::new(0.999_999, 0.0, 0.001_414_2),
+        // Grazing from above, and just below the horizon.
+        Vec3::new(1.0, 0.0, 1e-4).normalize(),
+        Vec3::new(1.0, 0.0, 1e-3).normalize(),
+        Vec3::new(1.0, 0.0, -1e-4).normalize(),
+        Vec3::new(0.6, 0.8, -1e-6).normalize(),
+        Vec3::new(0.6, -0.8, 0.0),
+        // z a denormal, and z whose square underflows.
+        Vec3::new(1.0, 0.0, f32::MIN_POSITIVE),
+        Vec3::new(1.0, 0.0, -1e-40),
+        Vec3::new(1.0, 0.0, 1e-20),
+        Vec3::new(0.0, 1.0, -1e-20),
+        // Within f32 precision of the poles: sin θ is 0 or underflows when squared.
+        Vec3::new(1e-20, 0.0, 1.0),
+        Vec3::new(0.0, 1e-20, -1.0),
+        Vec3::new(3e-4, 0.0, 1.0).normalize(),
+        Vec3::new(0.0, -3e-4, -1.0).normalize(),
+        Vec3::new(1e-40, 1e-40, -1.0),
+        -Vec3::Y,
     ];
     let mirrored: Vec<Vec3> = v.iter().map(|w| Vec3::new(-w.x, -w.y, w.z)).collect();
     v.extend(mirrored);
@@ -51,7 +77,7 @@ fn degenerate_samples() -> [f32; 4] {
 }
 
 /// Check one query; `None` if every output is finite and non-negative, otherwise what went wrong.
-fn probe<M: BsdfModel + ?Sized>(bsdf: &M, wo: Vec3, wi: Vec3, uc: f32, u: Vec2) -> Option<String> {
+fn probe<M: BsdfModel + ?Sized>(bsdf: &M, wo: Vec3, wi: Vec3, uc: f32, u: Vec2, feed_back: bool) -> Option<String> {
     let f = bsdf.f(wo, wi);
     if !f.is_finite() || f.min_component() < 0.0 {
         return Some(format!("f(wo={wo}, wi={wi}) = {f}"));
@@ -69,9 +95,21 @@ fn probe<M: BsdfModel + ?Sized>(bsdf: &M, wo: Vec3, wi: Vec3, uc: f32, u: Vec2) 
             && s.f.is_finite()
             && s.f.min_component() >= 0.0
             && s.eta.is_finite()
-            && s.eta > 0.0;
+            && s.eta > 0.0
+            && (s.wi.length() - 1.0).abs() < 1e-3;
         if !ok {
             return Some(format!("sample(wo={wo}, uc={uc}, u={u}) = {s:?}"));
+        }
+        // The sampled direction, fed back: f and pdf there (and with the arguments swapped, as an adjoint
+        // or reciprocity check would ask) must be finite too. Delta directions are as good a query as any.
+        if feed_back {
+            for (a, b) in [(wo, s.wi), (s.wi, wo)] {
+                let f = bsdf.f(a, b);
+                let pdf = bsdf.pdf(a, b);
+                if !f.is_finite() || f.min_component() < 0.0 || !pdf.is_finite() || pdf < 0.0 {
+                    return Some(format!("at a sampled direction: f(wo={a}, wi={b}) = {f}, pdf = {pdf}"));
+                }
+            }
         }
     }
     None
@@ -90,14 +128,16 @@ pub fn sweep<M: BsdfModel + Sync + ?Sized>(bsdf: &M, queries: usize, seed: u64) 
             let mut rng = Pcg32::new(seed, c as u64);
             let mut r = SweepResult::default();
             for k in 0..CHUNK {
-                let (wo, wi, uc, u) = if k % 4 == 0 {
+                let degenerate = k % 4 == 0;
+                let (wo, wi, uc, u) = if degenerate {
                     // Degenerate: wo from the list, wi one of −wo, wo, mirror, another listed or random one.
                     let wo = dirs[rng.next_u32() as usize % dirs.len()];
-                    let wi = match rng.next_u32() % 5 {
+                    let wi = match rng.next_u32() % 6 {
                         0 => -wo,
                         1 => wo,
                         2 => Vec3::new(-wo.x, -wo.y, wo.z),
                         3 => dirs[rng.next_u32() as usize % dirs.len()],
+                        4 => Vec3::new(wo.x, wo.y, -wo.z),
                         _ => random_direction(&mut rng),
                     };
                     let pick = |rng: &mut Pcg32| us[rng.next_u32() as usize % us.len()];
@@ -106,7 +146,7 @@ pub fn sweep<M: BsdfModel + Sync + ?Sized>(bsdf: &M, queries: usize, seed: u64) 
                     (random_direction(&mut rng), random_direction(&mut rng), rng.next_f32(), rng.next_vec2())
                 };
                 r.queries += 1;
-                if let Some(msg) = probe(bsdf, wo, wi, uc, u) {
+                if let Some(msg) = probe(bsdf, wo, wi, uc, u, degenerate) {
                     r.bad += 1;
                     r.first_bad.get_or_insert(msg);
                 }
@@ -155,6 +195,53 @@ mod tests {
         fn pdf(&self, _wo: Vec3, _wi: Vec3) -> f32 {
             0.0
         }
+    }
+
+    /// Always samples the direction `AIM` (finite sample), but f and pdf divide by the distance to it.
+    struct InfiniteAtItsSample;
+    const AIM: Vec3 = Vec3::new(0.48, 0.6, 0.64);
+    impl BsdfModel for InfiniteAtItsSample {
+        fn flags(&self) -> BsdfFlags {
+            BsdfFlags::GLOSSY_REFLECTION
+        }
+        fn f(&self, _wo: Vec3, wi: Vec3) -> Rgb {
+            Rgb::splat(1e-3 / (wi - AIM).length_squared())
+        }
+        fn sample(&self, _wo: Vec3, _uc: f32, _u: Vec2) -> Option<BsdfSample> {
+            BsdfSample::smooth(AIM, Rgb::splat(0.1), 1.0, BsdfFlags::GLOSSY_REFLECTION, 1.0)
+        }
+        fn pdf(&self, _wo: Vec3, _wi: Vec3) -> f32 {
+            1.0
+        }
+    }
+
+    #[test]
+    fn sampled_directions_are_fed_back_to_f() {
+        let r = sweep(&InfiniteAtItsSample, 20_000, 1);
+        assert_eq!(4 * r.bad, r.queries, "every degenerate query samples AIM, where f is infinite");
+        assert!(r.first_bad.unwrap().contains("at a sampled direction"));
+    }
+
+    /// Samples a direction of length 2.
+    struct LongSample;
+    impl BsdfModel for LongSample {
+        fn flags(&self) -> BsdfFlags {
+            BsdfFlags::GLOSSY_REFLECTION
+        }
+        fn f(&self, _wo: Vec3, _wi: Vec3) -> Rgb {
+            Rgb::splat(0.1)
+        }
+        fn sample(&self, _wo: Vec3, _uc: f32, _u: Vec2) -> Option<BsdfSample> {
+            BsdfSample::smooth(Vec3::new(0.0, 0.0, 2.0), Rgb::splat(0.1), 1.0, BsdfFlags::GLOSSY_REFLECTION, 1.0)
+        }
+        fn pdf(&self, _wo: Vec3, _wi: Vec3) -> f32 {
+            1.0
+        }
+    }
+
+    #[test]
+    fn a_sampled_direction_must_be_unit_length() {
+        assert_eq!(sweep(&LongSample, 1000, 1).bad, 16_384);
     }
 
     #[test]
