@@ -123,7 +123,7 @@ impl Merl {
 /// Tables made in memory from analytic models (a real MERL file cannot ship with gonio): a shiny
 /// aluminium GGX lobe, a rough Beckmann copper read with `nearest`, and a rough plastic. The nested model
 /// is tabulated when the spec is loaded, so no file is needed. With the continuous half-vector density the
-/// whole harness takes about 35 s of CPU per spec (2026-11): the first (shiny) spec is the
+/// whole harness takes 10–40 s per spec on 2 cores (2026-11): the first (shiny) spec is the
 /// [`crate::bsdf::Examples`] of `merl` (so in `gonio check --all`); the `#[ignore]`d test
 /// `harness_on_tables` runs all three, `chi2_on_the_shiny_table` two directions in every `cargo test`.
 pub const HARNESS_SPECS: &[&str] = &[
@@ -304,7 +304,7 @@ mod tests {
     use crate::sampling::Pcg32;
     use crate::verify::{check_named, energy::direction, CheckConfig};
 
-    /// About 2 minutes of CPU: run by hand with `--ignored`.
+    /// About a minute on 2 cores (all three specs, every check): run by hand with `--ignored`.
     #[test]
     #[ignore]
     fn harness_on_tables() {
