@@ -23,11 +23,14 @@
 //! 3. ωh = (d.x, d.y, √(1 − r²)) (Nusselt's projection: dA = cos θh dωh);
 //! 4. ωi reflects ωo about ωh: dωi = 4 (ωo·ωh) dωh (Torrance & Sparrow 1967).
 //!
-//! A 64 × 64 piecewise-constant [`Distribution2D`] over (a, b) is proportional to the channel sum of
-//! f(ωo,j, ωi) cos θi |dωi/d(a, b)| (averaged over 2 × 2 points per cell), so that its samples are
-//! distributed like f cos θi. At run time ωo is rotated into the xz-plane; the tables of the two nearest
-//! θo,j are mixed with weights linear in θo, and a cosine-weighted lobe is mixed in with probability
-//! 0.1 so that every direction where f > 0 can be drawn. The pdf is the exact density of this mixture:
+//! A continuous density over (a, b) — the bilinear interpolant of the channel sum of
+//! f(ωo,j, ωi) cos θi |dωi/d(a, b)| at the 65 × 65 nodes (i/64, j/64), sampled by inverting its marginal
+//! and conditional CDFs ([`Marginal2D`], the warp Dupuy & Jakob store their tables for) — so that its
+//! samples are distributed like f cos θi. Being continuous (a piecewise-constant table is not), it lets
+//! the chi-square test's adaptive quadrature converge quickly. At run time ωo is rotated into the
+//! xz-plane; the tables of the two nearest θo,j are mixed with weights linear in θo, and a
+//! cosine-weighted lobe is mixed in with probability 0.1 so that every direction where f > 0 can be
+//! drawn. The pdf is the exact density of this mixture:
 //! pdf = 0.1 cos θi/π + 0.9 Σⱼ wⱼ p_j(a, b)/|dωi/d(a, b)|, evaluated from the returned ωi.
 //!
 //! ```no_run
@@ -42,7 +45,7 @@ use crate::error::{Error, Result};
 use crate::math::{Vec2, Vec3};
 use crate::measured::{gonioreflectometer, Interpolation, MerlTable};
 use crate::props::Props;
-use crate::sampling::distribution::Distribution2D;
+use crate::sampling::marginal2d::Marginal2D;
 use crate::sampling::warp::{
     cosine_hemisphere_pdf, invert_uniform_disk_concentric, sample_cosine_hemisphere, sample_uniform_disk_concentric,
 };
@@ -53,7 +56,7 @@ use std::sync::Arc;
 
 /// Number of θo tables.
 const THETA_O_TABLES: usize = 32;
-/// Cells per side of each half-vector table.
+/// Cells per side of each half-vector table (GRID + 1 nodes).
 const GRID: usize = 64;
 /// The radial warp's constant c (see the module docs).
 const WARP_C: f32 = 3.0;
@@ -118,11 +121,11 @@ impl Merl {
 }
 
 /// Tables made in memory from analytic models (a real MERL file cannot ship with gonio): a shiny
-/// aluminium GGX lobe, a rough Beckmann copper read with `nearest`, and a rough plastic. They are not in
-/// [`crate::bsdf::Examples::EXAMPLES`] (so not in `gonio check --all`): the sampling density is piecewise constant
-/// over 64 × 64 cells of the warped square, and the chi-square harness's adaptive quadrature splits every
-/// chi-square cell crossed by one of those edges down to its depth limit, which costs minutes of CPU per
-/// direction (2026-11). `gonio check` runs them by hand; the `#[ignore]`d test `harness_on_tables` too.
+/// aluminium GGX lobe, a rough Beckmann copper read with `nearest`, and a rough plastic. The nested model
+/// is tabulated when the spec is loaded, so no file is needed. With the continuous half-vector density the
+/// whole harness takes 10–40 s per spec on 2 cores (2026-11): the first (shiny) spec is the
+/// [`crate::bsdf::Examples`] of `merl` (so in `gonio check --all`); the `#[ignore]`d test
+/// `harness_on_tables` runs all three, `chi2_on_the_shiny_table` two directions in every `cargo test`.
 pub const HARNESS_SPECS: &[&str] = &[
     r#"{"type": "merl", "bsdf": {"type": "roughconductor", "distribution": "ggx", "alpha": 0.05, "material": "Al"}}"#,
     r#"{"type": "merl", "interpolation": "nearest", "bsdf": {"type": "roughconductor", "alpha": 0.4, "material": "Cu"}}"#,
@@ -130,8 +133,8 @@ pub const HARNESS_SPECS: &[&str] = &[
 ];
 
 impl crate::bsdf::Examples for Merl {
-    /// None: see [`HARNESS_SPECS`].
-    const EXAMPLES: &'static [&'static str] = &[];
+    /// The shiny table of [`HARNESS_SPECS`].
+    const EXAMPLES: &'static [&'static str] = &[HARNESS_SPECS[0]];
 }
 
 impl BsdfModel for Merl {
@@ -171,7 +174,8 @@ impl BsdfModel for Merl {
 /// The per-θo half-vector distributions (see the module docs).
 #[derive(Debug, PartialEq)]
 struct HalfVectorSampler {
-    tables: Vec<Distribution2D>,
+    /// One normalised density per θo,j; `None` where f cos θi is zero over the whole table.
+    tables: Vec<Option<Marginal2D<0>>>,
 }
 
 /// The radial warp g and its derivative.
@@ -225,36 +229,34 @@ fn table_pair(cos_theta_o: f32) -> (usize, usize, f32) {
 impl HalfVectorSampler {
     fn build(table: &MerlTable) -> Self {
         use rayon::prelude::*;
+        const NODES: usize = GRID + 1;
         let tables = (0..THETA_O_TABLES)
             .into_par_iter()
             .map(|j| {
                 let theta_o = (j as f32 + 0.5) / THETA_O_TABLES as f32 * FRAC_PI_2;
                 let wo = Vec3::new(theta_o.sin(), 0.0, theta_o.cos());
-                let mut func = vec![0f32; GRID * GRID];
-                for (k, v) in func.iter_mut().enumerate() {
-                    let (ia, ib) = (k % GRID, k / GRID);
-                    let mut sum = 0.0;
-                    for sub in 0..4 {
-                        let ab = Vec2::new(
-                            (ia as f32 + 0.25 + 0.5 * (sub % 2) as f32) / GRID as f32,
-                            (ib as f32 + 0.25 + 0.5 * (sub / 2) as f32) / GRID as f32,
-                        );
-                        let (wh, area) = half_vector(ab);
-                        let cos_d = wo.dot(wh);
-                        if !(cos_d > 0.0 && wh.z > 0.0) {
-                            continue;
-                        }
-                        let wi = (2.0 * cos_d * wh - wo).normalize();
-                        if !(wi.z > 0.0) {
-                            continue;
-                        }
-                        let f = table.eval(wo, wi, Interpolation::Trilinear);
-                        let jacobian = area / wh.z * 4.0 * cos_d;
-                        sum += (f.r() + f.g() + f.b()) * wi.z * jacobian;
+                let mut values = vec![0f32; NODES * NODES];
+                for (k, v) in values.iter_mut().enumerate() {
+                    let ab = Vec2::new((k % NODES) as f32 / GRID as f32, (k / NODES) as f32 / GRID as f32);
+                    let (wh, area) = half_vector(ab);
+                    let cos_d = wo.dot(wh);
+                    if !(cos_d > 0.0 && wh.z > 0.0) {
+                        continue;
                     }
-                    *v = if sum.is_finite() { 0.25 * sum } else { 0.0 };
+                    let wi = (2.0 * cos_d * wh - wo).normalize();
+                    if !(wi.z > 0.0) {
+                        continue;
+                    }
+                    let f = table.eval(wo, wi, Interpolation::Trilinear);
+                    let jacobian = area / wh.z * 4.0 * cos_d;
+                    let value = (f.r() + f.g() + f.b()) * wi.z * jacobian;
+                    *v = if value.is_finite() { value.max(0.0) } else { 0.0 };
                 }
-                Distribution2D::new(&func, GRID, GRID)
+                if !values.iter().any(|&v| v > 0.0) {
+                    return None;
+                }
+                // Finite, non-negative, not all zero, 65 × 65: `new` cannot fail.
+                Some(Marginal2D::new(&values, [NODES, NODES], [], true, true).expect("a valid half-vector table"))
             })
             .collect();
         HalfVectorSampler { tables }
@@ -264,11 +266,8 @@ impl HalfVectorSampler {
     fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<Vec3> {
         let (wo_c, c, s) = canonical(wo);
         let (j0, j1, t) = table_pair(wo.z);
-        let table = &self.tables[if uc < 1.0 - t { j0 } else { j1 }];
-        if table.integral() <= 0.0 {
-            return None;
-        }
-        let (wh, _) = half_vector(table.sample(u).p);
+        let table = self.tables[if uc < 1.0 - t { j0 } else { j1 }].as_ref()?;
+        let (wh, _) = half_vector(table.sample(u, []).0);
         let cos_d = wo_c.dot(wh);
         if !(cos_d > 0.0) {
             return None;
@@ -289,7 +288,7 @@ impl HalfVectorSampler {
         let (ab, area) = invert_half_vector(wh);
         let jacobian = area / wh.z * 4.0 * cos_d;
         let (j0, j1, t) = table_pair(wo.z);
-        let density = |j: usize| if self.tables[j].integral() > 0.0 { self.tables[j].pdf(ab) } else { 0.0 };
+        let density = |j: usize| self.tables[j].as_ref().map_or(0.0, |m| m.eval(ab, []));
         let p = ((1.0 - t) * density(j0) + t * density(j1)) / jacobian;
         if p.is_finite() {
             p
@@ -305,18 +304,36 @@ mod tests {
     use crate::sampling::Pcg32;
     use crate::verify::{check_named, energy::direction, CheckConfig};
 
-    /// Minutes of CPU (see [`HARNESS_SPECS`]): run by hand with `--ignored`.
+    /// About a minute on 2 cores (all three specs, every check): run by hand with `--ignored`.
     #[test]
     #[ignore]
     fn harness_on_tables() {
         let failed: Vec<String> = HARNESS_SPECS
             .iter()
-            .map(|spec| check_named(&Bsdf::from_json(spec).unwrap(), spec, &CheckConfig::default()))
+            .map(|spec| {
+                let start = std::time::Instant::now();
+                let r = check_named(&Bsdf::from_json(spec).unwrap(), spec, &CheckConfig::default());
+                eprintln!("{spec}: {:.1} s", start.elapsed().as_secs_f64());
+                r
+            })
             .inspect(|r| eprintln!("{}", r.to_table()))
             .filter(|r| !r.passed())
             .map(|r| r.to_table())
             .collect();
         assert!(failed.is_empty(), "{}", failed.join("\n"));
+    }
+
+    /// Chi-square of the sampling alone, at two directions of the shiny table (a few seconds).
+    #[test]
+    fn chi2_on_the_shiny_table() {
+        use crate::verify::chi2::{chi2_bsdf, Chi2Config};
+        let b = Bsdf::from_json(HARNESS_SPECS[0]).unwrap();
+        for mu in [0.9f32, 0.3] {
+            let start = std::time::Instant::now();
+            let r = chi2_bsdf(&b, direction(mu, 0.3), &Chi2Config::default());
+            eprintln!("cosθo={mu}: {} ({:.1} s)", r.message, start.elapsed().as_secs_f64());
+            assert!(r.passed, "cosθo={mu}: {}", r.message);
+        }
     }
 
     /// Variance of the white-environment estimate f cos θi / pdf (one sample) with the model's sampling

@@ -106,7 +106,10 @@ impl HalfDiff {
         if !(wo.z > 0.0 && wi.z > 0.0) {
             return None;
         }
+        // Scaled by its largest component first: for subnormal grazing pairs (ωi ≈ −ωo on the horizon)
+        // |ωo + ωi|² underflows to 0 and ωh would be NaN (2026-11, found by the NaN sweep).
         let sum = wo + wi;
+        let sum = sum / sum.abs().max_element();
         let wh = sum / sum.length();
         // Angles by atan2 rather than acos: acos loses half the digits near 0, where the specular peak is
         // (2026-11: acos(f32) put θh = 0.01 off by 3e-3 of a cell).
