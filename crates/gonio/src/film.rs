@@ -22,6 +22,10 @@ pub struct FilmSpec {
 }
 
 impl FilmSpec {
+    /// At most this many pixels (2026-11, issue 8): the film holds three `f64` sums per pixel, so a
+    /// 65536² film (each side within range) would need 100 GB; 2²⁶ pixels need 1.6 GB.
+    pub const MAX_PIXELS: u64 = 1 << 26;
+
     /// Read `hdrfilm`; warnings (e.g. a filter rendered as a box) are appended to `warnings`.
     pub fn from_props(p: &Props, warnings: &mut Vec<String>) -> Result<FilmSpec> {
         if p.plugin_type() != "hdrfilm" {
@@ -29,6 +33,12 @@ impl FilmSpec {
         }
         let width = p.integer_in("width", 768, 1, 1 << 16)? as u32;
         let height = p.integer_in("height", 576, 1, 1 << 16)? as u32;
+        if u64::from(width) * u64::from(height) > Self::MAX_PIXELS {
+            return Err(Error::spec(
+                p.at_param("width"),
+                format!("a {width}×{height} film has more than the {} pixels gonio renders (8192×8192; 24 bytes each)", Self::MAX_PIXELS),
+            ));
+        }
         let _ = p.string("pixel_format")?;
         let _ = p.string("component_format")?;
         for f in p.nested_of("rfilter") {
