@@ -29,8 +29,11 @@ use std::path::Path;
 /// tiny files (an include, an include cycle, meshes, an image) kept beside the fuzz project.
 pub const FILES_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fuzz/files");
 
+/// A target's body: the content of one file.
+pub type Target = fn(&[u8]);
+
 /// Every target by name, as the fuzz project and the regression test name them.
-pub const TARGETS: &[(&str, fn(&[u8]))] = &[
+pub const TARGETS: &[(&str, Target)] = &[
     ("xml_scene", xml_scene),
     ("obj", obj),
     ("ply", ply),

@@ -219,7 +219,7 @@ mod tests {
         // The same with defaults: each repeats the previous one ten times.
         let mut text = format!("{SCENE}<default name=\"d0\" value=\"lol\"/>");
         for i in 1..10 {
-            text += &format!("\n<default name=\"d{i}\" value=\"{}\"/>", format!("${}", format!("d{}", i - 1)).repeat(10));
+            text += &format!("\n<default name=\"d{i}\" value=\"{}\"/>", format!("$d{}", i - 1).repeat(10));
         }
         let e = refused(&(text + "</scene>"), &dir);
         assert!(e.contains(&format!("expands to more than {} bytes", crate::xml::MAX_SUBSTITUTED_VALUE)), "{e}");
