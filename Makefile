@@ -3,13 +3,14 @@
 #   make test   build, then run the Rust tests and the Python tests (incl. the Mitsuba 3 cross-checks)
 #   make bench  criterion benchmarks, and gonio vs Mitsuba 3 timings, errors and scaling tables
 #   make gallery  regenerate docs/gallery/*.png and docs/gallery/README.md (the lecture's figures, < 10 min on 2 cores)
+#   make fuzz   run one loader's fuzz target (TARGET=ply FUZZ_SECONDS=600; docs/fuzzing.md)
 
 PYTHON ?= python3
 VENV   := .venv
 VPY    := $(VENV)/bin/python
 CARGO  ?= cargo
 
-.PHONY: all build cli venv python demo test test-rust test-python bench gallery fmt lint clean
+.PHONY: all build cli venv python demo test test-rust test-python bench gallery fuzz fmt lint clean
 
 all: build
 
@@ -64,6 +65,15 @@ bench: cli python
 # `gonio fit` for the measured materials instead of using docs/gallery/fits/*.xml).
 gallery: cli
 	docs/gallery/make_gallery.sh
+
+# One fuzz target for FUZZ_SECONDS (by hand, never part of `make test`; needs `cargo install cargo-fuzz`;
+# stable Rust, sanitizer off): make fuzz TARGET=ply. Targets and results: docs/fuzzing.md.
+TARGET       ?= xml_scene
+FUZZ_SECONDS ?= 600
+fuzz:
+	mkdir -p fuzz/corpus-work/$(TARGET) fuzz/artifacts/$(TARGET)
+	cd fuzz && nice -n 19 $(CARGO) fuzz run -s none --release $(TARGET) corpus-work/$(TARGET) seeds/$(TARGET) -- \
+		-max_total_time=$(FUZZ_SECONDS) -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 -artifact_prefix=artifacts/$(TARGET)/
 
 fmt:
 	$(CARGO) fmt --all

@@ -24,6 +24,8 @@ pub mod error;
 pub mod film;
 pub mod fit;
 pub mod fresnel;
+#[doc(hidden)]
+pub mod fuzz;
 pub mod geometry;
 pub mod image;
 pub mod integrator;

@@ -33,6 +33,16 @@ pub enum Value {
     Nested(Props),
 }
 
+/// Limits that keep a hostile description from exhausting memory or time (2026-11, issue 8): a plugin
+/// tree may hold at most this many plugins once references are expanded (each `<ref>` copies its target,
+/// so a chain of plugins that each refer to the previous one twice would otherwise double at every
+/// link, the "billion laughs" pattern)...
+pub const MAX_PLUGINS: usize = 1 << 18;
+/// ...nest at most this deep (the readers recurse once per level)...
+pub const MAX_NESTING: usize = 64;
+/// ...and one plugin may take at most this many parameters (each new one is compared with those before).
+pub const MAX_PARAMETERS: usize = 1024;
+
 impl Value {
     fn kind(&self) -> &'static str {
         match self {
@@ -66,19 +76,54 @@ pub struct Props {
     entries: Vec<Entry>,
     /// Every name a model asked for, to list the accepted parameters in errors.
     asked: RefCell<Vec<&'static str>>,
+    /// Plugins in this tree, itself included (checked against [`MAX_PLUGINS`]).
+    plugins: usize,
 }
 
 impl Props {
     /// An empty description of plugin `plugin`, located at `at` (for messages).
     #[must_use]
     pub fn new(plugin: &str, at: &str) -> Self {
-        Props { class: String::new(), plugin: plugin.into(), id: None, at: at.into(), entries: Vec::new(), asked: RefCell::new(Vec::new()) }
+        Props {
+            class: String::new(),
+            plugin: plugin.into(),
+            id: None,
+            at: at.into(),
+            entries: Vec::new(),
+            asked: RefCell::new(Vec::new()),
+            plugins: 1,
+        }
     }
 
     /// Add a parameter (the last of equal names wins, as in Mitsuba's dictionaries).
     pub fn set(&mut self, name: &str, value: Value, at: &str) {
         self.entries.retain(|e| e.name != name);
         self.entries.push(Entry { name: name.into(), value, at: at.into(), used: Cell::new(false) });
+        self.plugins = 1 + self.entries.iter().map(|e| if let Value::Nested(p) = &e.value { p.plugins } else { 0 }).sum::<usize>();
+    }
+
+    /// [`Props::set`] for values read from a file: refuses a parameter past [`MAX_PARAMETERS`] and a
+    /// tree past [`MAX_PLUGINS`] (checked before a nested plugin is stored, so before it is copied further).
+    pub(crate) fn set_checked(&mut self, name: &str, value: Value, at: &str) -> Result<()> {
+        if self.entries.len() >= MAX_PARAMETERS && !self.has(name) {
+            return Err(Error::spec(at, format!("`{}` has more than {MAX_PARAMETERS} parameters", self.plugin)));
+        }
+        if let Value::Nested(p) = &value {
+            if self.plugins + p.plugins > MAX_PLUGINS {
+                return Err(Error::spec(
+                    at,
+                    format!("more than {MAX_PLUGINS} plugins in one tree once references are expanded (a reference copies its target)"),
+                ));
+            }
+        }
+        self.set(name, value, at);
+        Ok(())
+    }
+
+    /// The number of plugins in this tree, itself and every nested (or referenced) plugin included.
+    #[must_use]
+    pub fn plugin_count(&self) -> usize {
+        self.plugins
     }
 
     #[must_use]
@@ -385,7 +430,7 @@ impl Props {
                 },
                 _ => {
                     let value = json_value(v, &at, scope)?;
-                    props.set(key, value, &at);
+                    props.set_checked(key, value, &at)?;
                 }
             }
         }
@@ -396,10 +441,7 @@ impl Props {
 
     /// Parse an XML document whose root is a `<bsdf>` element, or whose root holds exactly one.
     pub fn from_xml_bsdf(text: &str, source: &str) -> Result<Props> {
-        let doc = roxmltree::Document::parse(text).map_err(|e| {
-            let p = e.pos();
-            Error::Syntax { at: format!("{source}:{}:{}", p.row, p.col), message: format!("not valid XML: {e}") }
-        })?;
+        let doc = crate::xml::parse_document(text, source)?;
         let root = doc.root_element();
         let bsdf = if root.has_tag_name("bsdf") {
             root
@@ -426,7 +468,15 @@ impl Props {
     /// names resolved against the search paths, nested plugins of every kind, points, vectors,
     /// transforms and spectra read.
     pub fn from_xml_element_in(node: roxmltree::Node, source: &str, env: &XmlEnv) -> Result<Props> {
+        Props::from_xml_nested(node, source, env, 1)
+    }
+
+    /// [`Props::from_xml_element_in`] for an element `depth` plugins deep.
+    fn from_xml_nested(node: roxmltree::Node, source: &str, env: &XmlEnv, depth: usize) -> Result<Props> {
         let at = xml_at(source, node);
+        if depth > MAX_NESTING {
+            return Err(Error::spec(at, format!("plugins nested more than {MAX_NESTING} deep")));
+        }
         let tag = node.tag_name().name();
         let plugin = env.attr(node, "type", source)?.ok_or_else(|| Error::spec(&at, format!("<{tag}> needs a type attribute")))?;
         let mut props = Props::new(&plugin, &at);
@@ -442,9 +492,9 @@ impl Props {
                 format!("_arg_{unnamed}")
             };
             if PLUGIN_TAGS.contains(&ctag) {
-                let nested = Props::from_xml_element_in(child, source, env)?;
+                let nested = Props::from_xml_nested(child, source, env, depth + 1)?;
                 let key = name.unwrap_or_else(&mut auto_name);
-                props.set(&key, Value::Nested(nested), &cat);
+                props.set_checked(&key, Value::Nested(nested), &cat)?;
                 continue;
             }
             if ctag == "ref" {
@@ -454,7 +504,13 @@ impl Props {
                     .get(&id)
                     .ok_or_else(|| Error::spec(&cat, format!("<ref id=\"{id}\">: no plugin with this id was declared before")))?;
                 let key = name.unwrap_or_else(&mut auto_name);
-                props.set(&key, Value::Nested(target.clone()), &cat);
+                if props.plugins + target.plugins > MAX_PLUGINS {
+                    return Err(Error::spec(
+                        &cat,
+                        format!("<ref id=\"{id}\">: more than {MAX_PLUGINS} plugins in one tree once references are expanded"),
+                    ));
+                }
+                props.set_checked(&key, Value::Nested(target.clone()), &cat)?;
                 continue;
             }
             let name = name.ok_or_else(|| Error::spec(&cat, format!("<{ctag}> needs a name attribute")))?;
@@ -495,7 +551,7 @@ impl Props {
                 }
                 _ => return Err(Error::spec(&cat, format!("unsupported element <{ctag}> inside <{tag} type=\"{plugin}\">"))),
             };
-            props.set(&name, value, &cat);
+            props.set_checked(&name, value, &cat)?;
         }
         Ok(props)
     }

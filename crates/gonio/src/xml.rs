@@ -8,6 +8,7 @@ use crate::props::Props;
 use crate::spectrum::named::{parse_spd, spectrum_to_rgb};
 use crate::spectrum::Rgb;
 use glam::Vec3;
+use std::cell::Cell;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
@@ -18,6 +19,81 @@ pub struct XmlEnv {
     pub params: HashMap<String, String>,
     pub refs: HashMap<String, Props>,
     pub search_paths: Vec<PathBuf>,
+    /// Bytes produced by `$name` substitution so far (checked against [`MAX_SUBSTITUTED_TOTAL`]).
+    substituted: Cell<usize>,
+}
+
+/// Limits on `$name` substitution (2026-11, issue 8): a `<default>` may use the ones before it, so ten
+/// defaults that each repeat the previous one ten times would otherwise expand a few hundred bytes into
+/// 10¹⁰ (the "billion laughs" pattern of XML entities). One substituted value may be at most
+/// [`MAX_SUBSTITUTED_VALUE`] bytes, and one document may produce at most [`MAX_SUBSTITUTED_TOTAL`].
+pub const MAX_SUBSTITUTED_VALUE: usize = 1 << 16;
+pub const MAX_SUBSTITUTED_TOTAL: usize = 1 << 26;
+
+/// Elements may nest at most this deep. `roxmltree`'s tokenizer recurses once per element level, so a
+/// document of 100 000 nested elements (a few hundred KB) overflows the stack and aborts the process
+/// (found by fuzzing, 2026-11); [`parse_document`] counts the depth before handing the text to it.
+pub const MAX_ELEMENT_DEPTH: usize = 256;
+
+/// Parse an XML document: the nesting depth is checked first (see [`MAX_ELEMENT_DEPTH`]); DTDs, and
+/// with them entity expansion ("billion laughs"), are refused by `roxmltree`. `source` names the text.
+pub fn parse_document<'a>(text: &'a str, source: &str) -> Result<roxmltree::Document<'a>> {
+    check_depth(text, source)?;
+    roxmltree::Document::parse(text).map_err(|e| {
+        let p = e.pos();
+        Error::Syntax { at: format!("{source}:{}:{}", p.row, p.col), message: format!("not valid XML: {e}") }
+    })
+}
+
+/// A linear scan of the element structure: `<name` opens (unless it ends in `/>`), `</` closes;
+/// comments, CDATA, processing instructions and declarations are skipped. Over-counting malformed text is
+/// harmless: the parser rejects it anyway.
+fn check_depth(text: &str, source: &str) -> Result<()> {
+    let bytes = text.as_bytes();
+    let (mut depth, mut i) = (0usize, 0usize);
+    let skip_to =
+        |from: usize, end: &[u8]| bytes[from..].windows(end.len()).position(|w| w == end).map_or(bytes.len(), |k| from + k + end.len());
+    while i < bytes.len() {
+        match bytes[i] {
+            b'<' if bytes[i..].starts_with(b"<!--") => i = skip_to(i + 4, b"-->"),
+            b'<' if bytes[i..].starts_with(b"<![CDATA[") => i = skip_to(i + 9, b"]]>"),
+            b'<' if bytes[i..].starts_with(b"<?") => i = skip_to(i + 2, b"?>"),
+            b'<' if bytes[i..].starts_with(b"<!") => i = skip_to(i + 2, b">"),
+            b'<' if bytes[i..].starts_with(b"</") => {
+                depth = depth.saturating_sub(1);
+                i += 2;
+            }
+            b'<' => {
+                // An opening tag: find its end, outside quoted attribute values.
+                let start = i;
+                let mut quote = None;
+                i += 1;
+                while i < bytes.len() {
+                    match (quote, bytes[i]) {
+                        (None, q @ (b'"' | b'\'')) => quote = Some(q),
+                        (Some(q), c) if c == q => quote = None,
+                        (None, b'>') => break,
+                        _ => {}
+                    }
+                    i += 1;
+                }
+                if bytes[i.saturating_sub(1)] != b'/' {
+                    depth += 1;
+                    if depth > MAX_ELEMENT_DEPTH {
+                        let line = bytes[..start].iter().filter(|&&b| b == b'\n').count() + 1;
+                        let line_start = bytes[..start].iter().rposition(|&b| b == b'\n').map_or(0, |k| k + 1);
+                        let col = String::from_utf8_lossy(&bytes[line_start..start]).chars().count() + 1;
+                        return Err(Error::Syntax {
+                            at: format!("{source}:{line}:{col}"),
+                            message: format!("elements nested more than {MAX_ELEMENT_DEPTH} deep"),
+                        });
+                    }
+                }
+            }
+            _ => i += 1,
+        }
+    }
+    Ok(())
 }
 
 /// "file:line:col" of a node.
@@ -43,10 +119,18 @@ impl XmlEnv {
             let value = self.params.get(name).ok_or_else(|| {
                 Error::spec(at, format!("`${name}` is not defined (add <default name=\"{name}\" value=\"…\"/> or pass -D {name}=…)"))
             })?;
+            if out.len() + value.len() > MAX_SUBSTITUTED_VALUE {
+                return Err(Error::spec(at, format!("`${name}` expands to more than {MAX_SUBSTITUTED_VALUE} bytes")));
+            }
             out.push_str(value);
             rest = &tail[len..];
         }
         out.push_str(rest);
+        let total = self.substituted.get() + out.len();
+        if total > MAX_SUBSTITUTED_TOTAL || out.len() > MAX_SUBSTITUTED_VALUE {
+            return Err(Error::spec(at, format!("`$` substitutions produce more than {MAX_SUBSTITUTED_TOTAL} bytes in all")));
+        }
+        self.substituted.set(total);
         Ok(out)
     }
 

@@ -167,7 +167,12 @@ fn mulsign_neg(a: f32, b: f32) -> f32 {
 impl Measured {
     /// Load the RGL file at `path`.
     pub fn load(path: &Path) -> Result<Measured> {
-        Ok(Measured { tables: Arc::new(RglTables::load(path)?) })
+        Measured::from_file(TensorFile::open(path)?)
+    }
+
+    /// The material held by a parsed tensor file (checks every field as [`Measured::load`] does).
+    pub fn from_file(file: TensorFile) -> Result<Measured> {
+        Ok(Measured { tables: Arc::new(RglTables::from_file(file)?) })
     }
 
     pub fn from_props(p: &Props) -> Result<Self> {
@@ -244,8 +249,7 @@ impl Measured {
 }
 
 impl RglTables {
-    fn load(path: &Path) -> Result<RglTables> {
-        let file = TensorFile::open(path)?;
+    fn from_file(file: TensorFile) -> Result<RglTables> {
         if !file.has_field("rgb") && file.has_field("spectra") {
             return Err(file.error(
                 "rgb",
@@ -337,7 +341,7 @@ impl RglTables {
             r
         };
         Ok(RglTables {
-            path: path.to_path_buf(),
+            path: file.path().to_path_buf(),
             description,
             ndf: ndf_t,
             sigma: sigma_t,

@@ -106,7 +106,12 @@ impl MeshData {
 /// Loads a Wavefront OBJ file (see the module docs for what is understood).
 pub fn load_obj(path: &Path) -> Result<MeshData> {
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
-    parse_obj(path, &String::from_utf8_lossy(&bytes))
+    obj_from_bytes(path, &bytes)
+}
+
+/// Parses the content of an OBJ file; `path` only names it in errors.
+pub fn obj_from_bytes(path: &Path, bytes: &[u8]) -> Result<MeshData> {
+    parse_obj(path, &String::from_utf8_lossy(bytes))
 }
 
 /// One face corner: indices into the `v`, `vt`, `vn` arrays (`u32::MAX` for none).
@@ -219,7 +224,12 @@ fn parse_corner(corner: &str, nv: usize, nvt: usize, nvn: usize) -> std::result:
 /// Loads a Stanford PLY file, ascii or binary of either byte order (see the module docs).
 pub fn load_ply(path: &Path) -> Result<MeshData> {
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
-    parse_ply(path, &bytes)
+    ply_from_bytes(path, &bytes)
+}
+
+/// Parses the content of a PLY file; `path` only names it in errors.
+pub fn ply_from_bytes(path: &Path, bytes: &[u8]) -> Result<MeshData> {
+    parse_ply(path, bytes)
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -646,7 +656,12 @@ const MAX_INFLATE_RATIO: usize = 1032;
 /// An index past the last mesh is an error that says how many the file holds.
 pub fn load_serialized(path: &Path, shape_index: usize) -> Result<MeshData> {
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
-    parse_serialized(path, &bytes, shape_index)
+    serialized_from_bytes(path, &bytes, shape_index)
+}
+
+/// Parses mesh number `shape_index` of the content of a `.serialized` file; `path` only names it in errors.
+pub fn serialized_from_bytes(path: &Path, bytes: &[u8], shape_index: usize) -> Result<MeshData> {
+    parse_serialized(path, bytes, shape_index)
 }
 
 fn le_u16(bytes: &[u8], at: usize) -> Option<u16> {
@@ -768,8 +783,12 @@ fn decode_serialized_mesh(path: &Path, compressed: &[u8], stream_at: usize, vers
         )
     })?;
     let data_at = decompressed;
-    let mut data = vec![0u8; needed];
-    read_exact(&mut data, &mut decompressed)?;
+    // Grown as the stream delivers, so a stream that ends early costs only what it held.
+    let mut data = Vec::new();
+    let got = (&mut z).take(needed as u64).read_to_end(&mut data).map_err(|e| zerr(data_at + data.len(), e))?;
+    if got < needed {
+        return Err(zerr(data_at + got, std::io::Error::new(std::io::ErrorKind::UnexpectedEof, "failed to fill whole buffer")));
+    }
 
     let (nv, nt) = (vertex_count as usize, triangle_count as usize);
     let value = |k: usize| -> f32 {

@@ -14,6 +14,11 @@ use crate::error::{Error, Result};
 /// More pixels than this in one layer is taken as a hostile or corrupt header: refused before the
 /// decoder allocates for it (2²⁸ pixels = a 16384² image, 3 GiB as f32 RGB).
 const MAX_PIXELS: usize = 1 << 28;
+/// Every pixel of every layer holds at least one 2-byte (half) sample, and deflate, the strongest of
+/// the compressions the `exr` crate reads, expands by at most about 1032:1 (RFC 1951 §3.2.5: a 258-byte
+/// match in 2 bits); so an honest file holds at most 516 pixels per byte. A header claiming more is
+/// refused before the decoder allocates for it.
+const MAX_PIXELS_PER_BYTE: usize = 1032 / 2;
 
 pub(super) fn decode(path: &Path, bytes: &[u8]) -> Result<Image> {
     let exr_err = |e: ::exr::error::Error| Error::format(path, "OpenEXR data", e.to_string());
@@ -25,6 +30,19 @@ pub(super) fn decode(path: &Path, bytes: &[u8]) -> Result<Image> {
                 path,
                 "header",
                 format!("data window {}×{} exceeds the limit of {MAX_PIXELS} pixels", size.width(), size.height()),
+            ));
+        }
+        let pixels = size.width() * size.height();
+        if pixels > bytes.len().saturating_mul(MAX_PIXELS_PER_BYTE) {
+            return Err(Error::format(
+                path,
+                "header",
+                format!(
+                    "data window {}×{} ({pixels} pixels) cannot be stored in a file of {} bytes: truncated or corrupt",
+                    size.width(),
+                    size.height(),
+                    bytes.len()
+                ),
             ));
         }
     }

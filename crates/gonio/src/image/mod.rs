@@ -139,12 +139,18 @@ fn format_from_magic(bytes: &[u8]) -> Option<Format> {
 /// Reads an image file into linear RGB. See the module docs for the formats.
 pub fn read_image(path: &Path) -> Result<Image> {
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
-    let format = format_from_magic(&bytes)
+    decode_image(path, &bytes)
+}
+
+/// Decodes the content of an image file into linear RGB; `path` names it in errors and, when the magic
+/// bytes are not recognised, gives the format by its extension.
+pub fn decode_image(path: &Path, bytes: &[u8]) -> Result<Image> {
+    let format = format_from_magic(bytes)
         .or_else(|| format_from_extension(path))
         .ok_or_else(|| Error::format(path, "header", format!("not a recognised image file; accepted: {READ_EXTENSIONS}")))?;
     let image = guard(path, || match format {
-        Format::Exr => exr::decode(path, &bytes),
-        Format::Hdr | Format::Png | Format::Jpeg => ldr::decode(path, &bytes, format),
+        Format::Exr => exr::decode(path, bytes),
+        Format::Hdr | Format::Png | Format::Jpeg => ldr::decode(path, bytes, format),
     })?;
     if image.width == 0 || image.height == 0 {
         return Err(Error::format(path, "header", "image has no pixels"));
@@ -380,6 +386,39 @@ mod tests {
         assert_plausible(&museum, 512, 256, "museum.exr");
         let venice = read_image(Path::new(&format!("{DATA}/envmaps/venice_sunset_1k.hdr"))).unwrap();
         assert_plausible(&venice, 1024, 512, "venice_sunset_1k.hdr");
+    }
+
+    /// Headers claiming absurd sizes in files of a few hundred bytes: a clear error, fast, and no
+    /// allocation for the claimed pixels (a 4096² EXR is under the pixel limit, but cannot be held by 300
+    /// bytes; a 10⁵ × 10⁵ PNG hits the `image` crate's 512 MiB allocation limit).
+    #[test]
+    fn absurd_dimensions_are_refused_before_allocating() {
+        let dir = scratch_dir("absurd");
+        let exr = dir.join("claims.exr");
+        write_image(&exr, &test_pattern(3, 2)).unwrap();
+        let mut bytes = std::fs::read(&exr).unwrap();
+        let at = bytes.windows(11).position(|w| w == b"dataWindow\0").unwrap() + 11 + 6 + 4;
+        bytes[at + 8..at + 12].copy_from_slice(&4095i32.to_le_bytes());
+        bytes[at + 12..at + 16].copy_from_slice(&4095i32.to_le_bytes());
+        let start = std::time::Instant::now();
+        let err = decode_image(&exr, &bytes).unwrap_err().to_string();
+        assert!(err.contains("claims.exr") && err.contains("4096×4096") && err.contains("cannot be stored in a file of"), "{err}");
+
+        // PNG: signature, then an IHDR chunk (length, type, 13 bytes, CRC over type and data).
+        let mut png = vec![0x89, b'P', b'N', b'G', 0x0d, 0x0a, 0x1a, 0x0a];
+        let mut ihdr = b"IHDR".to_vec();
+        ihdr.extend_from_slice(&100_000u32.to_be_bytes());
+        ihdr.extend_from_slice(&100_000u32.to_be_bytes());
+        ihdr.extend_from_slice(&[8, 2, 0, 0, 0]); // 8-bit RGB, deflate, adaptive filter, no interlace
+        let mut crc = flate2::Crc::new();
+        crc.update(&ihdr);
+        png.extend_from_slice(&13u32.to_be_bytes());
+        png.extend_from_slice(&ihdr);
+        png.extend_from_slice(&crc.sum().to_be_bytes());
+        png.extend_from_slice(&[0, 0, 0, 0, b'I', b'E', b'N', b'D', 0xae, 0x42, 0x60, 0x82]);
+        let err = decode_image(Path::new("claims.png"), &png).unwrap_err().to_string();
+        assert!(err.contains("claims.png"), "{err}");
+        assert!(start.elapsed().as_secs_f64() < 10.0, "took {:?}", start.elapsed());
     }
 
     #[test]

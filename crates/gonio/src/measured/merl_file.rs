@@ -206,7 +206,11 @@ impl MerlTable {
     pub fn read(path: &Path) -> Result<MerlTable> {
         let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
         let len = file.metadata().map_err(|e| Error::io(path, e))?.len();
-        let mut reader = std::io::BufReader::with_capacity(1 << 20, file);
+        MerlTable::from_reader(path, std::io::BufReader::with_capacity(1 << 20, file), len)
+    }
+
+    /// Read the content of a MERL file, `len` bytes long, from `reader`; `path` names it in errors.
+    pub fn from_reader(path: &Path, mut reader: impl Read, len: u64) -> Result<MerlTable> {
         let mut header = [0u8; 12];
         if len < 12 {
             return Err(Error::format(path, "byte 0", format!("{len} bytes: too short for a MERL BRDF file (expected {FILE_SIZE} bytes)")));

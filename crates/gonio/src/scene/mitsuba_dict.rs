@@ -31,7 +31,7 @@
 use super::mitsuba_xml::SceneDescription;
 use crate::bsdf::PLUGINS;
 use crate::error::{Error, Result};
-use crate::props::{JsonScope, Props};
+use crate::props::{JsonScope, Props, MAX_PLUGINS};
 use serde_json::Value as J;
 use std::cell::RefCell;
 use std::collections::HashMap;
@@ -137,14 +137,19 @@ pub fn load_value(value: &J, source: &str) -> Result<SceneDescription> {
         declare(&mut ids, id, v, at.clone())?;
         collect_nested_ids(map, &at, &mut ids)?;
     }
-    let scope = DictScope { ids, stack: RefCell::new(Vec::new()) };
+    let scope = DictScope { ids, stack: RefCell::new(Vec::new()), resolved: RefCell::new(HashMap::new()) };
     let mut desc = SceneDescription { source: source.to_string(), ..SceneDescription::default() };
+    let mut total = 0;
     for (key, v) in root.iter().filter(|(k, _)| *k != "type") {
         let at = format!("$.{key}");
         if v.get("type").and_then(J::as_str) == Some("ref") {
             return Err(Error::spec(at, "a reference belongs inside a plugin, not at the top level of the scene"));
         }
         let props = Props::from_json_scoped(v, &at, Some(&scope))?;
+        total += props.plugin_count();
+        if total > MAX_PLUGINS {
+            return Err(Error::spec(at, format!("more than {MAX_PLUGINS} plugins in the scene once references are expanded")));
+        }
         match props.class() {
             "shape" => desc.shapes.push(props),
             "emitter" => desc.emitters.push(props),
@@ -190,6 +195,8 @@ struct DictScope<'a> {
     ids: HashMap<String, (&'a J, String)>,
     /// References being resolved, to reject cycles.
     stack: RefCell<Vec<String>>,
+    /// Each referenced plugin, read once and copied for every further reference.
+    resolved: RefCell<HashMap<String, Props>>,
 }
 
 impl JsonScope for DictScope<'_> {
@@ -203,12 +210,21 @@ impl JsonScope for DictScope<'_> {
             known.sort_unstable();
             return Err(Error::spec(at, format!("reference to an unknown id \"{id}\" (ids: {})", known.join(", "))));
         };
+        if let Some(props) = self.resolved.borrow().get(id) {
+            return Ok(props.clone());
+        }
         if self.stack.borrow().iter().any(|s| s == id) {
             return Err(Error::spec(at, format!("reference cycle through id \"{id}\"")));
+        }
+        if self.stack.borrow().len() >= crate::props::MAX_NESTING {
+            return Err(Error::spec(at, format!("references nested more than {} deep", crate::props::MAX_NESTING)));
         }
         self.stack.borrow_mut().push(id.to_string());
         let props = Props::from_json_scoped(target, target_at, Some(self));
         self.stack.borrow_mut().pop();
+        if let Ok(p) = &props {
+            self.resolved.borrow_mut().insert(id.to_string(), p.clone());
+        }
         props
     }
 }
@@ -299,6 +315,32 @@ mod tests {
             let e = err(dict);
             assert!(e.contains(want), "{e} should contain {want}");
         }
+    }
+
+    /// A chain of references 1000 long (the readers would recurse once per link) and a chain that doubles
+    /// at each link (2⁴⁰ copies) are clear errors, quickly.
+    #[test]
+    fn hostile_reference_chains_are_errors() {
+        let start = std::time::Instant::now();
+        let mut chain = serde_json::Map::new();
+        chain.insert("type".into(), json!("scene"));
+        for i in 0..1000 {
+            chain.insert(format!("a{i}"), json!({"type": "twosided", "bsdf": {"type": "ref", "id": format!("a{}", i + 1)}}));
+        }
+        chain.insert("a1000".into(), json!({"type": "diffuse"}));
+        let e = load_value(&J::Object(chain), "d").unwrap_err().to_string();
+        assert!(e.contains("references nested more than 64 deep"), "{e}");
+        let mut doubling = serde_json::Map::new();
+        doubling.insert("type".into(), json!("scene"));
+        doubling.insert("b0".into(), json!({"type": "diffuse"}));
+        for i in 1..40 {
+            let r = json!({"type": "ref", "id": format!("b{}", i - 1)});
+            doubling.insert(format!("b{i}"), json!({"type": "blendbsdf", "bsdf_0": r, "bsdf_1": r}));
+        }
+        let e = load_value(&J::Object(doubling), "d").unwrap_err().to_string();
+        assert!(e.contains("more than 262144 plugins"), "{e}");
+        // Bounded, not benchmarked (the machine running tests is shared): unbounded, this is 2⁴⁰ plugins.
+        assert!(start.elapsed().as_secs_f64() < 20.0, "{:?}", start.elapsed());
     }
 
     #[test]

@@ -50,13 +50,22 @@ struct Loader {
     desc: SceneDescription,
     /// Files being included, to reject include cycles.
     stack: Vec<PathBuf>,
+    /// Files read by `<include>` so far, and plugins in the document so far (with references expanded).
+    included: usize,
+    plugins: usize,
 }
+
+/// At most this many `<include>`s in one load, counting repeats (2026-11, issue 8: a file that includes
+/// the next one twice, ten deep, is read 2¹⁰ times)...
+pub const MAX_INCLUDES: usize = 256;
+/// ...and at most [`MAX_PLUGINS`] plugins in the whole document once references are expanded.
+pub use crate::props::MAX_PLUGINS;
 
 impl Loader {
     fn new(overrides: &[(String, String)]) -> Self {
         let mut env = XmlEnv::default();
         env.params.extend(overrides.iter().cloned());
-        Loader { env, paths: Vec::new(), desc: SceneDescription::default(), stack: Vec::new() }
+        Loader { env, paths: Vec::new(), desc: SceneDescription::default(), stack: Vec::new(), included: 0, plugins: 0 }
     }
 
     fn file(&mut self, path: &Path, included_at: Option<&str>) -> Result<()> {
@@ -83,11 +92,18 @@ impl Loader {
         all
     }
 
+    /// A top-level plugin element, counted against [`MAX_PLUGINS`].
+    fn plugin(&mut self, node: roxmltree::Node, source: &str, at: &str) -> Result<Props> {
+        let props = Props::from_xml_element_in(node, source, &self.env)?;
+        self.plugins += props.plugin_count();
+        if self.plugins > MAX_PLUGINS {
+            return Err(Error::spec(at, format!("more than {MAX_PLUGINS} plugins in the scene once references are expanded")));
+        }
+        Ok(props)
+    }
+
     fn document(&mut self, text: &str, source: &str, dir: &Path) -> Result<()> {
-        let doc = roxmltree::Document::parse(text).map_err(|e| {
-            let p = e.pos();
-            Error::Syntax { at: format!("{source}:{}:{}", p.row, p.col), message: format!("not valid XML: {e}") }
-        })?;
+        let doc = crate::xml::parse_document(text, source)?;
         let root = doc.root_element();
         let at = xml_at(source, root);
         if !root.has_tag_name("scene") {
@@ -118,10 +134,14 @@ impl Loader {
                 "include" => {
                     let name = self.env.required(node, "filename", source)?;
                     let path = self.env.resolve_file(&name, &at)?;
+                    self.included += 1;
+                    if self.included > MAX_INCLUDES {
+                        return Err(Error::spec(at, format!("more than {MAX_INCLUDES} <include>s in one scene")));
+                    }
                     self.file(&path, Some(&at))?;
                 }
                 "integrator" | "sensor" => {
-                    let props = Props::from_xml_element_in(node, source, &self.env)?;
+                    let props = self.plugin(node, source, &at)?;
                     let slot = if node.has_tag_name("sensor") { &mut self.desc.sensor } else { &mut self.desc.integrator };
                     if let Some(prev) = slot {
                         return Err(Error::spec(at, format!("a second <{}>; the first is at {}", node.tag_name().name(), prev.at())));
@@ -129,7 +149,7 @@ impl Loader {
                     *slot = Some(props);
                 }
                 tag @ ("shape" | "emitter" | "bsdf" | "texture") => {
-                    let props = Props::from_xml_element_in(node, source, &self.env)?;
+                    let props = self.plugin(node, source, &at)?;
                     if let Some(id) = props.id() {
                         self.env.refs.insert(id.to_string(), props.clone());
                     }
@@ -143,5 +163,121 @@ impl Loader {
             }
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::time::Instant;
+
+    fn scratch(tag: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("gonio-xml-{tag}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    /// The error of loading `text`, which must come in bounded time (a generous bound: the point is that
+    /// without the limits these inputs take hours or exhaust memory; the machine running tests is shared).
+    fn refused(text: &str, dir: &Path) -> String {
+        let start = Instant::now();
+        let e = match load_str(text, "h.xml", dir, &[]) {
+            Ok(_) => panic!("accepted: {}", &text[..text.len().min(200)]),
+            Err(e) => e.to_string(),
+        };
+        assert!(start.elapsed().as_secs_f64() < 20.0, "{e}: took {:?}", start.elapsed());
+        e
+    }
+
+    const SCENE: &str = "<scene version=\"3.0.0\">";
+
+    #[test]
+    fn include_cycles_and_fan_outs_are_errors() {
+        let dir = scratch("includes");
+        std::fs::write(dir.join("a.xml"), format!("{SCENE}<include filename=\"b.xml\"/></scene>")).unwrap();
+        std::fs::write(dir.join("b.xml"), format!("{SCENE}<include filename=\"a.xml\"/></scene>")).unwrap();
+        let e = refused(&format!("{SCENE}\n<include filename=\"a.xml\"/></scene>"), &dir);
+        assert!(e.contains("a.xml` includes itself"), "{e}");
+        // Each file includes the next twice: 2²⁰ reads without the limit.
+        for i in 0..20 {
+            let inc = format!("<include filename=\"f{}.xml\"/>", i + 1);
+            std::fs::write(dir.join(format!("f{i}.xml")), format!("{SCENE}{inc}{inc}</scene>")).unwrap();
+        }
+        std::fs::write(dir.join("f20.xml"), format!("{SCENE}</scene>")).unwrap();
+        let e = refused(&format!("{SCENE}<include filename=\"f0.xml\"/></scene>"), &dir);
+        assert!(e.contains(&format!("more than {MAX_INCLUDES} <include>s")), "{e}");
+    }
+
+    #[test]
+    fn expansion_bombs_are_errors() {
+        let dir = scratch("bombs");
+        // Entities: roxmltree refuses any DTD.
+        let laughs = "<?xml version=\"1.0\"?>\n<!DOCTYPE lolz [<!ENTITY lol \"lol\"><!ENTITY lol1 \"&lol;&lol;&lol;&lol;&lol;&lol;&lol;&lol;&lol;&lol;\">\
+                      <!ENTITY lol2 \"&lol1;&lol1;&lol1;&lol1;&lol1;&lol1;&lol1;&lol1;&lol1;&lol1;\">]>\n<scene version=\"3.0.0\">&lol2;</scene>";
+        let e = refused(laughs, &dir);
+        assert!(e.starts_with("h.xml:1:") && e.contains("not valid XML") && e.contains("DTD"), "{e}");
+        // The same with defaults: each repeats the previous one ten times.
+        let mut text = format!("{SCENE}<default name=\"d0\" value=\"lol\"/>");
+        for i in 1..10 {
+            text += &format!("\n<default name=\"d{i}\" value=\"{}\"/>", format!("$d{}", i - 1).repeat(10));
+        }
+        let e = refused(&(text + "</scene>"), &dir);
+        assert!(e.contains(&format!("expands to more than {} bytes", crate::xml::MAX_SUBSTITUTED_VALUE)), "{e}");
+        // References: each plugin refers to the previous one twice (2⁴⁰ copies without the limit).
+        let mut text = format!("{SCENE}<bsdf type=\"diffuse\" id=\"b0\"/>");
+        for i in 1..40 {
+            text += &format!("\n<bsdf type=\"blendbsdf\" id=\"b{i}\"><ref id=\"b{0}\"/><ref id=\"b{0}\"/></bsdf>", i - 1);
+        }
+        let e = refused(&(text + "</scene>"), &dir);
+        assert!(e.contains(&format!("more than {MAX_PLUGINS} plugins")), "{e}");
+        // Many small ones at the top level count too.
+        let mut text = format!("{SCENE}<bsdf type=\"diffuse\" id=\"b0\"/>");
+        for i in 1..12 {
+            text += &format!("\n<bsdf type=\"blendbsdf\" id=\"b{i}\"><ref id=\"b{0}\"/><ref id=\"b{0}\"/></bsdf>", i - 1);
+        }
+        text += &"<shape type=\"sphere\"><ref id=\"b11\"/></shape>".repeat(200);
+        let e = refused(&(text + "</scene>"), &dir);
+        assert!(e.contains("plugins in the scene"), "{e}");
+    }
+
+    #[test]
+    fn deep_nesting_and_wide_plugins_are_errors() {
+        let dir = scratch("deep");
+        // Plugins 100 deep: the plugin reader's limit. Elements 100 000 deep: caught before `roxmltree`,
+        // whose recursive tokenizer overflowed the stack here (an abort, not even a panic).
+        for (depth, want) in [(100, "plugins nested more than 64 deep".to_string()), (100_000, "elements nested more than 256 deep".into())]
+        {
+            let text = format!("{SCENE}{}{}</scene>", "<bsdf type=\"twosided\">".repeat(depth), "</bsdf>".repeat(depth));
+            let e = refused(&text, &dir);
+            assert!(e.starts_with("h.xml:1:") && e.contains(&want), "{e}");
+        }
+        let params: String = (0..1100).map(|i| format!("<float name=\"p{i}\" value=\"1\"/>")).collect();
+        let e = refused(&format!("{SCENE}<bsdf type=\"diffuse\">{params}</bsdf></scene>"), &dir);
+        assert!(e.contains(&format!("more than {} parameters", crate::props::MAX_PARAMETERS)), "{e}");
+    }
+
+    #[test]
+    fn absurd_resolutions_are_errors() {
+        let film = |w: &str, h: &str| {
+            format!(
+                "{SCENE}<sensor type=\"perspective\"><film type=\"hdrfilm\"><integer name=\"width\" value=\"{w}\"/>\
+                 <integer name=\"height\" value=\"{h}\"/></film></sensor></scene>"
+            )
+        };
+        let build = |text: String| {
+            let start = Instant::now();
+            let e = load_str(&text, "r.xml", Path::new("."), &[]).and_then(crate::scene::Scene::build).unwrap_err().to_string();
+            assert!(start.elapsed().as_secs_f64() < 20.0);
+            e
+        };
+        let e = build(film("99999999999999999999999", "4"));
+        assert!(e.starts_with("r.xml:1:") && e.contains("expected an integer"), "{e}");
+        let e = build(film("1000000", "1000000"));
+        assert!(e.contains("`width`") && e.contains("65536"), "{e}");
+        let e = build(film("65536", "65536"));
+        assert!(e.contains("a 65536×65536 film has more than the 67108864 pixels"), "{e}");
+        let largest = load_str(&film("8192", "8192"), "r.xml", Path::new("."), &[]).and_then(crate::scene::Scene::build).unwrap();
+        assert_eq!((largest.film.width, largest.film.height), (8192, 8192));
     }
 }
