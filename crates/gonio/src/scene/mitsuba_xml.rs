@@ -276,7 +276,7 @@ mod tests {
         let e = build(film("1000000", "1000000"));
         assert!(e.contains("`width`") && e.contains("65536"), "{e}");
         let e = build(film("65536", "65536"));
-        assert!(e.contains("a 65536×65536 film has more than the 67108864 pixels"), "{e}");
+        assert!(e.contains("a 65536×65536 film has more than 67108864 pixels (e.g. 8192×8192), the most gonio renders"), "{e}");
         let largest = load_str(&film("8192", "8192"), "r.xml", Path::new("."), &[]).and_then(crate::scene::Scene::build).unwrap();
         assert_eq!((largest.film.width, largest.film.height), (8192, 8192));
     }
