@@ -155,7 +155,7 @@ pic 07_albedo.png "Directional albedo against θo for the same four models: abov
     "$GONIO" plot '{"type": "phong", "diffuse_reflectance": 0, "specular_reflectance": 1, "exponent": 1, "normalization": "none"}' \
     '{"type": "phong", "diffuse_reflectance": 0, "specular_reflectance": 1, "exponent": 1, "form": "original"}' \
     '{"type": "blinn_phong", "diffuse_reflectance": 0, "specular_reflectance": 1, "exponent": 10}' \
-    '{"type": "roughconductor", "distribution": "ggx", "alpha": 0.3}' --theta-o 0 --kind albedo -o $OUT/07_albedo.png
+    '{"type": "roughconductor", "distribution": "ggx", "alpha": 0.3}' --label "Phong, unnormalised" --label "Phong, original form" --label "Blinn–Phong, normalised" --label "GGX α = 0.3" --theta-o 0 --kind albedo -o $OUT/07_albedo.png
 
 # 8 ------------------------------------------------------------------------------------------------------------
 md "## 8. Layered materials: diffuse base, glossy coat" ""
