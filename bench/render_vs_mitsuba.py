@@ -29,7 +29,7 @@ On a shared machine wall time depends on the other processes: the CPU-time ratio
 there, wall time on an idle machine. The load average is printed with each table.
 
 Usage: python bench/render_vs_mitsuba.py [--spp 64] [--ref-spp 2048] [--repeats 2] [--skip-compare] [--skip-scaling]
-                                        [--baseline OTHER_GONIO]
+                                        [--baseline OTHER_GONIO ...]
 (GONIO_BIN overrides the gonio binary, target/release/gonio by default; --baseline adds rows for another
 gonio build, e.g. one from before a change, timed in the same run.)
 """
@@ -187,7 +187,7 @@ def load_note() -> str:
 # 1. gonio vs Mitsuba
 
 
-def compare(spp: int, ref_spp: int, repeats: int, tmp: Path, baseline: Path | None = None) -> None:
+def compare(spp: int, ref_spp: int, repeats: int, tmp: Path, baseline: list[Path] | None = None) -> None:
     llvm = llvm_library()
     variants = list(VARIANTS)
     if llvm is None:
@@ -204,10 +204,11 @@ def compare(spp: int, ref_spp: int, repeats: int, tmp: Path, baseline: Path | No
         rows = []
         g = best_of(repeats, lambda: run_gonio(scene, spp, {}, tmp / f"{name}.exr"))
         rows.append(("gonio", g, mse(read_exr(tmp / f"{name}.exr"), ref)))
-        if baseline is not None:
-            # Another gonio build (e.g. before a change), timed in the same run as the others.
-            b = best_of(repeats, lambda: run_gonio(scene, spp, {}, tmp / f"{name}-baseline.exr", binary=baseline))
-            rows.append(("gonio baseline", b, mse(read_exr(tmp / f"{name}-baseline.exr"), ref)))
+        for k, other in enumerate(baseline or []):
+            # Other gonio builds (e.g. before a change), timed in the same run as the others.
+            out = tmp / f"{name}-baseline{k}.exr"
+            b = best_of(repeats, lambda other=other, out=out: run_gonio(scene, spp, {}, out, binary=other))
+            rows.append((f"gonio baseline {k + 1}" if len(baseline) > 1 else "gonio baseline", b, mse(read_exr(out), ref)))
         for v in variants:
             try:
                 t, img = best_of(repeats, lambda v=v: run_mitsuba(v, scene, spp, {}, llvm))
@@ -316,7 +317,9 @@ def main() -> None:
     ap.add_argument("--repeats", type=int, default=2)
     ap.add_argument("--skip-compare", action="store_true")
     ap.add_argument("--skip-scaling", action="store_true")
-    ap.add_argument("--baseline", type=Path, help="another gonio binary to time in the same run (e.g. a build before a change)")
+    ap.add_argument(
+        "--baseline", type=Path, action="append", help="another gonio binary to time in the same run (e.g. a build before a change; repeatable)"
+    )
     args = ap.parse_args()
     if not GONIO.exists():
         sys.exit(f"{GONIO} not found: run `cargo build --release -p gonio-cli` (or `make cli`) first")
