@@ -78,14 +78,20 @@ struct Primitives {
     triangles: Vec<Triangle4>,
     /// Bit `i` of `others[k]`: slot `4k + i` holds a shape that is not a triangle.
     others: Vec<u8>,
+    /// Some bit of `others` is set (else the leaf loops skip reading them: meshes only).
+    has_others: bool,
     slots: Vec<SlotRef>,
 }
 
 impl Primitives {
     fn new(shapes: &[Shape], refs: &[SlotRef], order: &[u32]) -> Self {
         let packets = order.len() / LANES;
-        let mut p =
-            Primitives { triangles: vec![Triangle4::default(); packets], others: vec![0; packets], slots: Vec::with_capacity(order.len()) };
+        let mut p = Primitives {
+            triangles: vec![Triangle4::default(); packets],
+            others: vec![0; packets],
+            has_others: false,
+            slots: Vec::with_capacity(order.len()),
+        };
         for (slot, &i) in order.iter().enumerate() {
             let (packet, lane) = (slot / LANES, slot % LANES);
             if i == EMPTY_SLOT {
@@ -99,6 +105,7 @@ impl Primitives {
             }
             p.slots.push(r);
         }
+        p.has_others = p.others.iter().any(|&bits| bits != 0);
         p
     }
 
@@ -116,6 +123,9 @@ impl Primitives {
                     tmax = h.t[lane];
                     best = Some((packet * LANES + lane, PrimHit { t: h.t[lane], uv: Vec2::new(h.b1[lane], h.b2[lane]) }));
                 }
+            }
+            if !self.has_others {
+                continue;
             }
             let mut others = u32::from(self.others[packet]);
             while others != 0 {
@@ -138,6 +148,9 @@ impl Primitives {
         for packet in (first as usize / LANES)..(first + count) as usize / LANES {
             if self.triangles[packet].intersect(ray, ray.tmax).mask != 0 {
                 return true;
+            }
+            if !self.has_others {
+                continue;
             }
             let mut others = u32::from(self.others[packet]);
             while others != 0 {
