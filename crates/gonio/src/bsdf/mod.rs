@@ -516,9 +516,9 @@ mod tests {
     use super::*;
     use crate::sampling::rng::Pcg32;
 
-    /// The batch methods (one `match` per batch, SIMD-compiled loops, constant-choice copies of
-    /// roughconductor and roughplastic) give every example model's per-pair results bit for bit, including
-    /// directions below the horizon and on it.
+    /// The batch methods (one `match` per batch, AVX2-compiled loops, the eight-lane kernels of diffuse and
+    /// GGX roughconductor and roughplastic in `lanes`) give every example model's per-pair results bit for
+    /// bit, including directions below the horizon and on it, and the rows after the last full eight.
     #[test]
     fn batches_equal_single_calls() {
         let mut rng = Pcg32::new(7, 0);
