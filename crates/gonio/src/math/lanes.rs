@@ -309,7 +309,7 @@ impl Real for F32x8 {
     }
     #[inline(always)]
     fn is_nan(self) -> M32x8 {
-        lanes!(M32x8, |i| bits(self.0[i] != self.0[i]))
+        lanes!(M32x8, |i| bits(self.0[i].is_nan()))
     }
     #[inline(always)]
     fn select(m: M32x8, a: Self, b: Self) -> Self {
@@ -354,6 +354,9 @@ pub struct V3<R> {
     pub z: R,
 }
 
+// Named methods rather than operator traits: `R`'s operators are generic, and the few vector operations
+// the kernels need read as well spelt out.
+#[allow(clippy::should_implement_trait)]
 impl<R: Real> V3<R> {
     #[inline(always)]
     pub fn new(x: R, y: R, z: R) -> Self {
