@@ -6,6 +6,7 @@
 //! Born & Wolf, *Principles of Optics*, §1.5.2 (eqs. 20–21: the amplitude coefficients rₛ, rₚ) and
 //! pbrt-v4 §9.3 (the complex-index form for conductors).
 
+use crate::math::lanes::{channels, Real, V3};
 use crate::math::Vec3;
 use crate::spectrum::Rgb;
 
@@ -14,6 +15,13 @@ use crate::spectrum::Rgb;
 #[must_use]
 pub fn reflect(w: Vec3, n: Vec3) -> Vec3 {
     2.0 * w.dot(n) * n - w
+}
+
+/// [`reflect`] in lanes ([`Real`]).
+#[inline(always)]
+#[must_use]
+pub fn reflect_lanes<R: Real>(w: V3<R>, n: V3<R>) -> V3<R> {
+    n.scale(w.dot(n) * 2.0).sub(w)
 }
 
 /// The outcome of refracting a direction through an interface.
@@ -55,9 +63,9 @@ pub fn refract_about(wi: Vec3, n: Vec3, eta: f32) -> Option<Refraction> {
 /// cos²θₜ = 1 − (1 − cos²θᵢ)/η² written as (cos²θᵢ + η² − 1)/η², which keeps its precision when η ≈ 1
 /// and θᵢ is grazing (2026-11: the first form rounded to total internal reflection at η = 1 for
 /// |cos θᵢ| < 1.7e-4, found by the Mitsuba cross-check). ≤ 0 means total internal reflection.
-#[inline]
-fn cos2_transmitted(cos_i: f32, eta: f32) -> f32 {
-    cos_i.mul_add(cos_i, eta.mul_add(eta, -1.0)) / (eta * eta)
+#[inline(always)]
+fn cos2_transmitted<R: Real>(cos_i: R, eta: R) -> R {
+    cos_i.mul_add(cos_i, eta.mul_add(eta, R::splat(-1.0))) / (eta * eta)
 }
 
 /// Fresnel reflectances (Rₛ, Rₚ) of s- and p-polarised light at a dielectric interface.
@@ -65,29 +73,41 @@ fn cos2_transmitted(cos_i: f32, eta: f32) -> f32 {
 #[inline(always)]
 #[must_use]
 pub fn fresnel_dielectric_sp(cos_theta_i: f32, eta: f32) -> (f32, f32) {
-    let (eta, cos_i) = if cos_theta_i < 0.0 { (1.0 / eta, -cos_theta_i) } else { (eta, cos_theta_i) };
-    let cos_i = cos_i.min(1.0);
-    if eta == 1.0 {
-        // No interface at all: nothing is reflected, even at grazing incidence.
-        return (0.0, 0.0);
-    }
+    fresnel_dielectric_sp_lanes(cos_theta_i, eta)
+}
+
+/// [`fresnel_dielectric_sp`] in lanes ([`Real`]).
+#[inline(always)]
+#[must_use]
+pub fn fresnel_dielectric_sp_lanes<R: Real>(cos_theta_i: R, eta: f32) -> (R, R) {
+    let inside = cos_theta_i.lt(R::splat(0.0));
+    let (eta, cos_i) = (R::select(inside, R::splat(1.0 / eta), R::splat(eta)), R::select(inside, -cos_theta_i, cos_theta_i));
+    let cos_i = cos_i.min(R::splat(1.0));
     let cos2_t = cos2_transmitted(cos_i, eta);
-    if cos2_t <= 0.0 {
-        return (1.0, 1.0);
-    }
     let cos_t = cos2_t.sqrt();
     // Born & Wolf eq. 1.5.21 with n₁ = 1, n₂ = η.
     let rs = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
     let rp = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
-    (rs * rs, rp * rp)
+    // Total internal reflection reflects all; no interface at all (η = 1) nothing, even at grazing incidence.
+    let total = cos2_t.le(R::splat(0.0));
+    let none = eta.eq(R::splat(1.0));
+    let (zero, one) = (R::splat(0.0), R::splat(1.0));
+    (R::select(none, zero, R::select(total, one, rs * rs)), R::select(none, zero, R::select(total, one, rp * rp)))
 }
 
 /// Unpolarised Fresnel reflectance (Rₛ + Rₚ)/2 of a dielectric interface.
 #[inline(always)]
 #[must_use]
 pub fn fresnel_dielectric(cos_theta_i: f32, eta: f32) -> f32 {
-    let (rs, rp) = fresnel_dielectric_sp(cos_theta_i, eta);
-    0.5 * (rs + rp)
+    fresnel_dielectric_lanes(cos_theta_i, eta)
+}
+
+/// [`fresnel_dielectric`] in lanes ([`Real`]).
+#[inline(always)]
+#[must_use]
+pub fn fresnel_dielectric_lanes<R: Real>(cos_theta_i: R, eta: f32) -> R {
+    let (rs, rp) = fresnel_dielectric_sp_lanes(cos_theta_i, eta);
+    (rs + rp) * 0.5
 }
 
 /// The hemispherical average of the Fresnel reflectance, F̄ = 2 ∫₀¹ F(μ) μ dμ, for light arriving from the
@@ -122,15 +142,16 @@ pub fn fresnel_diffuse_reflectance(eta: f32) -> f64 {
 /// (m ≈ |t|) is taken as 2η²k²/(m ∓ t) instead, the same value rearranged, so both keep full f32
 /// precision (silver, t ≈ −23, has a² ≈ 0.024: the direct form lost ~10 bits).
 #[inline(always)]
-fn conductor_cos_t(eta_k2: f32, eta_k: f32, sin2_i: f32) -> (f32, f32) {
-    let t = eta_k2 - sin2_i;
+fn conductor_cos_t<R: Real>(eta_k2: f32, eta_k: f32, sin2_i: R) -> (R, R) {
+    let t = R::splat(eta_k2) - sin2_i;
     let two_eta_k2 = 2.0 * eta_k * eta_k;
     let m = (t * t + 2.0 * two_eta_k2).sqrt();
     let big = m + t.abs();
     // big/2 is the larger of a², b²; the smaller is (m² − t²)/(2 big) = 2η²k²/big (0 when big = 0).
-    let larger = 0.5 * big;
-    let smaller = if big > 0.0 { two_eta_k2 / big } else { 0.0 };
-    let (a2, b2) = if t >= 0.0 { (larger, smaller) } else { (smaller, larger) };
+    let larger = big * 0.5;
+    let smaller = R::select(big.gt(R::splat(0.0)), R::splat(two_eta_k2) / big, R::splat(0.0));
+    let positive = t.ge(R::splat(0.0));
+    let (a2, b2) = (R::select(positive, larger, smaller), R::select(positive, smaller, larger));
     (a2.sqrt(), b2.sqrt())
 }
 
@@ -151,17 +172,29 @@ fn conductor_cos_t(eta_k2: f32, eta_k: f32, sin2_i: f32) -> (f32, f32) {
 #[inline(always)]
 #[must_use]
 pub fn fresnel_conductor(cos_theta_i: f32, eta: f32, k: f32) -> f32 {
+    fresnel_conductor_lanes(cos_theta_i, eta, k)
+}
+
+/// [`fresnel_conductor`] in lanes ([`Real`]).
+#[inline(always)]
+#[must_use]
+pub fn fresnel_conductor_lanes<R: Real>(cos_theta_i: R, eta: f32, k: f32) -> R {
     let c = cos_theta_i.clamp(0.0, 1.0);
     // Products of sums rather than differences of squares: exact to a rounding or two near c = 1, η = k.
     // (No `mul_add`: without a target FMA it is a library call per use, which would dominate.)
-    let sin2_i = (1.0 - c) * (1.0 + c);
+    let sin2_i = (R::splat(1.0) - c) * (c + 1.0);
     let (e, f) = ((eta - k) * (eta + k), 2.0 * eta * k);
     let (a, b) = conductor_cos_t(e, eta * k, sin2_i);
-    let sq = |x: f32, y: f32| x * x + y * y;
-    let rs = sq(c - a, b) / sq(c + a, b);
-    let (ec, fc) = (e * c, f * c);
-    let rp = sq(ec - a, fc - b) / sq(ec + a, fc + b);
-    0.5 * (rs + rp)
+    let rs = sum_of_squares(c - a, b) / sum_of_squares(c + a, b);
+    let (ec, fc) = (c * e, c * f);
+    let rp = sum_of_squares(ec - a, fc - b) / sum_of_squares(ec + a, fc + b);
+    (rs + rp) * 0.5
+}
+
+/// x² + y².
+#[inline(always)]
+fn sum_of_squares<R: Real>(x: R, y: R) -> R {
+    x * x + y * y
 }
 
 /// [`fresnel_conductor`] per RGB channel: the three channels are independent lanes of the same
@@ -169,10 +202,14 @@ pub fn fresnel_conductor(cos_theta_i: f32, eta: f32, k: f32) -> f32 {
 #[inline(always)]
 #[must_use]
 pub fn fresnel_conductor_rgb(cos_theta_i: f32, eta: Rgb, k: Rgb) -> Rgb {
-    // Written out, not `array::from_fn`: that one is not always inlined, and a call in a batch loop keeps it
-    // from being vectorised.
-    let channel = |i: usize| fresnel_conductor(cos_theta_i, eta.0[i], k.0[i]);
-    Rgb([channel(0), channel(1), channel(2)])
+    Rgb(fresnel_conductor_rgb_lanes(cos_theta_i, eta, k))
+}
+
+/// [`fresnel_conductor_rgb`] in lanes ([`Real`]): one lane value per channel.
+#[inline(always)]
+#[must_use]
+pub fn fresnel_conductor_rgb_lanes<R: Real>(cos_theta_i: R, eta: Rgb, k: Rgb) -> [R; 3] {
+    channels!(|i| fresnel_conductor_lanes(cos_theta_i, eta.0[i], k.0[i]))
 }
 
 #[cfg(test)]

@@ -56,6 +56,7 @@
 //! assert!(ggx.g(wo, wo, Vec3::Z, Shadowing::VCavity) == 1.0);
 //! ```
 
+use crate::math::lanes::{Real, V3};
 use crate::math::trig::sin_cos_turn;
 use crate::math::{Vec2, Vec3};
 use std::f32::consts::PI;
@@ -168,6 +169,13 @@ impl MicrofacetDistribution {
         MicrofacetDistribution::new(MicrofacetKind::Blinn, alpha, alpha)
     }
 
+    /// This distribution's roughness as a [`Ggx`] (whatever its kind).
+    #[inline(always)]
+    #[must_use]
+    pub fn ggx(&self) -> Ggx {
+        Ggx { alpha_x: self.alpha_x, alpha_y: self.alpha_y }
+    }
+
     /// Whether αx ≠ αy.
     #[must_use]
     pub fn is_anisotropic(&self) -> bool {
@@ -213,10 +221,7 @@ impl MicrofacetDistribution {
                 }
                 (-self.stretched_slope2(wm) / z2).exp() / (PI * self.alpha_x * self.alpha_y * cos4)
             }
-            MicrofacetKind::Ggx => {
-                let t = self.stretched_slope2(wm) + z * z;
-                1.0 / (PI * self.alpha_x * self.alpha_y * t * t)
-            }
+            MicrofacetKind::Ggx => self.ggx().d(wm.into()),
         }
     }
 
@@ -235,6 +240,9 @@ impl MicrofacetDistribution {
     /// Λ of the upper-hemisphere direction (x, y, z ≥ 0).
     #[inline(always)]
     fn lambda_upper(&self, x: f32, y: f32, z: f32) -> f32 {
+        if self.kind == MicrofacetKind::Ggx {
+            return self.ggx().lambda_upper(x, y, z);
+        }
         // α(φ)² sin²θ = αx² x² + αy² y² (the projected roughness of the anisotropic case, times sin²θ).
         let (ax, ay) = (self.alpha_x * x, self.alpha_y * y);
         let s2 = ax * ax + ay * ay;
@@ -244,17 +252,9 @@ impl MicrofacetDistribution {
         if z == 0.0 {
             return f32::INFINITY;
         }
-        match self.kind {
-            MicrofacetKind::Ggx => {
-                // Λ = (−1 + √(1 + α² tan²θ))/2, written as t / (2 (1 + √(1 + t))) to avoid cancellation at small t.
-                let t = s2 / (z * z);
-                t / (2.0 * (1.0 + (1.0 + t).sqrt()))
-            }
-            MicrofacetKind::Beckmann | MicrofacetKind::Blinn => {
-                let a = z as f64 / (s2 as f64).sqrt();
-                beckmann_lambda(a) as f32
-            }
-        }
+        // Beckmann, and Blinn through its equivalent Beckmann roughness (GGX returned above).
+        let a = z as f64 / (s2 as f64).sqrt();
+        beckmann_lambda(a) as f32
     }
 
     /// Smith masking G1(ω, ωm) = χ⁺(ω·ωm) / (1 + Λ(ω)) (Heitz 2014 eq. 43), for ω on either side
@@ -262,6 +262,9 @@ impl MicrofacetDistribution {
     #[must_use]
     #[inline(always)]
     pub fn g1(&self, w: Vec3, wm: Vec3) -> f32 {
+        if self.kind == MicrofacetKind::Ggx {
+            return self.ggx().g1(w.into(), wm.into());
+        }
         if w.dot(wm) * w.z <= 0.0 {
             return 0.0;
         }
@@ -281,6 +284,7 @@ impl MicrofacetDistribution {
                 let two_nm = 2.0 * wm.z.abs();
                 1f32.min(two_nm * wo.z.abs() / o_m.abs()).min(two_nm * wi.z.abs() / i_m.abs())
             }
+            Shadowing::Smith if self.kind == MicrofacetKind::Ggx => self.ggx().g_smith(wo.into(), wi.into(), wm.into()),
             Shadowing::Smith => self.g1(wo, wm) * self.g1(wi, wm),
             Shadowing::SmithCorrelated => {
                 // 1 + (Λo + Λi): the inner sum commutes, so G(ωo, ωi) = G(ωi, ωo) bit for bit.
@@ -307,7 +311,7 @@ impl MicrofacetDistribution {
         }
         debug_assert!(wo.z > 0.0, "visible normals are sampled for directions above the surface");
         match self.kind {
-            MicrofacetKind::Ggx => self.sample_visible_ggx(wo, u),
+            MicrofacetKind::Ggx => self.ggx().sample_visible(wo.into(), u.x, u.y).into(),
             _ => self.sample_visible_beckmann(wo, u),
         }
     }
@@ -322,6 +326,9 @@ impl MicrofacetDistribution {
         if wo.z <= 0.0 {
             return 0.0;
         }
+        if self.kind == MicrofacetKind::Ggx {
+            return self.ggx().pdf_visible(wo.into(), wm.into());
+        }
         // D_ωo(ωm) = G1(ωo, ωm) max(0, ωo·ωm) D(ωm) / cos θo (Heitz & d'Eon 2014).
         self.g1(wo, wm) * wo.dot(wm).max(0.0) * self.d(wm) / wo.z
     }
@@ -331,6 +338,9 @@ impl MicrofacetDistribution {
     #[must_use]
     #[inline(always)]
     pub fn pdf_reflected(&self, wo: Vec3, wm: Vec3, visible: bool) -> f32 {
+        if self.kind == MicrofacetKind::Ggx && visible {
+            return self.ggx().pdf_reflected_visible(wo.into(), wm.into());
+        }
         scattered_density(self.pdf_wm(wo, wm, visible), 1.0 / (4.0 * wo.dot(wm).abs()))
     }
 
@@ -371,29 +381,6 @@ impl MicrofacetDistribution {
         Vec3::new(sin_theta * cos_phi, sin_theta * sin_phi, cos_theta)
     }
 
-    /// Heitz 2018, JCGT 7(4): stretch ωo to the α = 1 configuration, sample the projected hemisphere of
-    /// its visible half-disk, reproject, unstretch.
-    #[inline(always)]
-    fn sample_visible_ggx(&self, wo: Vec3, u: Vec2) -> Vec3 {
-        let vh = Vec3::new(self.alpha_x * wo.x, self.alpha_y * wo.y, wo.z).normalize();
-        // Orthonormal basis around vh (T1 is horizontal; degenerate at normal incidence).
-        let len2 = vh.x * vh.x + vh.y * vh.y;
-        let t1 = if len2 > 0.0 { Vec3::new(-vh.y, vh.x, 0.0) / len2.sqrt() } else { Vec3::X };
-        let t2 = vh.cross(t1);
-        // A uniform point on the unit disk, squeezed onto the visible half: p2 blends towards the
-        // half-disk's straight edge by s = (1 + cos θv)/2.
-        let r = u.x.sqrt();
-        // φ = 2π u.y; the polynomial sine and cosine keep the loops over samples vectorisable.
-        let (sin_phi, cos_phi) = sin_cos_turn(u.y);
-        let p1 = r * cos_phi;
-        let s = 0.5 * (1.0 + vh.z);
-        let p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * r * sin_phi;
-        // Project onto the hemisphere around vh.
-        let nh = p1 * t1 + p2 * t2 + (1.0 - p1 * p1 - p2 * p2).max(0.0).sqrt() * vh;
-        // Unstretch (the normal transforms with the inverse transpose).
-        Vec3::new(self.alpha_x * nh.x, self.alpha_y * nh.y, nh.z.max(0.0)).normalize()
-    }
-
     /// Heitz & d'Eon 2014, §4: visible-normal sampling of Beckmann through its slopes.
     fn sample_visible_beckmann(&self, wo: Vec3, u: Vec2) -> Vec3 {
         // 1. Stretch ωo to the α = 1 configuration (f64 from here on).
@@ -410,6 +397,102 @@ impl MicrofacetDistribution {
         let py = self.alpha_y as f64 * (sin_phi * slope_x + cos_phi * slope_y);
         let n = (px * px + py * py + 1.0).sqrt();
         Vec3::new((-px / n) as f32, (-py / n) as f32, (1.0 / n) as f32)
+    }
+}
+
+/// The GGX formulas in lanes ([`Real`]: one `f32` or eight at a time), for [`MicrofacetDistribution`] of
+/// kind GGX (which calls them) and the SIMD batch loops of the GGX models. Each is the scalar method of the
+/// same name with its branches turned into selects.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ggx {
+    pub alpha_x: f32,
+    pub alpha_y: f32,
+}
+
+impl Ggx {
+    /// D(ωm) = 1 / (π αx αy (s² + z²)²), zero below the surface (Walter 2007 eq. 33; Heitz 2014 §5).
+    #[inline(always)]
+    #[must_use]
+    pub fn d<R: Real>(&self, wm: V3<R>) -> R {
+        let (x, y) = (wm.x / self.alpha_x, wm.y / self.alpha_y);
+        let t = x * x + y * y + wm.z * wm.z;
+        let d = R::splat(1.0) / (t * (PI * self.alpha_x * self.alpha_y) * t);
+        R::select(wm.z.le(R::splat(0.0)), R::splat(0.0), d)
+    }
+
+    /// Smith's Λ of the upper-hemisphere direction (x, y, z ≥ 0): 0 at the pole, ∞ on the horizon.
+    #[inline(always)]
+    #[must_use]
+    pub fn lambda_upper<R: Real>(&self, x: R, y: R, z: R) -> R {
+        // α(φ)² sin²θ = αx² x² + αy² y² (the projected roughness of the anisotropic case, times sin²θ).
+        let (ax, ay) = (x * self.alpha_x, y * self.alpha_y);
+        let s2 = ax * ax + ay * ay;
+        // Λ = (−1 + √(1 + α² tan²θ))/2, written as t / (2 (1 + √(1 + t))) to avoid cancellation at small t.
+        let t = s2 / (z * z);
+        let lambda = t / ((R::splat(1.0) + (t + 1.0).sqrt()) * 2.0);
+        let zero = R::splat(0.0);
+        R::select(s2.eq(zero), zero, R::select(z.eq(zero), R::splat(f32::INFINITY), lambda))
+    }
+
+    /// Smith masking G1(ω, ωm) = χ⁺(ω·ωm) / (1 + Λ(ω)) (Heitz 2014 eq. 43), ω seen from its own side.
+    #[inline(always)]
+    #[must_use]
+    pub fn g1<R: Real>(&self, w: V3<R>, wm: V3<R>) -> R {
+        let g = R::splat(1.0) / (self.lambda_upper(w.x, w.y, w.z.abs()) + 1.0);
+        R::select((w.dot(wm) * w.z).le(R::splat(0.0)), R::splat(0.0), g)
+    }
+
+    /// Separable Smith G = G1(ωo, ωm) G1(ωi, ωm) for reflection (Heitz 2014 eq. 98).
+    #[inline(always)]
+    #[must_use]
+    pub fn g_smith<R: Real>(&self, wo: V3<R>, wi: V3<R>, wm: V3<R>) -> R {
+        let zero = R::splat(0.0);
+        let sides = (wo.dot(wm) * wo.z).le(zero) | (wi.dot(wm) * wi.z).le(zero);
+        R::select(sides, zero, self.g1(wo, wm) * self.g1(wi, wm))
+    }
+
+    /// Heitz 2018, JCGT 7(4): stretch ωo to the α = 1 configuration, sample the projected hemisphere of
+    /// its visible half-disk, reproject, unstretch. Needs `wo.z > 0`.
+    #[inline(always)]
+    #[must_use]
+    pub fn sample_visible<R: Real>(&self, wo: V3<R>, ux: R, uy: R) -> V3<R> {
+        let zero = R::splat(0.0);
+        let vh = V3::new(wo.x * self.alpha_x, wo.y * self.alpha_y, wo.z).normalize();
+        // Orthonormal basis around vh (T1 is horizontal; degenerate at normal incidence).
+        let len2 = vh.x * vh.x + vh.y * vh.y;
+        let t1 = V3::select(len2.gt(zero), V3::new(-vh.y, vh.x, zero).div(len2.sqrt()), V3::splat(crate::math::Vec3::X));
+        let t2 = vh.cross(t1);
+        // A uniform point on the unit disk, squeezed onto the visible half: p2 blends towards the
+        // half-disk's straight edge by s = (1 + cos θv)/2.
+        let r = ux.sqrt();
+        // φ = 2π u.y; the polynomial sine and cosine run in lanes.
+        let (sin_phi, cos_phi) = sin_cos_turn(uy);
+        let p1 = r * cos_phi;
+        let s = (vh.z + 1.0) * 0.5;
+        let one = R::splat(1.0);
+        let p2 = (one - s) * (one - p1 * p1).max(zero).sqrt() + s * r * sin_phi;
+        // Project onto the hemisphere around vh.
+        let nh = t1.scale(p1).add(t2.scale(p2)).add(vh.scale((one - p1 * p1 - p2 * p2).max(zero).sqrt()));
+        // Unstretch (the normal transforms with the inverse transpose).
+        V3::new(nh.x * self.alpha_x, nh.y * self.alpha_y, nh.z.max(zero)).normalize()
+    }
+
+    /// The density of [`sample_visible`](Self::sample_visible): D_ωo(ωm) = G1(ωo, ωm) max(0, ωo·ωm) D(ωm) / cos θo
+    /// (Heitz & d'Eon 2014); 0 for `wo` not above the surface.
+    #[inline(always)]
+    #[must_use]
+    pub fn pdf_visible<R: Real>(&self, wo: V3<R>, wm: V3<R>) -> R {
+        let pdf = self.g1(wo, wm) * wo.dot(wm).max(R::splat(0.0)) * self.d(wm) / wo.z;
+        R::select(wo.z.le(R::splat(0.0)), R::splat(0.0), pdf)
+    }
+
+    /// The density of ωi = reflect(ωo, ωm) for visible normals: pdf(ωm) / (4 |ωo·ωm|) (Walter 2007 eq. 14),
+    /// 0 where not finite (see `scattered_density`).
+    #[inline(always)]
+    #[must_use]
+    pub fn pdf_reflected_visible<R: Real>(&self, wo: V3<R>, wm: V3<R>) -> R {
+        let pdf = self.pdf_visible(wo, wm) * (R::splat(1.0) / (wo.dot(wm).abs() * 4.0));
+        R::select(pdf.is_finite(), pdf, R::splat(0.0))
     }
 }
 

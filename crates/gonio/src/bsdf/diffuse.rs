@@ -15,11 +15,13 @@
 //! assert!((d.f(Vec3::Z, Vec3::Z).r() - 0.8 / std::f32::consts::PI).abs() < 1e-7);
 //! ```
 
+use super::lanes::{f_one, flag_lanes, pdf_one, sample_one, LaneModel, LaneSample};
 use super::{BsdfFlags, BsdfModel, BsdfSample};
 use crate::error::Result;
+use crate::math::lanes::{channels, Real, V3};
 use crate::math::{Vec2, Vec3};
 use crate::props::Props;
-use crate::sampling::warp::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
+use crate::sampling::warp::{cosine_hemisphere, cosine_hemisphere_density};
 use crate::spectrum::Rgb;
 use std::f32::consts::FRAC_1_PI;
 
@@ -55,31 +57,52 @@ impl BsdfModel for Diffuse {
 
     #[inline(always)]
     fn f(&self, wo: Vec3, wi: Vec3) -> Rgb {
-        if wo.z <= 0.0 || wi.z <= 0.0 {
-            return Rgb::ZERO;
-        }
-        self.reflectance * FRAC_1_PI
+        f_one(self, wo, wi)
     }
 
     #[inline(always)]
-    fn sample(&self, wo: Vec3, _uc: f32, u: Vec2) -> Option<BsdfSample> {
-        if wo.z <= 0.0 {
-            return None;
-        }
-        let wi = sample_cosine_hemisphere(u);
-        let pdf = cosine_hemisphere_pdf(wi);
-        // f·cos/pdf = (ρ/π)·cos/(cos/π) = ρ: set exactly rather than through a division that is 0/0 on the
-        // horizon.
-        let mut s = BsdfSample::smooth(wi, self.reflectance * FRAC_1_PI, pdf, BsdfFlags::DIFFUSE_REFLECTION, 1.0)?;
-        s.weight = self.reflectance;
-        Some(s)
+    fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
+        sample_one(self, wo, uc, u)
     }
 
     #[inline(always)]
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        if wo.z <= 0.0 {
-            return 0.0;
-        }
-        cosine_hemisphere_pdf(wi)
+        pdf_one(self, wo, wi)
+    }
+
+    lane_batch_methods!(lanes);
+}
+
+impl Diffuse {
+    /// Every configuration has the kernel below (a copy: three numbers).
+    #[inline(always)]
+    fn lanes(&self) -> Option<Self> {
+        Some(self.clone())
+    }
+}
+
+impl LaneModel for Diffuse {
+    #[inline(always)]
+    fn f_lanes<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> [R; 3] {
+        let zero = R::splat(0.0);
+        let below = wo.z.le(zero) | wi.z.le(zero);
+        channels!(|c| R::select(below, zero, R::splat(self.reflectance.0[c] * FRAC_1_PI)))
+    }
+
+    #[inline(always)]
+    fn pdf_lanes<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> R {
+        R::select(wo.z.le(R::splat(0.0)), R::splat(0.0), cosine_hemisphere_density(wi.z))
+    }
+
+    #[inline(always)]
+    fn sample_lanes<R: Real>(&self, wo: V3<R>, _uc: R, ux: R, uy: R) -> LaneSample<R> {
+        let wi = cosine_hemisphere(ux, uy);
+        let pdf = cosine_hemisphere_density(wi.z);
+        // pdf is finite; a sample wherever it is positive (not on the horizon).
+        let valid = !wo.z.le(R::splat(0.0)) & pdf.gt(R::splat(0.0));
+        let f = channels!(|c| R::splat(self.reflectance.0[c] * FRAC_1_PI));
+        // f·cos/pdf = (ρ/π)·cos/(cos/π) = ρ: set exactly rather than through a division.
+        let weight = channels!(|c| R::splat(self.reflectance.0[c]));
+        LaneSample { wi, f, pdf, weight, flags: flag_lanes(BsdfFlags::DIFFUSE_REFLECTION), eta: R::splat(1.0), valid }
     }
 }

@@ -67,6 +67,36 @@ macro_rules! forward_bsdf_model {
     };
 }
 
+/// The three batch methods of a model with a SIMD kernel ([`lanes::LaneModel`]) for some configurations:
+/// `lane_batch_methods!(kernel);` inside its `impl BsdfModel`, where `self.kernel()` returns `Some(k)` for a
+/// configuration `k` runs (`Option<impl LaneModel>`) and `None` for the others, which take the per-pair loops
+/// ([`f_each`] and friends).
+macro_rules! lane_batch_methods {
+    ($kernel:ident) => {
+        #[inline(always)]
+        fn f_batch(&self, wo: &[$crate::math::Vec3], wi: &[$crate::math::Vec3], out: &mut [$crate::spectrum::Rgb]) {
+            match self.$kernel() {
+                Some(k) => $crate::bsdf::lanes::f_rows(&k, wo, wi, out),
+                None => $crate::bsdf::f_each(self, wo, wi, out),
+            }
+        }
+        #[inline(always)]
+        fn pdf_batch(&self, wo: &[$crate::math::Vec3], wi: &[$crate::math::Vec3], out: &mut [f32]) {
+            match self.$kernel() {
+                Some(k) => $crate::bsdf::lanes::pdf_rows(&k, wo, wi, out),
+                None => $crate::bsdf::pdf_each(self, wo, wi, out),
+            }
+        }
+        #[inline(always)]
+        fn sample_batch(&self, wo: &[$crate::math::Vec3], uc: &[f32], u: &[$crate::math::Vec2], out: &mut $crate::bsdf::SampleColumns<'_>) {
+            match self.$kernel() {
+                Some(k) => $crate::bsdf::lanes::sample_rows(&k, wo, uc, u, out),
+                None => $crate::bsdf::sample_each(self, wo, uc, u, out),
+            }
+        }
+    };
+}
+
 pub mod ashikhmin_shirley;
 pub mod blend;
 pub mod blinn_phong;
@@ -75,6 +105,7 @@ pub mod dielectric;
 pub mod diffuse;
 pub mod energy_compensation;
 pub mod glossy_mix;
+pub mod lanes;
 pub mod layered;
 pub mod mask;
 pub mod measured;
@@ -341,20 +372,24 @@ pub trait Examples {
 
 /// Runs `$call` (one model's batch loop, chosen by one `match`) compiled twice: for the baseline target and,
 /// on x86-64 CPUs that have them (detected at run time, so one wheel runs everywhere), with AVX2 and FMA,
-/// whose 8-wide registers the compiler's loop vectoriser fills. Both builds round alike: Rust never fuses a
-/// multiply and an add on its own, and `mul_add` is the same exact operation in hardware and in libm, so
-/// the results are the same bit for bit on every path (test `batches_equal_single_calls`).
+/// whose 8-wide registers the kernels' lanes fill ([`lanes`]). The `match` and the loops it inlines are the
+/// body of a function compiled with those features (`$arg: $ty` are its parameters, named as in `$call`):
+/// a closure would not do, as it is compiled once, for the baseline, and merely called from the feature
+/// function (2026-11: that was the case before, and the AVX2 build held no 256-bit instruction). Both builds
+/// round alike: Rust never fuses a multiply and an add on its own, and `mul_add` is the same exact operation
+/// in hardware and in libm, so the results are the same bit for bit on every path (test
+/// `batches_equal_single_calls`).
 macro_rules! simd_batch {
-    ($self:ident, $m:ident => $call:expr) => {{
+    ($self:ident, $m:ident => $call:expr; $($arg:ident: $ty:ty),*) => {{
         #[cfg(target_arch = "x86_64")]
         {
             #[target_feature(enable = "avx2,fma")]
-            unsafe fn with_avx2(b: &Bsdf, run: impl FnOnce(&Bsdf)) {
-                run(b)
+            unsafe fn with_avx2(b: &Bsdf, $($arg: $ty),*) {
+                dispatch!(b, $m => $call)
             }
             if std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma") {
                 // SAFETY: the CPU has the features the function is compiled for (checked just above).
-                return unsafe { with_avx2($self, |b| dispatch!(b, $m => $call)) };
+                return unsafe { with_avx2($self, $($arg),*) };
             }
         }
         dispatch!($self, $m => $call)
@@ -388,13 +423,13 @@ macro_rules! bsdf_models {
             #[inline]
             fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 { dispatch!(self, m => m.pdf(wo, wi)) }
             fn f_batch(&self, wo: &[Vec3], wi: &[Vec3], out: &mut [Rgb]) {
-                simd_batch!(self, m => m.f_batch(wo, wi, out))
+                simd_batch!(self, m => m.f_batch(wo, wi, out); wo: &[Vec3], wi: &[Vec3], out: &mut [Rgb])
             }
             fn pdf_batch(&self, wo: &[Vec3], wi: &[Vec3], out: &mut [f32]) {
-                simd_batch!(self, m => m.pdf_batch(wo, wi, out))
+                simd_batch!(self, m => m.pdf_batch(wo, wi, out); wo: &[Vec3], wi: &[Vec3], out: &mut [f32])
             }
             fn sample_batch(&self, wo: &[Vec3], uc: &[f32], u: &[Vec2], out: &mut SampleColumns<'_>) {
-                simd_batch!(self, m => m.sample_batch(wo, uc, u, out))
+                simd_batch!(self, m => m.sample_batch(wo, uc, u, out); wo: &[Vec3], uc: &[f32], u: &[Vec2], out: &mut SampleColumns<'_>)
             }
         }
 
@@ -481,9 +516,9 @@ mod tests {
     use super::*;
     use crate::sampling::rng::Pcg32;
 
-    /// The batch methods (one `match` per batch, SIMD-compiled loops, constant-choice copies of
-    /// roughconductor and roughplastic) give every example model's per-pair results bit for bit, including
-    /// directions below the horizon and on it.
+    /// The batch methods (one `match` per batch, AVX2-compiled loops, the eight-lane kernels of diffuse and
+    /// GGX roughconductor and roughplastic in `lanes`) give every example model's per-pair results bit for
+    /// bit, including directions below the horizon and on it, and the rows after the last full eight.
     #[test]
     fn batches_equal_single_calls() {
         let mut rng = Pcg32::new(7, 0);

@@ -50,6 +50,7 @@ use super::dielectric::relative_ior_with_default;
 use super::{BsdfFlags, BsdfModel, BsdfSample};
 use crate::error::Result;
 use crate::fresnel::{fresnel_dielectric, fresnel_diffuse_reflectance, reflect};
+use crate::math::lanes::{channels, Real};
 use crate::math::{Vec2, Vec3};
 use crate::props::Props;
 use crate::sampling::warp::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
@@ -77,11 +78,12 @@ pub(crate) const POLYPROPYLENE: f32 = 1.49;
 /// `plastic` and `roughplastic`.
 #[must_use]
 #[inline(always)]
-pub(crate) fn coated_diffuse(rho: Rgb, t_o: f32, t_i: f32, eta: f32, internal_reflectance: f32, nonlinear: bool) -> Rgb {
+pub(crate) fn coated_diffuse<R: Real>(rho: Rgb, t_o: R, t_i: R, eta: f32, internal_reflectance: f32, nonlinear: bool) -> [R; 3] {
     let scale = t_o * t_i * FRAC_1_PI / (eta * eta);
-    rho.map(|r| {
+    channels!(|c| {
+        let r = rho.0[c];
         let denom = 1.0 - if nonlinear { r * internal_reflectance } else { internal_reflectance };
-        r / denom * scale
+        scale * (r / denom)
     })
 }
 
@@ -101,14 +103,10 @@ pub(crate) fn specular_sampling_weight(diffuse: Rgb, specular: Rgb) -> f32 {
 /// coating and the steering weight is `w`: r w / (r w + (1 − r)(1 − w)).
 #[must_use]
 #[inline(always)]
-pub(crate) fn specular_probability(r: f32, w: f32) -> f32 {
-    let (s, d) = (r * w, (1.0 - r) * (1.0 - w));
+pub(crate) fn specular_probability<R: Real>(r: R, w: f32) -> R {
+    let (s, d) = (r * w, (R::splat(1.0) - r) * (1.0 - w));
     // Both lobes carry nothing (e.g. a black specular multiplier and total reflection): pick either.
-    if s + d > 0.0 {
-        s / (s + d)
-    } else {
-        0.0
-    }
+    R::select((s + d).gt(R::splat(0.0)), s / (s + d), R::splat(0.0))
 }
 
 /// The parameters both plastics share.
@@ -167,7 +165,7 @@ impl BsdfModel for Plastic {
             return Rgb::ZERO;
         }
         let (t_o, t_i) = (1.0 - fresnel_dielectric(wo.z, self.eta), 1.0 - fresnel_dielectric(wi.z, self.eta));
-        coated_diffuse(self.diffuse_reflectance, t_o, t_i, self.eta, self.internal_reflectance, self.nonlinear)
+        Rgb(coated_diffuse(self.diffuse_reflectance, t_o, t_i, self.eta, self.internal_reflectance, self.nonlinear))
     }
 
     fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {

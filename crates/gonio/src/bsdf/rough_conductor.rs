@@ -43,11 +43,13 @@
 //! ```
 
 use super::energy_compensation::ConductorCompensation;
-use super::{f_each, pdf_each, sample_each, BsdfFlags, BsdfModel, BsdfSample, Conductor, SampleColumns};
+use super::lanes::{f_one, flag_lanes, pdf_one, sample_one, LaneModel, LaneSample};
+use super::{BsdfFlags, BsdfModel, BsdfSample, Conductor};
 use crate::error::{Error, Result};
-use crate::fresnel::reflect;
+use crate::fresnel::{fresnel_conductor_rgb_lanes, reflect, reflect_lanes};
+use crate::math::lanes::{channels, Real, V3};
 use crate::math::{Vec2, Vec3};
-use crate::microfacet::{alpha_from_blinn_exponent, MicrofacetDistribution, MicrofacetKind, Shadowing};
+use crate::microfacet::{alpha_from_blinn_exponent, Ggx, MicrofacetDistribution, MicrofacetKind, Shadowing};
 use crate::props::Props;
 use crate::spectrum::Rgb;
 
@@ -181,19 +183,66 @@ impl MicrofacetConductor {
     }
 }
 
+/// The common configuration of [`MicrofacetConductor`] — GGX, separable Smith, visible normals, no
+/// compensation — in lanes ([`LaneModel`]): `f`, `pdf` and `sample` of that configuration are these, for
+/// single calls and batches alike.
+#[derive(Clone, Copy, Debug)]
+pub struct GgxConductor {
+    ggx: Ggx,
+    eta_k: Option<(Rgb, Rgb)>,
+    specular_reflectance: Rgb,
+}
+
 impl MicrofacetConductor {
-    /// For the common configuration (GGX, Smith, visible normals, no compensation), a copy of this model whose
-    /// choices are constants: inlined into a batch loop they fold away, and what is left is branch-free
-    /// arithmetic the compiler vectorises. The copy computes the same values. `None` for the others.
+    /// The [`GgxConductor`] kernel of this model, `None` for other configurations.
     #[inline(always)]
-    fn constant_choices(&self) -> Option<MicrofacetConductor> {
+    fn lanes(&self) -> Option<GgxConductor> {
         let d = self.distribution;
-        if !(d.kind == MicrofacetKind::Ggx && self.shadowing == Shadowing::Smith && self.sample_visible && self.compensation.is_none()) {
-            return None;
+        (d.kind == MicrofacetKind::Ggx && self.shadowing == Shadowing::Smith && self.sample_visible && self.compensation.is_none())
+            .then_some(GgxConductor { ggx: d.ggx(), eta_k: self.fresnel.eta_k, specular_reflectance: self.fresnel.specular_reflectance })
+    }
+}
+
+impl LaneModel for GgxConductor {
+    /// [`MicrofacetConductor::eval`] for GGX: the same steps, with selects for its early returns.
+    #[inline(always)]
+    fn f_lanes<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> [R; 3] {
+        let zero = R::splat(0.0);
+        let wm = wo.add(wi).normalize();
+        let d = self.ggx.d(wm);
+        let g = self.ggx.g_smith(wo, wi, wm);
+        let value = d * g / (wo.z * 4.0 * wi.z);
+        // Below the surface, D = 0, or within f32 underflow of the horizon (see `eval`): 0.
+        let ok = !(wo.z.le(zero) | wi.z.le(zero)) & d.ne(zero) & value.is_finite();
+        let cos_theta_d = (wo.dot(wm) + wi.dot(wm)) * 0.5;
+        let fresnel = match self.eta_k {
+            Some((eta, k)) => fresnel_conductor_rgb_lanes(cos_theta_d, eta, k),
+            None => [R::splat(1.0); 3],
+        };
+        let s = self.specular_reflectance.0;
+        channels!(|c| R::select(ok, fresnel[c] * s[c] * value, zero))
+    }
+
+    /// [`MicrofacetConductor::pdf_lobe`] for GGX visible normals.
+    #[inline(always)]
+    fn pdf_lanes<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> R {
+        let zero = R::splat(0.0);
+        let wm = wo.add(wi).normalize();
+        R::select(wo.z.le(zero) | wi.z.le(zero), zero, self.ggx.pdf_reflected_visible(wo, wm))
+    }
+
+    /// [`MicrofacetConductor::sample_lobe`] for GGX visible normals.
+    #[inline(always)]
+    fn sample_lanes<R: Real>(&self, wo: V3<R>, _uc: R, ux: R, uy: R) -> LaneSample<R> {
+        let zero = R::splat(0.0);
+        let above = !wo.z.le(zero);
+        if !R::any(above) {
+            return LaneSample::none(above);
         }
-        let fresnel = Conductor { eta_k: self.fresnel.eta_k, specular_reflectance: self.fresnel.specular_reflectance };
-        let distribution = MicrofacetDistribution { kind: MicrofacetKind::Ggx, ..d };
-        Some(MicrofacetConductor { distribution, shadowing: Shadowing::Smith, sample_visible: true, fresnel, compensation: None })
+        let wm = self.ggx.sample_visible(wo, ux, uy);
+        let wi = reflect_lanes(wo, wm).normalize();
+        let valid = above & !(wi.z.is_nan() | wi.z.le(zero));
+        LaneSample::smooth(wi, self.f_lanes(wo, wi), self.pdf_lanes(wo, wi), flag_lanes(BsdfFlags::GLOSSY_REFLECTION), valid)
     }
 }
 
@@ -273,6 +322,9 @@ impl BsdfModel for MicrofacetConductor {
 
     #[inline(always)]
     fn f(&self, wo: Vec3, wi: Vec3) -> Rgb {
+        if let Some(k) = self.lanes() {
+            return f_one(&k, wo, wi);
+        }
         let single = self.eval(wo, wi);
         match &self.compensation {
             Some(ms) if wo.z > 0.0 && wi.z > 0.0 => single + ms.f(wo.z, wi.z),
@@ -284,6 +336,9 @@ impl BsdfModel for MicrofacetConductor {
     /// 1 − E(μo) instead.
     #[inline(always)]
     fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
+        if let Some(k) = self.lanes() {
+            return sample_one(&k, wo, uc, u);
+        }
         let Some(ms) = &self.compensation else { return self.sample_lobe(wo, u) };
         if !(wo.z > 0.0) {
             return None;
@@ -302,6 +357,9 @@ impl BsdfModel for MicrofacetConductor {
 
     #[inline(always)]
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        if let Some(k) = self.lanes() {
+            return pdf_one(&k, wo, wi);
+        }
         let lobe = self.pdf_lobe(wo, wi);
         match &self.compensation {
             Some(ms) if wo.z > 0.0 && wi.z > 0.0 => {
@@ -312,32 +370,7 @@ impl BsdfModel for MicrofacetConductor {
         }
     }
 
-    #[inline(always)]
-    fn f_batch(&self, wo: &[Vec3], wi: &[Vec3], out: &mut [Rgb]) {
-        // Two calls rather than a closure: each loop is inlined with its own constants.
-        match self.constant_choices() {
-            Some(m) => f_each(&m, wo, wi, out),
-            None => f_each(self, wo, wi, out),
-        }
-    }
-
-    #[inline(always)]
-    fn pdf_batch(&self, wo: &[Vec3], wi: &[Vec3], out: &mut [f32]) {
-        // Two calls rather than a closure: each loop is inlined with its own constants.
-        match self.constant_choices() {
-            Some(m) => pdf_each(&m, wo, wi, out),
-            None => pdf_each(self, wo, wi, out),
-        }
-    }
-
-    #[inline(always)]
-    fn sample_batch(&self, wo: &[Vec3], uc: &[f32], u: &[Vec2], out: &mut SampleColumns<'_>) {
-        // Two calls rather than a closure: each loop is inlined with its own constants.
-        match self.constant_choices() {
-            Some(m) => sample_each(&m, wo, uc, u, out),
-            None => sample_each(self, wo, uc, u, out),
-        }
-    }
+    lane_batch_methods!(lanes);
 }
 
 /// Mitsuba's rough conductor: Beckmann or GGX with separable Smith shadowing.

@@ -55,14 +55,17 @@
 //! assert!(s.wi.z > 0.0 && (s.pdf - b.pdf(wo, s.wi)).abs() <= 1e-5 * s.pdf);
 //! ```
 
+use super::lanes::{f_one, flag_lanes, pdf_one, sample_one, LaneModel, LaneSample};
 use super::plastic::{coated_diffuse, specular_probability, specular_sampling_weight, CoatingParams};
 use super::rough_conductor::{read_distribution, MicrofacetParams};
-use super::{f_each, pdf_each, sample_each, BsdfFlags, BsdfModel, BsdfSample, RoughDielectric, SampleColumns};
+use super::{BsdfFlags, BsdfModel, BsdfSample, RoughDielectric};
 use crate::error::{Error, Result};
+use crate::fresnel::{fresnel_dielectric_lanes, reflect_lanes};
+use crate::math::lanes::{channels, Real, V3};
 use crate::math::{Vec2, Vec3};
-use crate::microfacet::{MicrofacetDistribution, MicrofacetKind};
+use crate::microfacet::{Ggx, MicrofacetDistribution, MicrofacetKind};
 use crate::props::Props;
-use crate::sampling::warp::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
+use crate::sampling::warp::{cosine_hemisphere, cosine_hemisphere_density, cosine_hemisphere_pdf, sample_cosine_hemisphere};
 use crate::spectrum::Rgb;
 use crate::verify::energy::direction;
 use rayon::prelude::*;
@@ -226,23 +229,29 @@ impl BsdfModel for RoughPlastic {
 
     #[inline(always)]
     fn f(&self, wo: Vec3, wi: Vec3) -> Rgb {
+        if let Some(k) = self.lanes() {
+            return f_one(&k, wo, wi);
+        }
         if !(wo.z > 0.0 && wi.z > 0.0) {
             return Rgb::ZERO;
         }
-        let diffuse = coated_diffuse(
+        let diffuse = Rgb(coated_diffuse(
             self.diffuse_reflectance,
             self.transmittance(wo.z),
             self.transmittance(wi.z),
             self.coating.eta,
             self.internal_reflectance(),
             self.nonlinear,
-        );
+        ));
         // With compensation the coating's reflection includes its multiply scattered part.
         self.coating.reflection(wo, wi) + diffuse
     }
 
     #[inline(always)]
     fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
+        if let Some(k) = self.lanes() {
+            return sample_one(&k, wo, uc, u);
+        }
         if !(wo.z > 0.0) {
             return None;
         }
@@ -266,6 +275,9 @@ impl BsdfModel for RoughPlastic {
 
     #[inline(always)]
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        if let Some(k) = self.lanes() {
+            return pdf_one(&k, wo, wi);
+        }
         if !(wo.z > 0.0 && wi.z > 0.0) {
             return 0.0;
         }
@@ -280,54 +292,128 @@ impl BsdfModel for RoughPlastic {
         p * specular + (1.0 - p) * cosine_hemisphere_pdf(wi)
     }
 
-    #[inline(always)]
-    fn f_batch(&self, wo: &[Vec3], wi: &[Vec3], out: &mut [Rgb]) {
-        // Two calls rather than a closure: each loop is inlined with its own constants.
-        match self.constant_choices() {
-            Some(m) => f_each(&m, wo, wi, out),
-            None => f_each(self, wo, wi, out),
-        }
-    }
+    lane_batch_methods!(lanes);
+}
 
-    #[inline(always)]
-    fn pdf_batch(&self, wo: &[Vec3], wi: &[Vec3], out: &mut [f32]) {
-        // Two calls rather than a closure: each loop is inlined with its own constants.
-        match self.constant_choices() {
-            Some(m) => pdf_each(&m, wo, wi, out),
-            None => pdf_each(self, wo, wi, out),
-        }
-    }
-
-    #[inline(always)]
-    fn sample_batch(&self, wo: &[Vec3], uc: &[f32], u: &[Vec2], out: &mut SampleColumns<'_>) {
-        // Two calls rather than a closure: each loop is inlined with its own constants.
-        match self.constant_choices() {
-            Some(m) => sample_each(&m, wo, uc, u, out),
-            None => sample_each(self, wo, uc, u, out),
-        }
-    }
+/// GGX rough plastic with visible-normal sampling and no compensation, in lanes ([`LaneModel`]): `f`, `pdf`
+/// and `sample` of that configuration are these, for single calls and batches alike. Each step is the one
+/// of [`RoughPlastic`]'s methods and [`RoughDielectric::reflection`] with selects for the early returns.
+#[derive(Clone, Copy, Debug)]
+pub struct GgxPlastic<'a> {
+    ggx: Ggx,
+    eta: f32,
+    specular_reflectance: Rgb,
+    diffuse_reflectance: Rgb,
+    internal_reflectance: f32,
+    nonlinear: bool,
+    /// The steering weight of the glossy lobe ([`specular_sampling_weight`]).
+    weight: f32,
+    tables: &'a CoatingTables,
 }
 
 impl RoughPlastic {
-    /// For GGX with visible-normal sampling, a copy whose distribution and sampling choice are constants (see
-    /// `MicrofacetConductor::constant_choices`); `None` otherwise.
+    /// The [`GgxPlastic`] kernel of this model, `None` for other configurations.
     #[inline(always)]
-    fn constant_choices(&self) -> Option<RoughPlastic> {
+    fn lanes(&self) -> Option<GgxPlastic<'_>> {
         let c = &self.coating;
-        if !(c.distribution.kind == MicrofacetKind::Ggx && c.sample_visible && c.compensation.is_none()) {
-            return None;
-        }
-        let coating = RoughDielectric {
-            distribution: MicrofacetDistribution { kind: MicrofacetKind::Ggx, ..c.distribution },
-            sample_visible: true,
-            ..c.clone()
-        };
-        Some(RoughPlastic {
-            coating,
+        (c.distribution.kind == MicrofacetKind::Ggx && c.sample_visible && c.compensation.is_none()).then(|| GgxPlastic {
+            ggx: c.distribution.ggx(),
+            eta: c.eta,
+            specular_reflectance: c.specular_reflectance,
             diffuse_reflectance: self.diffuse_reflectance,
+            internal_reflectance: self.tables.internal_reflectance,
             nonlinear: self.nonlinear,
-            tables: self.tables.clone(),
+            weight: specular_sampling_weight(self.diffuse_reflectance, c.specular_reflectance),
+            tables: &self.tables,
         })
+    }
+}
+
+impl GgxPlastic<'_> {
+    /// T(μ) per lane (a table lookup).
+    #[inline(always)]
+    fn transmittance<R: Real>(&self, mu: R) -> R {
+        mu.map(|m| self.tables.transmittance(m))
+    }
+
+    /// [`RoughPlastic::specular_probability`].
+    #[inline(always)]
+    fn specular_probability<R: Real>(&self, cos_theta_o: R) -> R {
+        specular_probability(R::splat(1.0) - self.transmittance(cos_theta_o), self.weight)
+    }
+
+    /// The microfacet normal of a reflected pair with `wo` above ([`RoughDielectric`]'s half vector,
+    /// turned to +z), and the lanes where it is defined.
+    #[inline(always)]
+    fn half_vector<R: Real>(wo: V3<R>, wi: V3<R>) -> (V3<R>, R::Mask) {
+        let zero = R::splat(0.0);
+        let h = wo.add(wi);
+        let len = h.length();
+        let wm = h.div(len);
+        let wm = V3::select(wm.z.lt(zero), wm.neg(), wm);
+        let defined = !(wo.z.le(zero) | wi.z.eq(zero)) & wi.z.gt(zero) & len.gt(zero) & len.is_finite();
+        (wm, defined)
+    }
+
+    /// [`RoughDielectric::reflection`] (no compensation): Walter 2007 eq. 20.
+    #[inline(always)]
+    fn reflection<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> [R; 3] {
+        let zero = R::splat(0.0);
+        let (wm, defined) = Self::half_vector(wo, wi);
+        let d = self.ggx.d(wm);
+        let g = self.ggx.g_smith(wo, wi, wm);
+        let f = fresnel_dielectric_lanes((wo.dot(wm) + wi.dot(wm)) * 0.5, self.eta);
+        let value = f * d * g / (wo.z * 4.0 * wi.z);
+        let ok = (wo.z * wi.z).gt(zero) & defined & !(d.eq(zero) | g.eq(zero)) & value.is_finite();
+        channels!(|c| R::select(ok, value * self.specular_reflectance.0[c], zero))
+    }
+
+    /// [`RoughDielectric::reflection_pdf`] for GGX visible normals.
+    #[inline(always)]
+    fn reflection_pdf<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> R {
+        let zero = R::splat(0.0);
+        let (wm, defined) = Self::half_vector(wo, wi);
+        let ok = !(wo.z.le(zero) | wi.z.le(zero)) & defined & !wo.dot(wm).le(zero);
+        R::select(ok, self.ggx.pdf_reflected_visible(wo, wm), zero)
+    }
+}
+
+impl LaneModel for GgxPlastic<'_> {
+    #[inline(always)]
+    fn f_lanes<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> [R; 3] {
+        let zero = R::splat(0.0);
+        let above = wo.z.gt(zero) & wi.z.gt(zero);
+        let (t_o, t_i) = (self.transmittance(wo.z), self.transmittance(wi.z));
+        let diffuse = coated_diffuse(self.diffuse_reflectance, t_o, t_i, self.eta, self.internal_reflectance, self.nonlinear);
+        let specular = self.reflection(wo, wi);
+        channels!(|c| R::select(above, specular[c] + diffuse[c], zero))
+    }
+
+    #[inline(always)]
+    fn pdf_lanes<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> R {
+        let zero = R::splat(0.0);
+        let above = wo.z.gt(zero) & wi.z.gt(zero);
+        let p = self.specular_probability(wo.z);
+        let pdf = p * self.reflection_pdf(wo, wi) + (R::splat(1.0) - p) * cosine_hemisphere_density(wi.z);
+        R::select(above, pdf, zero)
+    }
+
+    #[inline(always)]
+    fn sample_lanes<R: Real>(&self, wo: V3<R>, uc: R, ux: R, uy: R) -> LaneSample<R> {
+        let zero = R::splat(0.0);
+        let above = wo.z.gt(zero);
+        if !R::any(above) {
+            return LaneSample::none(above);
+        }
+        // The glossy lobe with probability p (its sample may fail), else the base's cosine lobe.
+        let glossy = uc.lt(self.specular_probability(wo.z));
+        let wm = self.ggx.sample_visible(wo, ux, uy);
+        let reflected = reflect_lanes(wo, wm).normalize();
+        let glossy_ok = wo.dot(wm).gt(zero) & reflected.z.gt(zero);
+        let wi = V3::select(glossy, reflected, cosine_hemisphere(ux, uy));
+        let flags = R::select(glossy, flag_lanes(BsdfFlags::GLOSSY_REFLECTION), flag_lanes(BsdfFlags::DIFFUSE_REFLECTION));
+        let valid = above & (!glossy | glossy_ok) & wi.z.gt(zero);
+        LaneSample::smooth(wi, self.f_lanes(wo, wi), self.pdf_lanes(wo, wi), flags, valid)
     }
 }
 

@@ -1,6 +1,7 @@
 //! Vectors (re-exported from `glam`), the shading frame and spherical coordinates.
 
 pub mod frame;
+pub mod lanes;
 pub mod spherical;
 pub mod transform;
 pub mod trig;

@@ -1,39 +1,44 @@
 //! Short polynomial sine and cosine for arguments in [−π/4, π/4], for inner loops (the concentric disk
-//! map) where a general `sin_cos` call with its range reduction dominates.
+//! map, visible-normal sampling) where a general `sin_cos` call with its range reduction dominates, and
+//! which must run in SIMD lanes ([`Real`]).
+
+use crate::math::lanes::Real;
 
 /// (sin x, cos x) for |x| ≤ π/4 by the Taylor polynomials through x⁹ and x¹⁰ (Abramowitz & Stegun 4.3.65,
 /// 4.3.66). The truncation error is below x¹¹/11! ≤ 1.8e-9 (sine) and x¹²/12! ≤ 1.2e-10 (cosine) at
 /// |x| = π/4, far under f32's rounding, so the result is within 2 ulp of the correctly rounded value
 /// (test `matches_std_within_2_ulp`). Outside [−π/4, π/4] the error grows quickly: callers reduce first.
+/// Generic over [`Real`]: the same operations on one `f32` or in eight lanes.
 #[inline(always)]
 #[must_use]
-pub fn sin_cos_quarter(x: f32) -> (f32, f32) {
+pub fn sin_cos_quarter<R: Real>(x: R) -> (R, R) {
     let x2 = x * x;
     // Horner in x²: sin x = x (1 − x²/3! (1 − x²/(4·5) (1 − x²/(6·7) (1 − x²/(8·9))))), likewise cos.
-    let s = x * (1.0 - x2 / 6.0 * (1.0 - x2 / 20.0 * (1.0 - x2 / 42.0 * (1.0 - x2 / 72.0))));
-    let c = 1.0 - x2 / 2.0 * (1.0 - x2 / 12.0 * (1.0 - x2 / 30.0 * (1.0 - x2 / 56.0 * (1.0 - x2 / 90.0))));
+    let one = R::splat(1.0);
+    let s = x * (one - x2 / 6.0 * (one - x2 / 20.0 * (one - x2 / 42.0 * (one - x2 / 72.0))));
+    let c = one - x2 / 2.0 * (one - x2 / 12.0 * (one - x2 / 30.0 * (one - x2 / 56.0 * (one - x2 / 90.0))));
     (s, c)
 }
 
-/// (sin 2πt, cos 2πt) for any finite `t` (in turns), branch-free so that loops over it vectorise: t is
+/// (sin 2πt, cos 2πt) for finite `t` (in turns) with |t| < 2²¹, branch-free so that it runs in lanes: t is
 /// reduced to the nearest quarter turn q/4 and the rest r = t − q/4 ∈ [−1/8, 1/8] (exact: q/4 is a
 /// multiple of 1/4 within a factor of two of t, or t itself is small); [`sin_cos_quarter`] at 2πr ∈
 /// [−π/4, π/4] is then rotated by q quarter turns. Within 3 ulp of the correctly rounded value for t in
 /// [0, 1] (test `turns_match_std`), as good as `(2π t).sin_cos()`, whose rounding of 2πt is of the same size.
 #[inline(always)]
 #[must_use]
-pub fn sin_cos_turn(t: f32) -> (f32, f32) {
-    let q = (4.0 * t).round();
-    let r = t - 0.25 * q;
-    let (s, c) = sin_cos_quarter(std::f32::consts::TAU * r);
-    // Rotation by q·π/2: q ≡ 0: (s, c), 1: (c, −s), 2: (−s, −c), 3: (−c, s) (mod 4).
-    let quadrant = (q as i32) & 3;
-    let (s, c) = if quadrant & 1 == 0 { (s, c) } else { (c, -s) };
-    if quadrant & 2 == 0 {
-        (s, c)
-    } else {
-        (-s, -c)
-    }
+pub fn sin_cos_turn<R: Real>(t: R) -> (R, R) {
+    let q = (t * 4.0).round();
+    let r = t - q * 0.25;
+    let (s, c) = sin_cos_quarter(r * std::f32::consts::TAU);
+    // Rotation by q·π/2: q ≡ 0: (s, c), 1: (c, −s), 2: (−s, −c), 3: (−c, s) (mod 4). m = q − 4·round(q/4) ∈
+    // [−2, 2] is q mod 4 up to a multiple of 4, exact in f32 for integers below 2²³: q ≡ 1 ⇔ m = 1, q ≡ 2 ⇔
+    // |m| = 2, q ≡ 3 ⇔ m = −1.
+    let m = q - (q * 0.25).round() * 4.0;
+    let odd = m.abs().eq(R::splat(1.0));
+    let (s, c) = (R::select(odd, c, s), R::select(odd, -s, c));
+    let flip = m.abs().eq(R::splat(2.0)) | m.eq(R::splat(-1.0));
+    (R::select(flip, -s, s), R::select(flip, -c, c))
 }
 
 #[cfg(test)]
@@ -46,6 +51,8 @@ mod tests {
         for i in 0..=n {
             let t = i as f32 / n as f32;
             let (s, c) = sin_cos_turn(t);
+            let (s8, c8) = sin_cos_turn(crate::math::lanes::F32x8::splat(t));
+            assert!(s8.0.iter().all(|v| v.to_bits() == s.to_bits()) && c8.0.iter().all(|v| v.to_bits() == c.to_bits()));
             let (ws, wc) = (std::f64::consts::TAU * f64::from(t)).sin_cos();
             // Three ulp of 1 near the zeros (where an angle's rounding dominates), else of the value.
             let tol = |v: f64| 3.0 * (v.abs().max(0.5) * f64::from(f32::EPSILON));

@@ -5,6 +5,7 @@
 //! that produces it. The round-trip and chi-square tests beside them (and in `verify::chi2`) hold the
 //! three together.
 
+use crate::math::lanes::{Real, V3};
 use crate::math::trig::sin_cos_quarter;
 use crate::math::{Vec2, Vec3};
 use std::f32::consts::{FRAC_1_PI, FRAC_PI_2, FRAC_PI_4, PI};
@@ -16,17 +17,25 @@ const INV_4PI: f32 = 0.25 * FRAC_1_PI;
 #[inline(always)]
 #[must_use]
 pub fn sample_uniform_disk_concentric(u: Vec2) -> Vec2 {
-    let o = 2.0 * u - Vec2::ONE;
-    if o.x == 0.0 && o.y == 0.0 {
-        return Vec2::ZERO;
-    }
+    let (x, y) = concentric_disk(u.x, u.y);
+    Vec2::new(x, y)
+}
+
+/// [`sample_uniform_disk_concentric`] in lanes ([`Real`]): the point (x, y) for `(ux, uy)`.
+#[inline(always)]
+#[must_use]
+pub fn concentric_disk<R: Real>(ux: R, uy: R) -> (R, R) {
+    let (ox, oy) = (ux * 2.0 - 1.0, uy * 2.0 - 1.0);
     // Map each of the four wedges of the square to a wedge of the disk: θ = π/4 · (y/x) about the x axis,
     // or π/2 − π/4 · (x/y) about the y axis, whose cosine and sine are the sine and cosine of π/4 · (x/y).
     // Either way the angle to evaluate is in [−π/4, π/4], where a short polynomial is exact to f32.
-    let x_major = o.x.abs() > o.y.abs();
-    let (r, t) = if x_major { (o.x, o.y / o.x) } else { (o.y, o.x / o.y) };
-    let (s, c) = sin_cos_quarter(FRAC_PI_4 * t);
-    r * if x_major { Vec2::new(c, s) } else { Vec2::new(s, c) }
+    let x_major = ox.abs().gt(oy.abs());
+    let (r, t) = (R::select(x_major, ox, oy), R::select(x_major, oy / ox, ox / oy));
+    let (s, c) = sin_cos_quarter(t * FRAC_PI_4);
+    let (x, y) = (r * R::select(x_major, c, s), r * R::select(x_major, s, c));
+    // The centre (where t is 0/0).
+    let centre = ox.eq(R::splat(0.0)) & oy.eq(R::splat(0.0));
+    (R::select(centre, R::splat(0.0), x), R::select(centre, R::splat(0.0), y))
 }
 
 /// Density of [`sample_uniform_disk_concentric`] per unit area: 1/π inside the disk.
@@ -68,20 +77,30 @@ pub fn invert_uniform_disk_concentric(p: Vec2) -> Vec2 {
 #[inline(always)]
 #[must_use]
 pub fn sample_cosine_hemisphere(u: Vec2) -> Vec3 {
-    let d = sample_uniform_disk_concentric(u);
-    let z = (1.0 - d.length_squared()).max(0.0).sqrt();
-    Vec3::new(d.x, d.y, z)
+    cosine_hemisphere(u.x, u.y).into()
+}
+
+/// [`sample_cosine_hemisphere`] in lanes ([`Real`]).
+#[inline(always)]
+#[must_use]
+pub fn cosine_hemisphere<R: Real>(ux: R, uy: R) -> V3<R> {
+    let (x, y) = concentric_disk(ux, uy);
+    let z = (R::splat(1.0) - (x * x + y * y)).max(R::splat(0.0)).sqrt();
+    V3::new(x, y, z)
 }
 
 /// Density of [`sample_cosine_hemisphere`]: cos θ / π above the horizon, 0 below.
 #[inline(always)]
 #[must_use]
 pub fn cosine_hemisphere_pdf(w: Vec3) -> f32 {
-    if w.z > 0.0 {
-        w.z * FRAC_1_PI
-    } else {
-        0.0
-    }
+    cosine_hemisphere_density(w.z)
+}
+
+/// [`cosine_hemisphere_pdf`] in lanes, from cos θ.
+#[inline(always)]
+#[must_use]
+pub fn cosine_hemisphere_density<R: Real>(cos_theta: R) -> R {
+    R::select(cos_theta.gt(R::splat(0.0)), cos_theta * FRAC_1_PI, R::splat(0.0))
 }
 
 /// The inverse of [`sample_cosine_hemisphere`].

@@ -1,0 +1,508 @@
+//! Numbers in lanes: one formula written once, run on a single `f32` or on eight at a time.
+//!
+//! | item        | what it is                                                                          |
+//! |-------------|-------------------------------------------------------------------------------------|
+//! | [`Real`]    | the arithmetic a formula needs: + − × ÷, √, fused multiply–add, min/max, comparisons into a mask, `select` |
+//! | `f32`       | one lane; its mask is `bool` and `select` a branch — the renderer's single calls      |
+//! | [`F32x8`]   | eight lanes (one AVX register); each operation is a loop over the lanes that the compiler turns into one vector instruction |
+//! | [`V3`]      | a direction of lanes (structure of arrays: x, y and z each one `Real`)               |
+//!
+//! A formula generic over [`Real`] computes, in every lane of an [`F32x8`], exactly the IEEE operations it
+//! computes on an `f32`, in the same order (every operation is correctly rounded, and Rust never fuses a
+//! multiply and an add on its own), so the eight-lane result equals eight single calls bit for bit. Branches
+//! become masks: both sides are computed and [`Real::select`] keeps one per lane; a lane's discarded side may
+//! be NaN or infinite, which is harmless. [`Real::any`] lets a formula skip work no lane needs (on an `f32`
+//! it is the early return of scalar code).
+//!
+//! The loops over eight lanes are plain Rust: compiled inside gonio's AVX2 + FMA batch functions (see
+//! `bsdf::simd_batch`), LLVM's SLP vectoriser maps each to one 256-bit instruction (checked with callgrind
+//! instruction counts per row, see `bsdf::lanes`); on other CPUs they run as SSE pairs or scalar loops with
+//! the same results.
+
+use crate::math::{Vec2, Vec3};
+use std::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
+
+/// The arithmetic of a lane type (see the module doc). Every method is the per-lane `f32` operation of the
+/// same name.
+pub trait Real:
+    Copy
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+    + Add<f32, Output = Self>
+    + Sub<f32, Output = Self>
+    + Mul<f32, Output = Self>
+    + Div<f32, Output = Self>
+{
+    /// One comparison result per lane.
+    type Mask: Copy + BitAnd<Output = Self::Mask> + BitOr<Output = Self::Mask> + Not<Output = Self::Mask>;
+    const LANES: usize;
+
+    fn splat(v: f32) -> Self;
+    fn sqrt(self) -> Self;
+    fn abs(self) -> Self;
+    /// `f32::min`: the other operand where one is NaN.
+    fn min(self, o: Self) -> Self;
+    fn max(self, o: Self) -> Self;
+    fn clamp(self, lo: f32, hi: f32) -> Self;
+    /// `f32::mul_add`: self · a + b with one rounding.
+    fn mul_add(self, a: Self, b: Self) -> Self;
+    /// `f32::round`: to the nearest integer, halves away from zero.
+    fn round(self) -> Self;
+    /// `f(lane)` in every lane: for a table lookup or other scalar code (not vectorised, same results).
+    fn map(self, f: impl Fn(f32) -> f32) -> Self;
+    fn lt(self, o: Self) -> Self::Mask;
+    fn le(self, o: Self) -> Self::Mask;
+    fn gt(self, o: Self) -> Self::Mask;
+    fn ge(self, o: Self) -> Self::Mask;
+    fn eq(self, o: Self) -> Self::Mask;
+    fn ne(self, o: Self) -> Self::Mask;
+    fn is_finite(self) -> Self::Mask;
+    fn is_nan(self) -> Self::Mask;
+    /// `a` where `m` is set, else `b`, per lane.
+    fn select(m: Self::Mask, a: Self, b: Self) -> Self;
+    /// Whether any lane of `m` is set.
+    fn any(m: Self::Mask) -> bool;
+}
+
+impl Real for f32 {
+    type Mask = bool;
+    const LANES: usize = 1;
+
+    #[inline(always)]
+    fn splat(v: f32) -> Self {
+        v
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        f32::sqrt(self)
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        f32::abs(self)
+    }
+    #[inline(always)]
+    fn min(self, o: Self) -> Self {
+        f32::min(self, o)
+    }
+    #[inline(always)]
+    fn max(self, o: Self) -> Self {
+        f32::max(self, o)
+    }
+    #[inline(always)]
+    fn clamp(self, lo: f32, hi: f32) -> Self {
+        f32::clamp(self, lo, hi)
+    }
+    #[inline(always)]
+    fn mul_add(self, a: Self, b: Self) -> Self {
+        f32::mul_add(self, a, b)
+    }
+    #[inline(always)]
+    fn round(self) -> Self {
+        f32::round(self)
+    }
+    #[inline(always)]
+    fn map(self, f: impl Fn(f32) -> f32) -> Self {
+        f(self)
+    }
+    #[inline(always)]
+    fn lt(self, o: Self) -> bool {
+        self < o
+    }
+    #[inline(always)]
+    fn le(self, o: Self) -> bool {
+        self <= o
+    }
+    #[inline(always)]
+    fn gt(self, o: Self) -> bool {
+        self > o
+    }
+    #[inline(always)]
+    fn ge(self, o: Self) -> bool {
+        self >= o
+    }
+    #[inline(always)]
+    fn eq(self, o: Self) -> bool {
+        self == o
+    }
+    #[inline(always)]
+    fn ne(self, o: Self) -> bool {
+        self != o
+    }
+    #[inline(always)]
+    fn is_finite(self) -> bool {
+        f32::is_finite(self)
+    }
+    #[inline(always)]
+    fn is_nan(self) -> bool {
+        f32::is_nan(self)
+    }
+    #[inline(always)]
+    fn select(m: bool, a: Self, b: Self) -> Self {
+        if m {
+            a
+        } else {
+            b
+        }
+    }
+    #[inline(always)]
+    fn any(m: bool) -> bool {
+        m
+    }
+}
+
+/// Eight `f32` lanes, aligned as one 256-bit register.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C, align(32))]
+pub struct F32x8(pub [f32; 8]);
+
+/// Eight comparison results: all bits set (true) or clear (false) per lane, the form vector compares
+/// produce and blends consume.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(C, align(32))]
+pub struct M32x8(pub [i32; 8]);
+
+/// `F32x8` from `f(lane index)`, as a loop the compiler unrolls and vectorises.
+macro_rules! lanes {
+    ($t:ident, |$i:ident| $e:expr) => {{
+        let mut r = $t([Default::default(); 8]);
+        for $i in 0..8 {
+            r.0[$i] = $e;
+        }
+        r
+    }};
+}
+
+macro_rules! lane_ops {
+    ($($tr:ident $f:ident $op:tt),*) => {$(
+        impl $tr for F32x8 {
+            type Output = F32x8;
+            #[inline(always)]
+            fn $f(self, o: F32x8) -> F32x8 { lanes!(F32x8, |i| self.0[i] $op o.0[i]) }
+        }
+        impl $tr<f32> for F32x8 {
+            type Output = F32x8;
+            #[inline(always)]
+            fn $f(self, o: f32) -> F32x8 { lanes!(F32x8, |i| self.0[i] $op o) }
+        }
+    )*};
+}
+lane_ops!(Add add +, Sub sub -, Mul mul *, Div div /);
+
+impl Neg for F32x8 {
+    type Output = F32x8;
+    #[inline(always)]
+    fn neg(self) -> F32x8 {
+        lanes!(F32x8, |i| -self.0[i])
+    }
+}
+
+impl BitAnd for M32x8 {
+    type Output = M32x8;
+    #[inline(always)]
+    fn bitand(self, o: M32x8) -> M32x8 {
+        lanes!(M32x8, |i| self.0[i] & o.0[i])
+    }
+}
+
+impl BitOr for M32x8 {
+    type Output = M32x8;
+    #[inline(always)]
+    fn bitor(self, o: M32x8) -> M32x8 {
+        lanes!(M32x8, |i| self.0[i] | o.0[i])
+    }
+}
+
+impl Not for M32x8 {
+    type Output = M32x8;
+    #[inline(always)]
+    fn not(self) -> M32x8 {
+        lanes!(M32x8, |i| !self.0[i])
+    }
+}
+
+impl M32x8 {
+    /// Lane `i` as a `bool`.
+    #[inline(always)]
+    #[must_use]
+    pub fn get(self, i: usize) -> bool {
+        self.0[i] != 0
+    }
+}
+
+/// A mask lane from a `bool`: all bits set for true.
+#[inline(always)]
+fn bits(b: bool) -> i32 {
+    -i32::from(b)
+}
+
+impl Real for F32x8 {
+    type Mask = M32x8;
+    const LANES: usize = 8;
+
+    #[inline(always)]
+    fn splat(v: f32) -> Self {
+        F32x8([v; 8])
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        lanes!(F32x8, |i| self.0[i].sqrt())
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        lanes!(F32x8, |i| self.0[i].abs())
+    }
+    #[inline(always)]
+    fn min(self, o: Self) -> Self {
+        lanes!(F32x8, |i| self.0[i].min(o.0[i]))
+    }
+    #[inline(always)]
+    fn max(self, o: Self) -> Self {
+        lanes!(F32x8, |i| self.0[i].max(o.0[i]))
+    }
+    #[inline(always)]
+    fn clamp(self, lo: f32, hi: f32) -> Self {
+        lanes!(F32x8, |i| self.0[i].clamp(lo, hi))
+    }
+    #[inline(always)]
+    fn mul_add(self, a: Self, b: Self) -> Self {
+        lanes!(F32x8, |i| self.0[i].mul_add(a.0[i], b.0[i]))
+    }
+    #[inline(always)]
+    fn round(self) -> Self {
+        lanes!(F32x8, |i| self.0[i].round())
+    }
+    #[inline(always)]
+    fn map(self, f: impl Fn(f32) -> f32) -> Self {
+        lanes!(F32x8, |i| f(self.0[i]))
+    }
+    #[inline(always)]
+    fn lt(self, o: Self) -> M32x8 {
+        lanes!(M32x8, |i| bits(self.0[i] < o.0[i]))
+    }
+    #[inline(always)]
+    fn le(self, o: Self) -> M32x8 {
+        lanes!(M32x8, |i| bits(self.0[i] <= o.0[i]))
+    }
+    #[inline(always)]
+    fn gt(self, o: Self) -> M32x8 {
+        lanes!(M32x8, |i| bits(self.0[i] > o.0[i]))
+    }
+    #[inline(always)]
+    fn ge(self, o: Self) -> M32x8 {
+        lanes!(M32x8, |i| bits(self.0[i] >= o.0[i]))
+    }
+    #[inline(always)]
+    fn eq(self, o: Self) -> M32x8 {
+        lanes!(M32x8, |i| bits(self.0[i] == o.0[i]))
+    }
+    #[inline(always)]
+    fn ne(self, o: Self) -> M32x8 {
+        lanes!(M32x8, |i| bits(self.0[i] != o.0[i]))
+    }
+    #[inline(always)]
+    fn is_finite(self) -> M32x8 {
+        // |x| < ∞ is false for ±∞ and NaN: one compare, where `f32::is_finite` works on the bits.
+        lanes!(M32x8, |i| bits(self.0[i].abs() < f32::INFINITY))
+    }
+    #[inline(always)]
+    fn is_nan(self) -> M32x8 {
+        lanes!(M32x8, |i| bits(self.0[i].is_nan()))
+    }
+    #[inline(always)]
+    fn select(m: M32x8, a: Self, b: Self) -> Self {
+        lanes!(F32x8, |i| if m.0[i] != 0 { a.0[i] } else { b.0[i] })
+    }
+    #[inline(always)]
+    fn any(m: M32x8) -> bool {
+        m.0.iter().fold(0, |acc, &v| acc | v) != 0
+    }
+}
+
+/// `[e(0), e(1), e(2)]`, one expression per RGB channel: `channels!(|c| f[c] * s)`. A macro, not a function
+/// taking a closure (nor `array::map`): closures carry no `#[inline(always)]`, and one left as a call in a
+/// batch loop is compiled without the loop's AVX2 and keeps it from being vectorised (2026-11: seen in
+/// callgrind, a third of the instructions of roughconductor's `f`).
+macro_rules! channels {
+    (|$c:ident| $e:expr) => {
+        [
+            {
+                let $c = 0;
+                $e
+            },
+            {
+                let $c = 1;
+                $e
+            },
+            {
+                let $c = 2;
+                $e
+            },
+        ]
+    };
+}
+pub(crate) use channels;
+
+/// A direction (or any 3-vector) of lanes: x, y and z each a [`Real`]. The operations are those of
+/// [`Vec3`] written out in the order `glam` evaluates them, so `V3<f32>` gives `Vec3`'s results bit for bit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct V3<R> {
+    pub x: R,
+    pub y: R,
+    pub z: R,
+}
+
+// Named methods rather than operator traits: `R`'s operators are generic, and the few vector operations
+// the kernels need read as well spelt out.
+#[allow(clippy::should_implement_trait)]
+impl<R: Real> V3<R> {
+    #[inline(always)]
+    pub fn new(x: R, y: R, z: R) -> Self {
+        V3 { x, y, z }
+    }
+
+    #[inline(always)]
+    pub fn splat(v: Vec3) -> Self {
+        V3::new(R::splat(v.x), R::splat(v.y), R::splat(v.z))
+    }
+
+    #[inline(always)]
+    #[must_use]
+    pub fn dot(self, o: Self) -> R {
+        self.x * o.x + self.y * o.y + self.z * o.z
+    }
+
+    #[inline(always)]
+    #[must_use]
+    pub fn length(self) -> R {
+        self.dot(self).sqrt()
+    }
+
+    /// `Vec3::normalize`: times the reciprocal of the length.
+    #[inline(always)]
+    #[must_use]
+    pub fn normalize(self) -> Self {
+        self.scale(R::splat(1.0) / self.length())
+    }
+
+    #[inline(always)]
+    #[must_use]
+    pub fn scale(self, s: R) -> Self {
+        V3::new(self.x * s, self.y * s, self.z * s)
+    }
+
+    /// Each component divided by `s` (`Vec3 / f32`).
+    #[inline(always)]
+    #[must_use]
+    pub fn div(self, s: R) -> Self {
+        V3::new(self.x / s, self.y / s, self.z / s)
+    }
+
+    #[inline(always)]
+    #[must_use]
+    pub fn add(self, o: Self) -> Self {
+        V3::new(self.x + o.x, self.y + o.y, self.z + o.z)
+    }
+
+    #[inline(always)]
+    #[must_use]
+    pub fn sub(self, o: Self) -> Self {
+        V3::new(self.x - o.x, self.y - o.y, self.z - o.z)
+    }
+
+    #[inline(always)]
+    #[must_use]
+    pub fn neg(self) -> Self {
+        V3::new(-self.x, -self.y, -self.z)
+    }
+
+    #[inline(always)]
+    #[must_use]
+    pub fn cross(self, o: Self) -> Self {
+        V3::new(self.y * o.z - o.y * self.z, self.z * o.x - o.z * self.x, self.x * o.y - o.x * self.y)
+    }
+
+    /// `a` where `m` is set, else `b`, per lane.
+    #[inline(always)]
+    #[must_use]
+    pub fn select(m: R::Mask, a: Self, b: Self) -> Self {
+        V3::new(R::select(m, a.x, b.x), R::select(m, a.y, b.y), R::select(m, a.z, b.z))
+    }
+}
+
+impl From<Vec3> for V3<f32> {
+    #[inline(always)]
+    fn from(v: Vec3) -> Self {
+        V3::new(v.x, v.y, v.z)
+    }
+}
+
+impl From<V3<f32>> for Vec3 {
+    #[inline(always)]
+    fn from(v: V3<f32>) -> Self {
+        Vec3::new(v.x, v.y, v.z)
+    }
+}
+
+impl V3<F32x8> {
+    /// Eight `Vec3`s (exactly eight) as lanes.
+    #[inline(always)]
+    #[must_use]
+    pub fn load(v: &[Vec3]) -> Self {
+        let v: &[Vec3; 8] = v.try_into().expect("eight directions");
+        V3::new(lanes!(F32x8, |i| v[i].x), lanes!(F32x8, |i| v[i].y), lanes!(F32x8, |i| v[i].z))
+    }
+
+    /// Lane `i` as a `Vec3`.
+    #[inline(always)]
+    #[must_use]
+    pub fn lane(&self, i: usize) -> Vec3 {
+        Vec3::new(self.x.0[i], self.y.0[i], self.z.0[i])
+    }
+}
+
+impl F32x8 {
+    /// Eight numbers (exactly eight).
+    #[inline(always)]
+    #[must_use]
+    pub fn load(v: &[f32]) -> Self {
+        let v: &[f32; 8] = v.try_into().expect("eight numbers");
+        F32x8(*v)
+    }
+
+    /// The x and y of eight `Vec2`s (exactly eight).
+    #[inline(always)]
+    #[must_use]
+    pub fn load2(v: &[Vec2]) -> (Self, Self) {
+        let v: &[Vec2; 8] = v.try_into().expect("eight pairs");
+        (lanes!(F32x8, |i| v[i].x), lanes!(F32x8, |i| v[i].y))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every operation of `F32x8` is the `f32` operation per lane, bit for bit, NaN and infinities included.
+    #[test]
+    fn lanes_are_scalar_operations() {
+        let a = [0.5f32, -1.5, 0.0, -0.0, f32::INFINITY, f32::NAN, 3.0e-39, 2.5];
+        let b = [2.0f32, -1.5, -0.0, 1.0, 1.0, 0.5, -7.0, f32::NEG_INFINITY];
+        let (x, y) = (F32x8(a), F32x8(b));
+        let same = |l: F32x8, f: &dyn Fn(f32, f32) -> f32| (0..8).all(|i| l.0[i].to_bits() == f(a[i], b[i]).to_bits());
+        assert!(same(x + y, &|p, q| p + q) && same(x - y, &|p, q| p - q) && same(x * y, &|p, q| p * q));
+        assert!(same(x / y, &|p, q| p / q) && same(x.min(y), &f32::min) && same(x.max(y), &f32::max));
+        assert!(
+            same(x.sqrt(), &|p, _| p.sqrt()) && same(x.round(), &|p, _| p.round()) && same(x.clamp(0.0, 1.0), &|p, _| p.clamp(0.0, 1.0))
+        );
+        assert!(same(x.mul_add(y, x), &|p, q| p.mul_add(q, p)) && same(-x, &|p, _| -p) && same(x.abs(), &|p, _| p.abs()));
+        let mask = |m: M32x8, f: &dyn Fn(f32, f32) -> bool| (0..8).all(|i| m.get(i) == f(a[i], b[i]));
+        assert!(mask(x.lt(y), &|p, q| p < q) && mask(x.le(y), &|p, q| p <= q) && mask(x.gt(y), &|p, q| p > q));
+        assert!(mask(x.ge(y), &|p, q| p >= q) && mask(x.eq(y), &|p, q| p == q) && mask(x.ne(y), &|p, q| p != q));
+        assert!(mask(x.is_finite(), &|p, _| p.is_finite()) && mask(x.is_nan(), &|p, _| p.is_nan()));
+        assert!(same(F32x8::select(x.lt(y), x, y), &|p, q| if p < q { p } else { q }));
+        assert!(F32x8::any(x.lt(y)) && !F32x8::any(x.is_nan() & x.is_finite()));
+    }
+}
