@@ -735,8 +735,10 @@ def test_plastic_eval_pdf(params):
 # roughplastic: gonio and Mitsuba 3 share the model (see crates/gonio/src/bsdf/rough_plastic.rs) and differ in
 # how the coating's tables are integrated: T(μ) (both a 64-point table, each by its own quadrature) and R̄ᵢ
 # (gonio: Gauss–Legendre in μ; Mitsuba: 2·mean of Rᵢ(μ)μ over its 64 table points). The specular part has
-# neither and is compared directly; the diffuse part ρ T(μo) T(μi) / (π η² (1 − X)), X = R̄ᵢ (or ρR̄ᵢ with
-# `nonlinear`), must be Mitsuba's times one constant per channel, the R̄ᵢ ratio.
+# neither and is compared directly. T is integrated independently below (`coating_transmittance_f64`): gonio's
+# table matches it, Mitsuba's is off by up to 3.7e-4 (GGX) and 1.6e-3 (Beckmann α = 1), so the pdf and diffuse
+# tests put the integral's T in Mitsuba's place. The diffuse part ρ T(μo) T(μi) / (π η² (1 − X)), X = R̄ᵢ (or
+# ρR̄ᵢ with `nonlinear`), must then be Mitsuba's times one constant per channel, the R̄ᵢ ratio.
 ROUGH_PLASTIC_RHO = np.array([0.2, 0.5, 0.8])
 ROUGH_PLASTIC_SETS = [(d, a, e) for d in ("ggx", "beckmann") for a in (0.05, 0.3, 1.0) for e in ("1.5",)] + [
     ("ggx", 0.3, "default"), ("beckmann", 0.3, "default")]
@@ -805,25 +807,182 @@ def test_roughplastic_specular(params):
     np.testing.assert_allclose(g_val[~big], mi_val[~big], rtol=0, atol=ROUGH_RTOL * ROUGH_FLOOR)
 
 
-BECKMANN_TABLE_REASON = (
-    "open (2026-11): Mitsuba 3.9.1 integrates its T(μ) table with its Beckmann G1, Walter 2007's rational "
-    "approximation (eq. 27); gonio with the exact G1. At α = 1 that makes the diffuse ratio vary by 3.9e-3 "
-    "over the pairs (α ≤ 0.3: ≤ 6e-4). Not corrected here: the table is internal to Mitsuba")
+# --- the coating's transmittance T(μ), independently of both renderers ------------------------------------
+# Both renderers tabulate T(μ) at μ = k/63 (the horizon node at 1e-6) and interpolate linearly; gonio integrates
+# each node by a 128 × 128 Gauss–Legendre rule in f64, Mitsuba 3.9.1 by a 32 × 32 rule in f32 (for η > 1) over
+# its visible-normal sampler, with its rational Beckmann G1. `coating_transmittance_f64` integrates T without
+# either renderer, so the tests below can say which table is right and undo the other one's error.
+
+TABLE_MU = np.maximum(np.arange(64, dtype=np.float32) / np.float32(63), np.float32(1e-6))
 
 
-@pytest.mark.parametrize("params", [pytest.param(p, marks=pytest.mark.xfail(strict=True, reason=BECKMANN_TABLE_REASON))
-                                    if p[:2] == ("beckmann", 1.0) else p for p in ROUGH_PLASTIC_SETS], ids=rough_plastic_id)
+def smith_lambda_f64(distribution, alpha, tan2):
+    """Smith's Λ, exact, of an isotropic distribution at tan²θ: GGX (√(1 + α² tan²θ) − 1)/2 (Heitz 2014
+    eq. 86); Beckmann `lambda_exact` with a = 1/(α tanθ)."""
+    if distribution == "ggx":
+        return (np.sqrt(1 + alpha * alpha * tan2) - 1) / 2
+    with np.errstate(divide="ignore"):
+        return lambda_exact(1 / (alpha * np.sqrt(tan2)))
+
+
+def gauss_legendre_on(n, a, b):
+    """Gauss–Legendre nodes and weights on [a, b] (a, b arrays: one rule per row)."""
+    x, w = np.polynomial.legendre.leggauss(n)
+    a, b = np.asarray(a, dtype=np.float64)[..., None], np.asarray(b, dtype=np.float64)[..., None]
+    return a + (b - a) * (x + 1) / 2, w * (b - a) / 2
+
+
+def coating_transmittance_f64(distribution, alpha, eta, mu, n=64):
+    """T(μ) = ∫ D_ωo(ωm) (1 − F(ωo·ωm)) G1(ωt, ωm) dωm from outside, η > 1, in float64: the energy the rough
+    interface transmits (Walter et al. 2007 eqs. 21, 40; D_ωo = G1(ωo) max(0, ωo·ωm) D(ωm)/cos θo, Heitz &
+    d'Eon 2014 eq. 2; separable Smith G1 with the exact Λ; exact unpolarised Fresnel).
+
+    Product Gauss–Legendre in (φm, s), where s carries D(ωm) cos θm dωm smoothly — GGX: tan θm = α tan s,
+    measure 2 sin s cos s ds dφ/2π; Beckmann: tan θm = α s, measure 2 s exp(−s²) ds dφ/2π (s ≤ 9) — over
+    φm ∈ [0, π] (mirror symmetry) in two panels, with the s range cut exactly at ωo·ωm = 0. That cut is the
+    integrand's only kink: for η > 1 the refracted ray always leaves downward (ωt·n < 0 and ωt·ωm < 0), so
+    the rule converges spectrally (n = 64 and 128 agree to 3e-8 at the GGX α = 0.05 horizon node, 1e-11
+    elsewhere, 2026-11)."""
+    assert eta > 1
+    so, co = np.sqrt(1 - mu * mu), mu
+    g1o = 1 / (1 + smith_lambda_f64(distribution, alpha, np.array([(so / co) ** 2])))[0]
+    phi, w_phi = [np.concatenate(x) for x in zip(gauss_legendre_on(n, 0, np.pi / 2), gauss_legendre_on(n, np.pi / 2, np.pi))]
+    cphi, sphi = np.cos(phi), np.sin(phi)
+    hi = np.full(phi.shape, np.pi / 2 if distribution == "ggx" else 9.0)
+    if so > 0:
+        # ωo·ωm = cos θm (so cos φ tan θm + co) vanishes at tan θm = −co/(so cos φ) when cos φ < 0.
+        with np.errstate(divide="ignore"):
+            s_cut = np.where(cphi < 0, -co / (so * np.minimum(cphi, -1e-300)), np.inf) / alpha
+        hi = np.minimum(hi, np.arctan(s_cut) if distribution == "ggx" else s_cut)
+    s, w_s = gauss_legendre_on(n, np.zeros_like(hi), hi)
+    if distribution == "ggx":
+        tan_m, measure = alpha * np.tan(s), 2 * np.sin(s) * np.cos(s)
+    else:
+        tan_m, measure = alpha * s, 2 * s * np.exp(-s * s)
+    cos_m = 1 / np.sqrt(1 + tan_m * tan_m)
+    mx, my, mz = tan_m * cos_m * cphi[:, None], tan_m * cos_m * sphi[:, None], cos_m
+    o_m_over_cos = so * cphi[:, None] * tan_m + co  # (ωo·ωm)/cos θm
+    c = np.maximum(o_m_over_cos * cos_m, 0.0)
+    cos_t = np.sqrt(1 - (1 - c * c) / (eta * eta))
+    rs, rp = (c - eta * cos_t) / (c + eta * cos_t), (eta * c - cos_t) / (eta * c + cos_t)
+    fresnel = 0.5 * (rs * rs + rp * rp)
+    # ωt = −ωo/η + (c/η − cos θt) ωm (Walter et al. 2007 eq. 40).
+    k = c / eta - cos_t
+    wtx, wty, wtz = -so / eta + k * mx, k * my, -co / eta + k * mz
+    g1t = 1 / (1 + smith_lambda_f64(distribution, alpha, (wtx ** 2 + wty ** 2) / wtz ** 2))
+    value = np.where(c > 0, o_m_over_cos * (1 - fresnel) * g1t, 0.0)
+    return float(g1o / co * np.sum(w_phi * np.sum(w_s * measure * value, axis=1)) / np.pi)
+
+
+@pytest.mark.parametrize("distribution", ["ggx", "beckmann"])
+def test_transmittance_integral_closed_form(distribution):
+    """The integrator on a closed form: an index-matched interface (η → 1, F = 0, ωt = −ωo) transmits
+    ∫ D_ωo G1(−ωo) dωm = G1(ωo); and it has converged (n = 64 vs 96)."""
+    for alpha in (0.05, 0.7):
+        for mu in (0.95, 0.5, 0.05):
+            g1 = 1 / (1 + smith_lambda_f64(distribution, alpha, np.array([(1 - mu * mu) / (mu * mu)])))[0]
+            t = coating_transmittance_f64(distribution, alpha, 1 + 1e-12, mu)
+            assert abs(t - g1) < 1e-9, (alpha, mu, t, g1)
+            t64, t96 = (coating_transmittance_f64(distribution, alpha, 1.5, mu, n) for n in (64, 96))
+            assert abs(t64 - t96) < 1e-9, (alpha, mu, t64, t96)
+
+
+def lerp_table(values, mu):
+    """A 64-node table at μ, interpolated linearly as both renderers do."""
+    x = np.clip(np.asarray(mu, dtype=np.float64), 0, 1) * 63
+    k = np.minimum(x.astype(int), 62)
+    return (k + 1 - x) * values[k] + (x - k) * values[k + 1]
+
+
+def coating_eta(params):
+    return 1.5 if params[2] == "1.5" else float(np.float32(1.49) / np.float32(1.000277))
+
+
+def glossy_probability(t, w):
+    """The probability of sampling the glossy lobe: (1 − T) w / ((1 − T) w + T (1 − w)), w = s̄/(d̄ + s̄)."""
+    return (1 - t) * w / ((1 - t) * w + t * (1 - w))
+
+
+GLOSSY_WEIGHT = 1 / (1 + ROUGH_PLASTIC_RHO.mean())  # s̄/(d̄ + s̄) for ROUGH_PLASTIC_RHO, s = 1
+
+
+@functools.lru_cache(maxsize=None)
+def exact_transmittance_table(params):
+    d, a, _ = params
+    return np.array([coating_transmittance_f64(d, a, coating_eta(params), float(mu)) for mu in TABLE_MU])
+
+
+@functools.lru_cache(maxsize=None)
+def transmittance_tables(params):
+    """gonio's and Mitsuba's T at the 64 table nodes, read off their pdfs at ωi = n: pdf = P p_glossy +
+    (1 − P)/π with p_glossy the renderer's own ρ = 0 pdf (P = 1 there), solved for P, then P for T."""
+    wo = np.stack([np.sqrt(1 - TABLE_MU * TABLE_MU), np.zeros(64, dtype=np.float32), TABLE_MU], axis=1).astype(np.float32)
+    normal = np.tile(np.array([[0, 0, 1]], dtype=np.float32), (64, 1))
+    pdfs = []  # [ρ = 0, ρ][gonio, Mitsuba]
+    for rho in (0.0, ROUGH_PLASTIC_RHO.tolist()):
+        g, m = load_both(rough_plastic_spec(params, rho, False))
+        pdfs.append((g.pdf(wo, normal).astype(np.float64), mi_eval_pdf(m, wo, normal)[1]))
+    w = GLOSSY_WEIGHT
+    p = [(pdfs[1][r] - 1 / np.pi) / (pdfs[0][r] - 1 / np.pi) for r in (0, 1)]
+    return tuple(w * (1 - q) / (w + q * (1 - 2 * w)) for q in p)
+
+
+def mitsuba_transmittance_rule(params, mu, res=32):
+    """Mitsuba's own recipe for one node, through its Python API: the res × res Gauss–Legendre mean over
+    its visible-normal sampler of (1 − F) G1(ωt, ωm) (its smith_g1: for Beckmann Walter's rational form)."""
+    d, a, _ = params
+    distr = mi.MicrofacetDistribution(mi.MicrofacetType.GGX if d == "ggx" else mi.MicrofacetType.Beckmann, a, True)
+    x, w = np.polynomial.legendre.leggauss(res)
+    x = (x * 0.5 + 0.5).astype(np.float32)
+    mu = np.float32(mu)
+    wo = mi.Vector3f(float(np.sqrt(np.float32(1) - mu * mu)), 0.0, float(mu))
+    eta = coating_eta(params)
+    total = 0.0
+    for i in range(res):
+        for j in range(res):
+            wm, _ = distr.sample(wo, mi.Point2f(float(x[i]), float(x[j])))
+            f, cos_t, _, eta_ti = mi.fresnel(float(wm[0] * wo[0] + wm[1] * wo[1] + wm[2] * wo[2]), eta)
+            wt = mi.refract(wo, wm, cos_t, eta_ti)
+            if wt[2] < 0:
+                total += w[i] * w[j] * float(distr.smith_g1(wt, wm)) * (1 - float(f))
+    return total / 4
+
+
+@pytest.mark.parametrize("params", ROUGH_PLASTIC_SETS, ids=rough_plastic_id)
+def test_roughplastic_transmittance_table(params):
+    """Which T(μ) table is right: gonio's is within 1e-5 of the f64 integral at every node; Mitsuba's is its
+    32 × 32 rule (recomputed through its API at three nodes, to 2e-6), which is further off the integral
+    than gonio's table at its worst node. The pdf and diffuse tests then put the integral in Mitsuba's place."""
+    exact = exact_transmittance_table(params)
+    t_g, t_mi = transmittance_tables(params)
+    err_g, dev_mi = t_g - exact, t_mi - exact
+    print(f"\nroughplastic {rough_plastic_id(params)} T(μ) − integral: gonio [{err_g.min():.2e}, {err_g.max():.2e}], "
+          f"Mitsuba [{dev_mi.min():.2e}, {dev_mi.max():.2e}]")
+    assert np.abs(err_g).max() < 1e-5, f"gonio's T table vs the integral: {np.abs(err_g).max():.3e}"
+    for k in (1, 32, 63):
+        rule = mitsuba_transmittance_rule(params, TABLE_MU[k])
+        assert abs(t_mi[k] - rule) < 2e-6, f"node {k}: Mitsuba's table {t_mi[k]:.7f} vs its 32-point rule {rule:.7f}"
+    assert np.abs(dev_mi).max() > 5 * np.abs(err_g).max()
+
+
+@pytest.mark.parametrize("params", ROUGH_PLASTIC_SETS, ids=rough_plastic_id)
 def test_roughplastic_diffuse(params):
     """(b) The diffuse part (total − specular) of gonio == Mitsuba's × one constant per channel, to 1e-3
-    relative at every pair where Mitsuba's exceeds 1e-4 and both are ≥ 1 % of their totals, linear and nonlinear; the constant (the median
-    ratio) equals the one predicted from the two renderers' R̄ᵢ, (1 − X_mitsuba)/(1 − X_gonio), to 1e-3, where
-    each renderer's R̄ᵢ is read off its own linear / nonlinear ratio (`internal_reflectance_from`)."""
+    relative at every pair where Mitsuba's exceeds 1e-4 and both are ≥ 1 % of their totals, linear and
+    nonlinear, once Mitsuba's T(μo) T(μi) is replaced by the integral's (its own table read off its pdf,
+    `transmittance_tables`; Beckmann α = 1 makes that a 3.9e-3 correction); the constant (the median ratio)
+    equals the one predicted from the two renderers' R̄ᵢ, (1 − X_mitsuba)/(1 − X_gonio), to 1e-3, where each
+    renderer's R̄ᵢ is read off its own linear / nonlinear ratio (`internal_reflectance_from`)."""
     v = rough_plastic_values(params)
-    diffuse = {k: (v[k][0] - v["spec"][0], v[k][2] - v["spec"][2]) for k in ("lin", "nl")}
+    exact, t_mi = exact_transmittance_table(params), transmittance_tables(params)[1]
+    mu_o, mu_i = v["wo"][:, 2], v["wi"][:, 2]
+    t_fix = (lerp_table(exact, mu_o) * lerp_table(exact, mu_i) / (lerp_table(t_mi, mu_o) * lerp_table(t_mi, mu_i)))[:, None]
+    diffuse = {k: (v[k][0] - v["spec"][0], (v[k][2] - v["spec"][2]) * t_fix) for k in ("lin", "nl")}
     r_g = internal_reflectance_from(diffuse["lin"][0], diffuse["nl"][0])
     r_mi = internal_reflectance_from(diffuse["lin"][1], diffuse["nl"][1])
     report = [f"\nroughplastic {rough_plastic_id(params)}: R̄ᵢ gonio {r_g.mean():.5f} (channels within "
-              f"{np.ptp(r_g):.1e}), Mitsuba {r_mi.mean():.5f} (within {np.ptp(r_mi):.1e})"]
+              f"{np.ptp(r_g):.1e}), Mitsuba {r_mi.mean():.5f} (within {np.ptp(r_mi):.1e}); T correction "
+              f"[{t_fix.min():.6f}, {t_fix.max():.6f}]"]
     failures = []
     for key in ("lin", "nl"):
         ours, theirs = diffuse[key]
@@ -848,19 +1007,22 @@ def test_roughplastic_diffuse(params):
     assert np.ptp(r_g) < 1e-3 and np.ptp(r_mi) < 1e-3
 
 
-PDF_TABLE_REASON = (
-    "open (2026-11): the glossy-lobe probability is (1 − T(μo)) w / ((1 − T) w + T (1 − w)); gonio's T(μ) table is "
-    "below Mitsuba's by 0.8e-4..2.6e-4 (GGX, read off both pdfs at ωi = n), and where T ≈ 0.95 that is ~4e-3 "
-    "relative in 1 − T: pdf up to 3e-3 apart. Which table is closer to the integral is not yet established. "
-    "Beckmann adds Mitsuba's G1 approximation in its T table and in the visible-normal pdf (not undone here)")
-
-
-@pytest.mark.parametrize("params", [p if p[:2] == ("ggx", 1.0) else pytest.param(
-    p, marks=pytest.mark.xfail(strict=True, reason=PDF_TABLE_REASON)) for p in ROUGH_PLASTIC_SETS], ids=rough_plastic_id)
+@pytest.mark.parametrize("params", ROUGH_PLASTIC_SETS, ids=rough_plastic_id)
 def test_roughplastic_pdf(params):
-    """(c) pdfs (linear, coloured ρ) agree to 1e-3 relative above 1e-4."""
-    _, g_pdf, _, mi_pdf = rough_plastic_values(params)["lin"]
-    err, big = relative_errors(g_pdf, mi_pdf)
-    print(f"\nroughplastic {rough_plastic_id(params)} pdf: max rel error {err.max():.2e} ({big.sum()} values)")
+    """(c) pdfs (linear, coloured ρ) agree to 1e-3 relative above 1e-4 once Mitsuba's is recomposed with the
+    integral's T: P(T(μo)) p_glossy + (1 − P) cos θi/π, with Mitsuba's own glossy pdf p_glossy (its ρ = 0
+    pdf; Beckmann × G1_exact/G1_walter(ωo), its visible-normal pdf's approximation undone as for
+    roughdielectric). The raw gap (up to 3.3e-3, from Mitsuba's T table) is printed."""
+    v = rough_plastic_values(params)
+    _, g_pdf, _, mi_pdf = v["lin"]
+    glossy = v["spec"][3]
+    if params[0] == "beckmann":
+        glossy = glossy * g1_ratio(v["wo"], params[1], params[1])
+    p = glossy_probability(lerp_table(exact_transmittance_table(params), v["wo"][:, 2]), GLOSSY_WEIGHT)
+    recomposed = p * glossy + (1 - p) * v["wi"][:, 2].astype(np.float64) / np.pi
+    raw, _ = relative_errors(g_pdf, mi_pdf)
+    err, big = relative_errors(g_pdf, recomposed)
+    print(f"\nroughplastic {rough_plastic_id(params)} pdf: raw max rel difference {raw.max():.2e}, with the integral's T "
+          f"{err.max():.2e} ({big.sum()} values)")
     assert big.sum() >= 1000 * 0.9
-    assert err.max() < ROUGH_RTOL, f"pdf vs Mitsuba: {err.max():.3e}"
+    assert err.max() < ROUGH_RTOL, f"pdf vs recomposed Mitsuba pdf: {err.max():.3e}"
