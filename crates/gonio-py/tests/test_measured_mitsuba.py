@@ -189,7 +189,7 @@ def test_own_encoder_round_trips(tmp_path, paper):
     ("wrong shape", r"field `luminance`: expected shape \[1, 8, ≥2, ≥2\]"),
     ("wrong dtype", r"field `theta_i`: expected a 1-dimensional f32 array, found a 1-dimensional f64"),
     ("all zero", r"field `rgb`: has no positive value"),
-    ("spectral", r"spectral RGL file"),
+    ("spectral without wavelengths", r"field `wavelengths`: missing"),
 ])
 def test_bad_files_are_named_errors(tmp_path, paper, case, pattern):
     fields = {k: v.copy() for k, v in paper.items()}
@@ -215,7 +215,7 @@ def test_bad_files_are_named_errors(tmp_path, paper, case, pattern):
         fields["theta_i"] = fields["theta_i"].astype(np.float64)
     elif case == "all zero":
         fields["rgb"][:] = 0
-    elif case == "spectral":
+    elif case == "spectral without wavelengths":
         fields["spectra"] = fields.pop("rgb")
     if data is None:
         data = tensor_file(fields)
