@@ -4,7 +4,7 @@
 //!
 //! | parameter  | type   | default | meaning                                                          |
 //! |------------|--------|---------|------------------------------------------------------------------|
-//! | `filename` | string | —       | an RGL `.bsdf` file (the `tensor_file` container, RGB variant `*_rgb.bsdf`) |
+//! | `filename` | string | —       | an RGL `.bsdf` file (the `tensor_file` container; RGB `*_rgb.bsdf` or spectral) |
 //!
 //! # The tables (fields of the file)
 //!
