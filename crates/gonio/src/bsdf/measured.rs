@@ -935,11 +935,14 @@ mod tests {
                 let mu = rng.next_f32().max(0.05);
                 let s = (1.0 - mu * mu).sqrt();
                 // Exact axes for the quarter turns (cos(π/2) in f32 is not 0).
-                let (c, sn) = match phi {
-                    p if p == 0.0 => (1.0, 0.0),
-                    p if p == FRAC_PI_2 => (0.0, 1.0),
-                    p if p == -FRAC_PI_2 => (0.0, -1.0),
-                    _ => (-1.0, 0.0),
+                let (c, sn) = if phi == 0.0 {
+                    (1.0, 0.0)
+                } else if phi == FRAC_PI_2 {
+                    (0.0, 1.0)
+                } else if phi == -FRAC_PI_2 {
+                    (0.0, -1.0)
+                } else {
+                    (-1.0, 0.0)
                 };
                 let wo = Vec3::new(s * c, s * sn, mu);
                 let wi = direction(rng.next_f32().max(0.02), rng.next_f32() * std::f32::consts::TAU);
