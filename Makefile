@@ -4,13 +4,14 @@
 #   make bench  criterion benchmarks, and gonio vs Mitsuba 3 timings, errors and scaling tables
 #   make gallery  regenerate docs/gallery/*.png and docs/gallery/README.md (the lecture's figures, < 10 min on 2 cores)
 #   make fuzz   run one loader's fuzz target (TARGET=ply FUZZ_SECONDS=600; docs/fuzzing.md)
+#   make fit-table  fit every `gonio fit` model to each RGL material; residuals to docs/fitting.md (by hand)
 
 PYTHON ?= python3
 VENV   := .venv
 VPY    := $(VENV)/bin/python
 CARGO  ?= cargo
 
-.PHONY: all build cli venv python demo test test-rust test-python bench gallery fuzz fmt lint clean
+.PHONY: all build cli venv python demo test test-rust test-python bench gallery fit-table fuzz fmt lint clean
 
 all: build
 
@@ -70,6 +71,11 @@ bench: cli python
 # `gonio fit` for the measured materials instead of using docs/gallery/fits/*.xml).
 gallery: cli
 	docs/gallery/make_gallery.sh
+
+# The fitting residuals of every `gonio fit` model on each RGL material (by hand: minutes of CPU; writes
+# docs/fitting.md through bench/fit_rgl_table.sh).
+fit-table: cli
+	bench/fit_rgl_table.sh
 
 # One fuzz target for FUZZ_SECONDS (by hand, never part of `make test`; needs `cargo install cargo-fuzz`;
 # stable Rust, sanitizer off): make fuzz TARGET=ply. Targets and results: docs/fuzzing.md.

@@ -161,5 +161,11 @@ fn fit_recovers_a_known_model_and_writes_loadable_xml() {
     let bad = gonio(&["fit", target, "--model", "gxx"]);
     assert_eq!(bad.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&bad.stderr).contains("unknown model `gxx`"));
+    // `gonio fit --list` needs no measured BSDF (bench/fit_rgl_table.sh reads the model names from it).
+    let list = gonio(&["fit", "--list"]);
+    assert_eq!(list.status.code(), Some(0), "{}", String::from_utf8_lossy(&list.stderr));
+    let names: Vec<String> =
+        String::from_utf8_lossy(&list.stdout).lines().filter_map(|l| l.split_whitespace().next().map(str::to_string)).collect();
+    assert_eq!(names, gonio::fit::MODELS.iter().map(|m| m.name).collect::<Vec<_>>());
     std::fs::remove_dir_all(dir).unwrap();
 }

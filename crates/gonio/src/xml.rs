@@ -5,7 +5,7 @@
 use crate::error::{Error, Result};
 use crate::math::Transform;
 use crate::props::Props;
-use crate::spectrum::named::{parse_spd, spectrum_to_rgb};
+use crate::spectrum::named::{parse_spd, reflectance_to_rgb, spectrum_to_rgb};
 use crate::spectrum::Rgb;
 use glam::Vec3;
 use std::cell::Cell;
@@ -196,19 +196,12 @@ pub fn parse_vector(node: roxmltree::Node, env: &XmlEnv, source: &str, default: 
 ///
 /// Inside an `<emitter>` the spectrum is radiance: [`spectrum_to_rgb`] (no illuminant). Elsewhere it is a
 /// reflectance, which Mitsuba weights by D65 so that a flat spectrum stays grey; gonio approximates that by
-/// dividing each channel by the response to the equal-energy white (exact for flat spectra: a flat 0.78
+/// dividing each channel by the response to the equal-energy white ([`reflectance_to_rgb`], the one
+/// reduction of reflectance spectra, also used by spectral RGL files; exact for flat spectra: a flat 0.78
 /// over 400–700 nm gives (0.777, 0.781, 0.775) here and (0.776, 0.780, 0.776) in Mitsuba 3.9.1; 2026-11,
 /// until a D65 table lands in `spectrum`).
 pub fn parse_spectrum(node: roxmltree::Node, env: &XmlEnv, source: &str, within_emitter: bool) -> Result<Rgb> {
-    let reduce = |w: &[f64], v: &[f64]| {
-        let c = spectrum_to_rgb(w, v);
-        if within_emitter {
-            c
-        } else {
-            let white = spectrum_to_rgb(&[crate::spectrum::cie::CIE_MIN, crate::spectrum::cie::CIE_MAX], &[1.0, 1.0]);
-            c.zip(white, |a, b| if b > 0.0 { a / b } else { 0.0 })
-        }
-    };
+    let reduce = |w: &[f64], v: &[f64]| if within_emitter { spectrum_to_rgb(w, v) } else { reflectance_to_rgb(w, v) };
     let at = xml_at(source, node);
     if let Some(file) = env.attr(node, "filename", source)? {
         let path = env.resolve_file(&file, &at)?;

@@ -11,7 +11,8 @@ use std::process::ExitCode;
 #[derive(clap::Args)]
 pub struct Args {
     /// The BSDF to fit to: a MERL .binary, an RGL .bsdf file, JSON, or an XML file with one <bsdf>.
-    measured: String,
+    #[arg(required_unless_present = "list")]
+    measured: Option<String>,
     /// The analytic model (repeat to fit several; the best goes to --output): see --list.
     #[arg(long = "model", required_unless_present = "list")]
     models: Vec<String>,
@@ -35,7 +36,8 @@ pub fn run(args: Args) -> Result<ExitCode, Error> {
     }
     // Resolve every model name before the (slow) fits, so a typo fails at once.
     let models = args.models.iter().map(|name| model(name)).collect::<Result<Vec<_>, _>>()?;
-    let target = load_bsdf(&args.measured)?;
+    let measured = args.measured.unwrap_or_default();
+    let target = load_bsdf(&measured)?;
     let set = pairs(&target, args.strata as usize);
     let mut best: Option<gonio::fit::Fit> = None;
     for m in models {
@@ -65,7 +67,7 @@ pub fn run(args: Args) -> Result<ExitCode, Error> {
         // XML comments may not contain "--": hyphens in the source's name become U+2010.
         let comment = format!(
             "<!-- fitted by gonio to {}: model {}, relative error {:.4} (Ngan et al. 2005 metric, {} direction pairs) -->\n",
-            args.measured.replace('-', "\u{2010}"),
+            measured.replace('-', "\u{2010}"),
             best.model,
             best.relative_error,
             set.len()

@@ -4,7 +4,7 @@
 //!
 //! | parameter  | type   | default | meaning                                                          |
 //! |------------|--------|---------|------------------------------------------------------------------|
-//! | `filename` | string | —       | an RGL `.bsdf` file (the `tensor_file` container, RGB variant `*_rgb.bsdf`) |
+//! | `filename` | string | —       | an RGL `.bsdf` file (the `tensor_file` container; RGB `*_rgb.bsdf` or spectral) |
 //!
 //! # The tables (fields of the file)
 //!
@@ -16,6 +16,8 @@
 //! | `vndf`        | [nφ, nθ, n, n]             | the visible-normal distribution D_ωi(ωm) per incident direction, as a density over the unit square (u_θ, u_φ) of ωm |
 //! | `luminance`   | [nφ, nθ, m, m]             | the luminance of the reflectance in the square the VNDF warp maps from (§5.2) |
 //! | `rgb`         | [nφ, nθ, 3, m, m]          | the RGB reflectance ρ in that square                       |
+//! | `spectra`     | [nφ, nθ, nλ, m, m]         | spectral files: ρ at each wavelength, in place of (or besides) `rgb` |
+//! | `wavelengths` | [nλ]                       | spectral files: the wavelengths of `spectra`, nm, increasing |
 //! | `jacobian`    | [1] u8                     | whether f carries the D/(4σ) factor (all RGL files: 1)     |
 //! | `description` | [k] u8                     | the material's name                                        |
 //!
@@ -37,6 +39,18 @@
 //! [`Marginal2D`], which reproduces Mitsuba's `Marginal2D` numerics, so `f` and `pdf` agree with
 //! Mitsuba 3 (scalar_rgb) to float32 round-off (see crates/gonio-py/tests/test_measured_mitsuba.py).
 //!
+//! # Spectral files
+//! The RGL database also ships spectral files, whose reflectance is `spectra` at `wavelengths` (the
+//! spectrum of each cell of the reflectance square) instead of `rgb`. gonio renders in
+//! RGB, so at load each cell's spectrum — piecewise linear between the wavelengths, 0 outside them — is
+//! reduced to linear sRGB by [`SpectrumToRgb::reflectance_rgb`], the same reduction of reflectance
+//! spectra as the XML `<spectrum>` of a BSDF ([`crate::spectrum::named::reflectance_to_rgb`]: the CIE 1931
+//! integral, divided by the response to the equal-energy white so that a flat spectrum stays grey). The
+//! reduction is linear, so the table then behaves exactly as an RGB table would (it is not clamped per
+//! cell; f clamps after interpolation, as for RGB files). A file with both fields uses `rgb`, as
+//! Mitsuba's RGB variants do. Wavelengths that do not increase, fewer than two of them, none in the
+//! visible range (360–830 nm) or a `spectra` shape that does not match are errors naming the field.
+//!
 //! Anisotropic files (nφ > 2) cover a fraction 1/r of the azimuths (r = 2π / (φ_last − φ_first), 1, 2
 //! or 4); directions are folded into the measured range by the mirror symmetries the file implies, as
 //! Mitsuba does.
@@ -47,7 +61,8 @@
 //!   since a BSDF value is non-negative.
 //! - A sample's `f` and `pdf` are evaluated at the returned direction through the inverse warp, like
 //!   `f` and `pdf` themselves, so that sample, f and pdf agree to float32 round-off.
-//! - Spectral files (`spectra` and `wavelengths` fields) are refused with an error: use the `_rgb` files.
+//! - Spectral files are read and reduced to RGB at load (Mitsuba's RGB variants require the `rgb` field;
+//!   its spectral variants evaluate the spectra at the sampled wavelengths): see *Spectral files* above.
 //! - Bad files are errors naming the file and field (see [`crate::measured::tensor_file`]); Mitsuba
 //!   trusts the header.
 //!
@@ -69,6 +84,7 @@ use crate::math::{Vec2, Vec3};
 use crate::measured::tensor_file::{F32Array, TensorFile};
 use crate::props::Props;
 use crate::sampling::marginal2d::Marginal2D;
+use crate::spectrum::named::SpectrumToRgb;
 use crate::spectrum::Rgb;
 use std::f32::consts::{FRAC_PI_2, PI};
 use std::path::{Path, PathBuf};
@@ -250,12 +266,6 @@ impl Measured {
 
 impl RglTables {
     fn from_file(file: TensorFile) -> Result<RglTables> {
-        if !file.has_field("rgb") && file.has_field("spectra") {
-            return Err(file.error(
-                "rgb",
-                "this is a spectral RGL file (fields `spectra`, `wavelengths`); gonio reads the RGB variant of each material (`*_rgb.bsdf`)",
-            ));
-        }
         let description = String::from_utf8_lossy(file.u8_field("description", 1)?).trim_end_matches('\0').to_string();
         let theta_i = file.f32_field("theta_i", 1)?;
         let phi_i = file.f32_field("phi_i", 1)?;
@@ -263,7 +273,6 @@ impl RglTables {
         let sigma = file.f32_field("sigma", 2)?;
         let vndf = file.f32_field("vndf", 4)?;
         let luminance = file.f32_field("luminance", 4)?;
-        let rgb = file.f32_field("rgb", 5)?;
         let jacobian = file.u8_field("jacobian", 1)?;
         if jacobian.len() != 1 {
             return Err(file.error("jacobian", format!("expected a single u8 flag, found {} values", jacobian.len())));
@@ -272,6 +281,10 @@ impl RglTables {
         if n_phi == 0 || n_theta == 0 {
             return Err(file.error(if n_phi == 0 { "phi_i" } else { "theta_i" }, "no incident directions tabulated"));
         }
+        // The RGB table when the file has one (what Mitsuba's RGB variants read), else the spectra reduced.
+        let spectral = !file.has_field("rgb") && file.has_field("spectra");
+        let (rgb, rgb_field) =
+            if spectral { (rgb_from_spectra(&file, n_phi, n_theta)?, "spectra") } else { (file.f32_field("rgb", 5)?, "rgb") };
         let expect_shape = |name: &str, a: &F32Array, lead: &[usize]| -> Result<()> {
             let ok = a.shape.len() == lead.len() + 2 && a.shape[..lead.len()] == *lead && a.shape[lead.len()..].iter().all(|&n| n >= 2);
             if ok {
@@ -293,10 +306,10 @@ impl RglTables {
         expect_shape("sigma", &sigma, &[])?;
         expect_shape("vndf", &vndf, &[n_phi, n_theta])?;
         expect_shape("luminance", &luminance, &[n_phi, n_theta])?;
-        expect_shape("rgb", &rgb, &[n_phi, n_theta, 3])?;
+        expect_shape(rgb_field, &rgb, &[n_phi, n_theta, 3])?;
         if luminance.shape[2..] != rgb.shape[3..] {
             return Err(file.error(
-                "rgb",
+                rgb_field,
                 format!("the reflectance grid {:?} must match the luminance grid {:?}", &rgb.shape[3..], &luminance.shape[2..]),
             ));
         }
@@ -314,7 +327,7 @@ impl RglTables {
             }
         }
         if !rgb.data.iter().any(|v| *v > 0.0) {
-            return Err(file.error("rgb", "has no positive value: the material would be black"));
+            return Err(file.error(rgb_field, "has no positive value: the material would be black"));
         }
         let file = &file;
         let table_error = |name: &'static str| move |m: String| file.error(name, m);
@@ -328,7 +341,7 @@ impl RglTables {
         let vndf_t = Marginal2D::new(&vndf.data, grid(&vndf), params2(), true, true).map_err(table_error("vndf"))?;
         let lum_t = Marginal2D::new(&luminance.data, grid(&luminance), params2(), true, true).map_err(table_error("luminance"))?;
         let rgb_t = Marginal2D::new(&rgb.data, grid(&rgb), [phi_i.data.clone(), theta_i.data.clone(), vec![0.0, 1.0, 2.0]], false, false)
-            .map_err(table_error("rgb"))?;
+            .map_err(|m| file.error(rgb_field, m))?;
         let isotropic = n_phi <= 2;
         let reduction = if isotropic {
             0
@@ -373,6 +386,69 @@ impl RglTables {
         let f = |w: Vec3| Vec3::new(mulsign_neg(w.x, sx), mulsign_neg(w.y, sy), w.z);
         (f(wo), f(wi))
     }
+}
+
+/// The RGB reflectance table of a spectral RGL file: `spectra` [nφ, nθ, nλ, m, m] at `wavelengths` [nλ]
+/// (nm, ascending) reduced cell by cell to linear sRGB by [`SpectrumToRgb::reflectance_rgb`], the reduction
+/// of reflectance spectra that gonio's XML `<spectrum>` uses. The reduction is linear and left unclamped,
+/// like the `rgb` tables of the RGB files (which hold small negative entries); `f` clamps at 0 after
+/// interpolation, for both kinds of file alike.
+fn rgb_from_spectra(file: &TensorFile, n_phi: usize, n_theta: usize) -> Result<F32Array> {
+    let wavelengths = file.f32_field("wavelengths", 1)?;
+    let spectra = file.f32_field("spectra", 5)?;
+    let n_lambda = wavelengths.data.len();
+    if n_lambda < 2 {
+        return Err(file.error("wavelengths", format!("holds {n_lambda} wavelength(s); a spectrum needs at least 2")));
+    }
+    if let Some(k) = wavelengths.data.windows(2).position(|w| w[1] <= w[0]) {
+        return Err(file.error(
+            "wavelengths",
+            format!("must increase: element {} ({} nm) follows {} nm", k + 1, wavelengths.data[k + 1], wavelengths.data[k]),
+        ));
+    }
+    let lambda: Vec<f64> = wavelengths.data.iter().map(|&l| f64::from(l)).collect();
+    let reduction = SpectrumToRgb::new(&lambda);
+    if reduction.is_black() {
+        return Err(file.error(
+            "wavelengths",
+            format!(
+                "{}–{} nm lies outside the visible range ({}–{} nm, the CIE 1931 tables): the material would be black",
+                lambda[0],
+                lambda[n_lambda - 1],
+                crate::spectrum::cie::CIE_MIN,
+                crate::spectrum::cie::CIE_MAX
+            ),
+        ));
+    }
+    let shape = &spectra.shape;
+    if shape[..3] != [n_phi, n_theta, n_lambda] || shape[3] < 2 || shape[4] < 2 {
+        return Err(file.error(
+            "spectra",
+            format!(
+                "expected shape [{n_phi}, {n_theta}, {n_lambda}, ≥2, ≥2] (φᵢ × θᵢ incident directions × one sample per entry of `wavelengths` × the reflectance grid), found {shape:?}"
+            ),
+        ));
+    }
+    let (slices, cells) = (shape[0] * shape[1], shape[3] * shape[4]);
+    let mut rgb = vec![0f32; slices * 3 * cells];
+    let mut values = vec![0f64; n_lambda];
+    for slice in 0..slices {
+        let src = &spectra.data[slice * n_lambda * cells..(slice + 1) * n_lambda * cells];
+        let dst = &mut rgb[slice * 3 * cells..(slice + 1) * 3 * cells];
+        for cell in 0..cells {
+            for (k, v) in values.iter_mut().enumerate() {
+                *v = f64::from(src[k * cells + cell]);
+            }
+            let c = reduction.reflectance_rgb(&values);
+            for (channel, value) in c.iter().enumerate() {
+                #[allow(clippy::cast_possible_truncation)] // the tables are f32
+                {
+                    dst[channel * cells + cell] = *value as f32;
+                }
+            }
+        }
+    }
+    Ok(F32Array { shape: vec![shape[0], shape[1], 3, shape[3], shape[4]], data: rgb })
 }
 
 impl crate::bsdf::Examples for Measured {
@@ -537,6 +613,401 @@ mod tests {
         assert_eq!(m.pdf(down, up), 0.0);
         assert!(m.sample(down, 0.5, Vec2::new(0.3, 0.3)).is_none());
         assert!(m.f(up, up).g() > 0.0);
+    }
+
+    // --- Files derived from the real ones: spectral and anisotropic twins --------------------------------
+
+    use crate::measured::tensor_file::{encode, f32_bytes, DType};
+
+    /// Every field of a tensor file, to rewrite some of them and encode the result.
+    #[derive(Clone)]
+    struct Fields(Vec<(String, DType, Vec<usize>, Vec<u8>)>);
+
+    impl Fields {
+        fn read(name: &str) -> Fields {
+            let file = TensorFile::open(&Path::new(DATA).join(name)).unwrap_or_else(|e| panic!("the shared RGL data must be present: {e}"));
+            Fields(
+                file.fields()
+                    .iter()
+                    .map(|f| (f.name.clone(), f.dtype, f.shape.clone(), file.field_bytes(&f.name).unwrap().to_vec()))
+                    .collect(),
+            )
+        }
+
+        fn f32(&self, name: &str) -> (Vec<usize>, Vec<f32>) {
+            let (_, _, shape, bytes) = self.0.iter().find(|f| f.0 == name).unwrap_or_else(|| panic!("no field {name}"));
+            (shape.clone(), bytes.chunks_exact(4).map(|b| f32::from_le_bytes(b.try_into().unwrap())).collect())
+        }
+
+        fn set_f32(&mut self, name: &str, shape: &[usize], data: &[f32]) {
+            assert_eq!(shape.iter().product::<usize>(), data.len(), "{name}");
+            self.remove(name);
+            self.0.push((name.to_string(), DType::F32, shape.to_vec(), f32_bytes(data)));
+        }
+
+        fn remove(&mut self, name: &str) {
+            self.0.retain(|f| f.0 != name);
+        }
+
+        fn parse(&self, name: &str) -> Result<Measured> {
+            let fields: Vec<(&str, DType, &[usize], &[u8])> =
+                self.0.iter().map(|(n, d, s, b)| (n.as_str(), *d, s.as_slice(), b.as_slice())).collect();
+            Measured::from_file(TensorFile::parse(Path::new(name), encode(&fields))?)
+        }
+
+        fn load(&self, name: &str) -> Measured {
+            self.parse(name).unwrap_or_else(|e| panic!("{e}"))
+        }
+    }
+
+    /// Random pairs of directions above the surface, half of them near the mirror configuration.
+    fn random_pairs(n: usize, seed: u64) -> Vec<(Vec3, Vec3)> {
+        let mut rng = Pcg32::new(seed, 3);
+        (0..n)
+            .map(|k| {
+                let wo = direction(rng.next_f32().max(0.05), rng.next_f32() * std::f32::consts::TAU);
+                let wi = if k % 2 == 0 {
+                    let j = Vec3::new(-wo.x, -wo.y, wo.z) + 0.15 * (Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) - 0.5);
+                    Vec3::new(j.x, j.y, j.z.abs().max(0.02)).normalize()
+                } else {
+                    direction(rng.next_f32().max(0.02), rng.next_f32() * std::f32::consts::TAU)
+                };
+                (wo, wi)
+            })
+            .collect()
+    }
+
+    /// The largest difference of f between two materials over `pairs`, relative to the largest channel of
+    /// f (plus `floor`), with the number of pairs where either is non-zero.
+    fn worst_difference(a: &Measured, b: &Measured, pairs: &[(Vec3, Vec3)], floor: f32) -> (f32, usize) {
+        let mut worst = 0f32;
+        let mut lit = 0;
+        for &(wo, wi) in pairs {
+            let (fa, fb) = (a.f(wo, wi), b.f(wo, wi));
+            if fa.max_component() > 0.0 || fb.max_component() > 0.0 {
+                lit += 1;
+            }
+            let scale = fa.max_component().max(fb.max_component()) + floor;
+            worst = worst.max((0..3).map(|c| (fa.0[c] - fb.0[c]).abs()).fold(0.0, f32::max) / scale);
+        }
+        (worst, lit)
+    }
+
+    /// The wavelengths of the constructed spectral files: 360, 370, …, 830 nm.
+    fn wavelengths() -> Vec<f32> {
+        (0..48).map(|k| 360.0 + 10.0 * k as f32).collect()
+    }
+
+    /// A spectral file whose spectrum in every cell is `spectrum(r, g, b)` at [`wavelengths`], (r, g, b) the
+    /// cell of the RGB file; `rgb` is removed.
+    fn spectral_twin(rgb_file: &Fields, spectrum: impl Fn([f64; 3]) -> Vec<f64>) -> Fields {
+        let (shape, rgb) = rgb_file.f32("rgb");
+        let n_lambda = wavelengths().len();
+        let (slices, cells) = (shape[0] * shape[1], shape[3] * shape[4]);
+        let mut spectra = vec![0f32; slices * n_lambda * cells];
+        for slice in 0..slices {
+            for cell in 0..cells {
+                let c = [0, 1, 2].map(|ch| f64::from(rgb[(slice * 3 + ch) * cells + cell]));
+                for (k, v) in spectrum(c).into_iter().enumerate() {
+                    spectra[(slice * n_lambda + k) * cells + cell] = v as f32;
+                }
+            }
+        }
+        let mut out = rgb_file.clone();
+        out.remove("rgb");
+        out.set_f32("wavelengths", &[n_lambda], &wavelengths());
+        out.set_f32("spectra", &[shape[0], shape[1], n_lambda, shape[3], shape[4]], &spectra);
+        out
+    }
+
+    /// A spectral file made from an RGB one gives the same f: every cell's spectrum is a combination of
+    /// three step-like spectra (blue below 490 nm, green 500–570 nm, red above 580 nm, linear ramps between
+    /// the nodes) whose weights are chosen so that its reduction is the cell's RGB. This checks the layout
+    /// (axis order of `spectra`, one spectrum per cell) and that the reduction is applied per cell, linearly.
+    #[test]
+    fn spectral_file_reduces_to_its_rgb_twin() {
+        let source = Fields::read("cc_ibiza_sunset_rgb.bsdf");
+        let lambda: Vec<f64> = wavelengths().iter().map(|&l| f64::from(l)).collect();
+        let basis: [Vec<f64>; 3] = [
+            lambda.iter().map(|&l| f64::from(l >= 580.0)).collect(),
+            lambda.iter().map(|&l| f64::from((500.0..=570.0).contains(&l))).collect(),
+            lambda.iter().map(|&l| f64::from(l <= 490.0)).collect(),
+        ];
+        // M: column c is the reduction of basis spectrum c; a cell of RGB ρ gets the weights M⁻¹ ρ.
+        let reduction = SpectrumToRgb::new(&lambda);
+        let cols = basis.clone().map(|b| glam::DVec3::from(reduction.reflectance_rgb(&b)));
+        let m = glam::DMat3::from_cols(cols[0], cols[1], cols[2]);
+        eprintln!("reduction of the basis spectra (columns): {m:?}");
+        assert!(m.determinant().abs() > 0.1, "the basis must span RGB");
+        let inv = m.inverse();
+        let spectral = spectral_twin(&source, |rho| {
+            let w = inv * glam::DVec3::from(rho);
+            (0..lambda.len()).map(|k| w.x * basis[0][k] + w.y * basis[1][k] + w.z * basis[2][k]).collect()
+        });
+        let (a, b) = (source.load("ibiza_rgb.bsdf"), spectral.load("ibiza_spectral.bsdf"));
+        let pairs = random_pairs(10_000, 11);
+        let (worst, lit) = worst_difference(&a, &b, &pairs, 1e-6);
+        eprintln!("spectral twin: worst |Δf| / max f = {worst:.2e} over {lit} lit pairs");
+        assert!(lit > 9_000, "{lit}");
+        // Spectra stored as f32, reduced in f64 through M⁻¹ (condition number ~3): a few ulps of f32.
+        assert!(worst < 1e-5, "{worst}");
+        for &(wo, wi) in pairs.iter().take(500) {
+            assert_eq!(a.pdf(wo, wi), b.pdf(wo, wi), "the luminance and VNDF tables are shared");
+        }
+        // With both fields, the RGB table is used (as Mitsuba's RGB variants do): a zero spectrum changes nothing.
+        let mut both = source.clone();
+        let (shape, _) = source.f32("rgb");
+        both.set_f32("wavelengths", &[48], &wavelengths());
+        both.set_f32("spectra", &[shape[0], shape[1], 48, shape[3], shape[4]], &vec![0.0; shape[0] * shape[1] * 48 * shape[3] * shape[4]]);
+        let c = both.load("both.bsdf");
+        assert!(pairs.iter().take(500).all(|&(wo, wi)| c.f(wo, wi) == a.f(wo, wi)));
+    }
+
+    /// The reduction itself, independently of gonio's weights: a flat spectrum of value v over the whole
+    /// visible range is grey, (v, v, v), so a spectral file whose every cell is flat at the cell's green
+    /// value gives the f of an RGB file holding (g, g, g).
+    #[test]
+    fn flat_spectra_reduce_to_grey() {
+        let source = Fields::read("paper_white_rgb.bsdf");
+        let flat = spectral_twin(&source, |rho| vec![rho[1]; 48]);
+        let (shape, rgb) = source.f32("rgb");
+        let cells = shape[3] * shape[4];
+        let mut grey_rgb = rgb.clone();
+        for slice in 0..shape[0] * shape[1] {
+            for ch in [0, 2] {
+                let (dst, src) = ((slice * 3 + ch) * cells, (slice * 3 + 1) * cells);
+                grey_rgb.copy_within(src..src + cells, dst);
+            }
+        }
+        let mut grey = source.clone();
+        grey.set_f32("rgb", &shape, &grey_rgb);
+        let (a, b) = (grey.load("grey.bsdf"), flat.load("flat.bsdf"));
+        let pairs = random_pairs(10_000, 12);
+        let (worst, lit) = worst_difference(&a, &b, &pairs, 1e-6);
+        eprintln!("flat spectra: worst |Δf| / max f = {worst:.2e} over {lit} lit pairs");
+        assert!(lit > 9_000 && worst < 1e-5, "{worst} over {lit}");
+        let f = b.f(Vec3::new(0.0, 0.6, 0.8), Vec3::Z);
+        assert!(f.r() == f.g() || (f.r() - f.g()).abs() < 1e-6 * f.g(), "{f:?}");
+    }
+
+    #[test]
+    fn malformed_spectral_fields_are_named() {
+        let source = Fields::read("paper_white_rgb.bsdf");
+        let good = spectral_twin(&source, |rho| vec![rho[1]; 48]);
+        let (shape, spectra) = good.f32("spectra");
+        let error = |fields: &Fields| fields.parse("bad_spectral.bsdf").map(|_| ()).unwrap_err().to_string();
+        let with = |name: &str, shape: &[usize], data: &[f32]| {
+            let mut f = good.clone();
+            f.set_f32(name, shape, data);
+            error(&f)
+        };
+        let mut down = wavelengths();
+        down.swap(10, 11);
+        let m = with("wavelengths", &[48], &down);
+        assert!(
+            m.contains("bad_spectral.bsdf")
+                && m.contains("field `wavelengths`")
+                && m.contains("must increase: element 11 (460 nm) follows 470 nm"),
+            "{m}"
+        );
+        let m = with("wavelengths", &[48], &(0..48).map(|k| 1000.0 + k as f32).collect::<Vec<_>>());
+        assert!(m.contains("outside the visible range") && m.contains("would be black"), "{m}");
+        let mut one = good.clone();
+        one.set_f32("wavelengths", &[1], &[550.0]);
+        one.set_f32("spectra", &[shape[0], shape[1], 1, shape[3], shape[4]], &spectra[..spectra.len() / 48]);
+        let m = error(&one);
+        assert!(m.contains("holds 1 wavelength(s); a spectrum needs at least 2"), "{m}");
+        let m = with("wavelengths", &[47], &wavelengths()[..47]);
+        assert!(
+            m.contains("field `spectra`") && m.contains("expected shape [1, 8, 47, ≥2, ≥2]") && m.contains("found [1, 8, 48, 32, 32]"),
+            "{m}"
+        );
+        let m = with("spectra", &[1, 8, 48, 1024], &spectra);
+        assert!(m.contains("field `spectra`") && m.contains("expected a 5-dimensional f32 array, found a 4-dimensional"), "{m}");
+        let mut nan = spectra.clone();
+        nan[5] = f32::NAN;
+        let m = with("spectra", &shape, &nan);
+        assert!(m.contains("field `spectra`") && m.contains("element [0, 0, 0, 0, 5] is NaN"), "{m}");
+        let m = with("spectra", &shape, &vec![0.0; spectra.len()]);
+        assert!(m.contains("field `spectra`: has no positive value"), "{m}");
+        let mut missing = good.clone();
+        missing.remove("wavelengths");
+        let m = error(&missing);
+        assert!(m.contains("field `wavelengths`: missing"), "{m}");
+    }
+
+    /// Refine a periodic table [slices, m, m] to [slices, 4(m − 1) + 1, 4(m − 1) + 1] by inserting three
+    /// points in every interval of both axes: bilinear interpolation on the fine grid is then the same
+    /// function as on the coarse one, and a shift by a quarter or half turn is a whole number of rows.
+    fn refine4(data: &[f32], m: usize) -> (usize, Vec<f32>) {
+        let n = 4 * (m - 1) + 1;
+        let at = |x: usize| (x / 4, (x % 4) as f32 / 4.0);
+        let mut out = Vec::with_capacity(data.len() / (m * m) * n * n);
+        for slice in data.chunks_exact(m * m) {
+            for y in 0..n {
+                let (y0, ty) = at(y);
+                let y1 = (y0 + 1).min(m - 1);
+                for x in 0..n {
+                    let (x0, tx) = at(x);
+                    let x1 = (x0 + 1).min(m - 1);
+                    let v = |yy: usize, xx: usize| slice[yy * m + xx];
+                    out.push((1.0 - ty) * ((1.0 - tx) * v(y0, x0) + tx * v(y0, x1)) + ty * ((1.0 - tx) * v(y1, x0) + tx * v(y1, x1)));
+                }
+            }
+        }
+        (n, out)
+    }
+
+    /// An isotropic material and an anisotropic file of it, tabulated at incident azimuths `phis` (a full
+    /// turn [−π, π] or a half turn [−π, 0], in quarter turns), the reflectance at azimuth k scaled by
+    /// `gains[k]`. From `cc_ibiza_sunset`, made exactly representable in both forms:
+    /// - the VNDF is replaced by its average over the half-vector azimuth (every row of the table the same),
+    ///   so its warp is the identity in u_φ and the same for every incident azimuth;
+    /// - the reflectance and luminance squares are made periodic in their u_φ axis (last row = first) and
+    ///   refined ×4 ([`refine4`]), so that the anisotropic table of azimuth φₖ is the isotropic one turned by
+    ///   φₖ / 2π, a whole number of rows: the isotropic file takes φm − φᵢ where the anisotropic one takes
+    ///   φm, and at φᵢ = φₖ both give the same point of the square.
+    fn isotropic_and_anisotropic(phis: &[f32], gains: &[f32]) -> (Fields, Fields) {
+        let source = Fields::read("cc_ibiza_sunset_rgb.bsdf");
+        let mut iso = source.clone();
+        iso.remove("valid");
+        let (vshape, vndf) = source.f32("vndf");
+        let (rows, cols) = (vshape[2], vshape[3]);
+        let mut flat = vec![0f32; vndf.len()];
+        for (slice, out) in vndf.chunks_exact(rows * cols).zip(flat.chunks_exact_mut(rows * cols)) {
+            for x in 0..cols {
+                let mean = (0..rows).map(|y| f64::from(slice[y * cols + x])).sum::<f64>() / rows as f64;
+                (0..rows).for_each(|y| out[y * cols + x] = mean as f32);
+            }
+        }
+        iso.set_f32("vndf", &vshape, &flat);
+        for name in ["ndf", "sigma"] {
+            let (shape, d) = source.f32(name);
+            assert!(d[..shape[1]] == d[shape[1]..2 * shape[1]] && shape[0] == 2, "{name}: the isotropic files tabulate one row twice");
+        }
+        let (n_theta, m) = (vshape[1], source.f32("luminance").0[2]);
+        let mut periodic_refined = |name: &str, lead: &[usize]| -> (usize, Vec<f32>) {
+            let (_, mut d) = source.f32(name);
+            for slice in d.chunks_exact_mut(m * m) {
+                slice.copy_within(0..m, (m - 1) * m);
+            }
+            let (n, fine) = refine4(&d, m);
+            iso.set_f32(name, &[lead, &[n, n]].concat(), &fine);
+            (n, fine)
+        };
+        let (n, lum) = periodic_refined("luminance", &[1, n_theta]);
+        let (_, rgb) = periodic_refined("rgb", &[1, n_theta, 3]);
+        let mut aniso = iso.clone();
+        let turn = |table: &[f32], phi: f32, gain: f32| -> Vec<f32> {
+            let shift = (n - 1) as f32 * phi / std::f32::consts::TAU;
+            assert!((shift - shift.round()).abs() < 1e-4, "φ = {phi} is not a whole number of rows");
+            let shift = shift.round() as isize;
+            let mut out = Vec::with_capacity(table.len());
+            for slice in table.chunks_exact(n * n) {
+                for y in 0..n {
+                    let from = (y as isize - shift).rem_euclid((n - 1) as isize) as usize;
+                    out.extend(slice[from * n..(from + 1) * n].iter().map(|v| v * gain));
+                }
+            }
+            out
+        };
+        let k = phis.len();
+        let lum_a: Vec<f32> = phis.iter().flat_map(|&phi| turn(&lum, phi, 1.0)).collect();
+        let rgb_a: Vec<f32> = phis.iter().zip(gains).flat_map(|(&phi, &g)| turn(&rgb, phi, g)).collect();
+        aniso.set_f32("phi_i", &[k], phis);
+        aniso.set_f32("vndf", &[k, n_theta, rows, cols], &flat.repeat(k));
+        aniso.set_f32("luminance", &[k, n_theta, n, n], &lum_a);
+        aniso.set_f32("rgb", &[k, n_theta, 3, n, n], &rgb_a);
+        (iso, aniso)
+    }
+
+    const FULL_TURN: [f32; 5] = [-PI, -FRAC_PI_2, 0.0, FRAC_PI_2, PI];
+    const HALF_TURN: [f32; 3] = [-PI, -FRAC_PI_2, 0.0];
+
+    /// f and pdf of an anisotropic file against the isotropic material it was made from (see
+    /// [`isotropic_and_anisotropic`]), for viewer directions at the tabulated azimuths: the worst relative
+    /// difference of f · gain and of the pdf.
+    fn compare_at_nodes(iso: &Measured, aniso: &Measured, azimuths: &[(f32, f32)]) -> (f32, f32) {
+        let (mut worst_f, mut worst_pdf) = (0f32, 0f32);
+        let mut rng = Pcg32::new(21, 5);
+        for &(phi, gain) in azimuths {
+            for _ in 0..1500 {
+                let mu = rng.next_f32().max(0.05);
+                let s = (1.0 - mu * mu).sqrt();
+                // Exact axes for the quarter turns (cos(π/2) in f32 is not 0).
+                let (c, sn) = if phi == 0.0 {
+                    (1.0, 0.0)
+                } else if phi == FRAC_PI_2 {
+                    (0.0, 1.0)
+                } else if phi == -FRAC_PI_2 {
+                    (0.0, -1.0)
+                } else {
+                    (-1.0, 0.0)
+                };
+                let wo = Vec3::new(s * c, s * sn, mu);
+                let wi = direction(rng.next_f32().max(0.02), rng.next_f32() * std::f32::consts::TAU);
+                let (a, b) = (iso.f(wo, wi) * gain, aniso.f(wo, wi));
+                let scale = a.max_component().max(b.max_component()) + 1e-6;
+                worst_f = worst_f.max((0..3).map(|c| (a.0[c] - b.0[c]).abs()).fold(0.0, f32::max) / scale);
+                let (p, q) = (iso.pdf(wo, wi), aniso.pdf(wo, wi));
+                worst_pdf = worst_pdf.max((p - q).abs() / (p.max(q) + 1e-6));
+            }
+        }
+        (worst_f, worst_pdf)
+    }
+
+    /// An isotropic material written as an anisotropic file (over a full turn, and over a half turn with
+    /// the 2-fold symmetry) is the same material: at every tabulated azimuth of the viewer, and for every
+    /// direction of the light, f and pdf equal the isotropic file's. This checks the φ warp (absolute φm for
+    /// anisotropic files, φm − φᵢ for isotropic ones), the φᵢ axis of the tables and the folding.
+    #[test]
+    fn anisotropic_file_of_an_isotropic_material_is_the_same_material() {
+        for (phis, label) in [(&FULL_TURN[..], "full turn"), (&HALF_TURN[..], "half turn")] {
+            let (iso, aniso) = isotropic_and_anisotropic(phis, &vec![1.0; phis.len()]);
+            let (iso, aniso) = (iso.load("iso.bsdf"), aniso.load("aniso.bsdf"));
+            assert!(iso.is_isotropic() && !aniso.is_isotropic());
+            // Every quarter turn of the viewer, including those a half-turn file folds onto its range.
+            let azimuths: Vec<(f32, f32)> = FULL_TURN[..4].iter().map(|&p| (p, 1.0)).collect();
+            let (wf, wp) = compare_at_nodes(&iso, &aniso, &azimuths);
+            eprintln!("{label}: worst relative difference f {wf:.2e}, pdf {wp:.2e}");
+            // The two files find the same point of the square through u_φ computed two ways (φm − φᵢ and
+            // φm): float32 round-off of u, times the tables' slopes (2026-11: measured ≤ 2e-5).
+            assert!(wf < 2e-4 && wp < 2e-4, "{label}: f {wf}, pdf {wp}");
+        }
+        // The 4-fold symmetry is detected from a quarter-turn span; a span of 1 rad is refused.
+        let (_, mut aniso) = isotropic_and_anisotropic(&HALF_TURN, &[1.0; 3]);
+        aniso.set_f32("phi_i", &[3], &[-PI, -PI + 0.5, -PI + 1.0]);
+        let m = aniso.parse("odd.bsdf").map(|_| ()).unwrap_err().to_string();
+        assert!(m.contains("field `phi_i`") && m.contains("expected 2π, π or π/2"), "{m}");
+    }
+
+    /// An anisotropic file with a known dependence on the viewer's azimuth: the reflectance at φₖ scaled by
+    /// gₖ. At the tabulated azimuths f = gₖ · f of the isotropic material (between them gonio interpolates
+    /// the tables linearly, as Mitsuba does; crates/gonio-py/tests/test_measured_mitsuba.py compares
+    /// gonio with Mitsuba 3 on such files at random azimuths).
+    #[test]
+    fn anisotropic_file_with_a_known_azimuthal_dependence() {
+        let gains = [0.6, 0.9, 1.2, 1.5, 0.6];
+        let (iso, aniso) = isotropic_and_anisotropic(&FULL_TURN, &gains);
+        let (iso, aniso) = (iso.load("iso.bsdf"), aniso.load("aniso_gain.bsdf"));
+        let azimuths: Vec<(f32, f32)> = FULL_TURN[..4].iter().zip(gains).map(|(&p, g)| (p, g)).collect();
+        let (wf, wp) = compare_at_nodes(&iso, &aniso, &azimuths);
+        eprintln!("gains {gains:?}: worst relative difference f {wf:.2e}, pdf {wp:.2e}");
+        assert!(wf < 2e-4 && wp < 2e-4, "f {wf}, pdf {wp}");
+    }
+
+    /// Sampling anisotropic files draws what `pdf` says, between the tabulated azimuths (where the tables
+    /// of two azimuths are blended) and through the 2-fold folding.
+    #[test]
+    fn chi2_anisotropic_files() {
+        let cfg = Chi2Config { samples: 1_000_000, tests: 2, ..Chi2Config::default() };
+        let (_, half) = isotropic_and_anisotropic(&HALF_TURN, &[1.0; 3]);
+        let (_, gain) = isotropic_and_anisotropic(&FULL_TURN, &[0.6, 0.9, 1.2, 1.5, 0.6]);
+        for (m, wo) in [(half.load("half.bsdf"), direction(0.6, 2.0)), (gain.load("gain.bsdf"), direction(0.8, -0.7))] {
+            let r = chi2_bsdf(&m, wo, &cfg);
+            eprintln!("anisotropic at {wo}: p = {:.3e} (α = {:.1e})", r.p_value, r.alpha);
+            assert!(r.passed, "{wo}: {}", r.message);
+        }
     }
 
     #[test]

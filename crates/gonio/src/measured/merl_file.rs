@@ -33,6 +33,11 @@
 //! continues the measured values outwards rather than dropping to black, so interpolation next to an
 //! unmeasured region stays accurate. The writer writes −1 to the cells that were filled.
 //!
+//! Cost (2026-11, a 34,992,012-byte file written by `gonio measure`, warm page cache, loaded through
+//! `gonio.load_bsdf` as the `merl` BSDF, i.e. read + fill + the sampling tables): 60–62 ms of CPU time
+//! over all threads (10 loads; wall time 316–360 ms on the shared 2-core machine at load average 18),
+//! and the process's peak resident memory grows by 24 MiB (the 17.5 MB table plus the sampling tables).
+//!
 //! # Lookups
 //! - **nearest** (`interpolation = "nearest"`) is the reference reader's: the floor of each index.
 //! - **trilinear** (the default) reads each entry as the value at the centre of its cell in the index

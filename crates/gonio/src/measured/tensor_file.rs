@@ -323,6 +323,12 @@ impl TensorFile {
         &self.bytes[f.offset..f.offset + f.len() * f.dtype.size()]
     }
 
+    /// The data of field `name` as stored: little-endian bytes, C order (to copy a field into another
+    /// file with [`encode`]).
+    pub fn field_bytes(&self, name: &str) -> Result<&[u8]> {
+        Ok(self.raw(self.field(name)?))
+    }
+
     /// The raw bytes of a `u8` field of rank `rank`.
     pub fn u8_field(&self, name: &str, rank: usize) -> Result<&[u8]> {
         let f = self.field(name)?;

@@ -146,36 +146,117 @@ const SPECTRUM_TO_RGB_STEPS: usize = 1000;
 #[must_use]
 pub fn spectrum_to_rgb(wavelengths: &[f64], values: &[f64]) -> Rgb {
     debug_assert_eq!(wavelengths.len(), values.len(), "one value per wavelength");
-    debug_assert!(wavelengths.windows(2).all(|w| w[0] <= w[1]), "wavelengths must ascend");
     let n = wavelengths.len().min(values.len());
-    if n < 2 {
-        return Rgb::ZERO;
-    }
-    let (wavelengths, values) = (&wavelengths[..n], &values[..n]);
-    let (first, last) = (wavelengths[0], wavelengths[n - 1]);
+    clamped_rgb(SpectrumToRgb::new(&wavelengths[..n]).linear_rgb(&values[..n]))
+}
 
-    let mut xyz = [0.0_f64; 3];
-    for i in 0..SPECTRUM_TO_RGB_STEPS {
-        // Step 1: 1000 wavelengths spanning the CIE range, both ends included.
-        let lambda = CIE_MIN + (i as f64 / (SPECTRUM_TO_RGB_STEPS - 1) as f64) * (CIE_MAX - CIE_MIN);
-        // Step 2: outside the table the spectrum counts as 0.
-        if !(first..=last).contains(&lambda) {
-            continue;
-        }
-        // Step 3: the interval [x0, x1] holding λ (the last one for λ = last), and the linear interpolant.
-        let i0 = (wavelengths.partition_point(|&w| w <= lambda).saturating_sub(1)).min(n - 2);
-        let (x0, x1, y0, y1) = (wavelengths[i0], wavelengths[i0 + 1], values[i0], values[i0 + 1]);
-        let s = if x1 > x0 { y0 + (y1 - y0) * (lambda - x0) / (x1 - x0) } else { y1 };
-        let cmf = cie1931_xyz(lambda);
-        for c in 0..3 {
-            xyz[c] += cmf[c] * s;
-        }
-    }
-    // Step 4: Mitsuba's scale is 470 nm / 1000 (not / 999), then 1/∫ȳ.
-    let scale = (CIE_MAX - CIE_MIN) / SPECTRUM_TO_RGB_STEPS as f64 * CIE_Y_NORMALIZATION;
-    let rgb = xyz_to_linear_srgb(xyz.map(|v| v * scale));
-    #[allow(clippy::cast_possible_truncation)] // gonio renders in f32
+/// Reduces a *reflectance* spectrum to linear sRGB: [`spectrum_to_rgb`] divided, channel by channel, by
+/// the response to the equal-energy white (1 over [`CIE_MIN`], [`CIE_MAX`]), so that a flat spectrum stays
+/// grey: 1 everywhere gives (1, 1, 1). Mitsuba's RGB variants weight reflectances by D65 for the same
+/// purpose; this is gonio's approximation of it (exact for flat spectra; see `xml::parse_spectrum`, the
+/// `<spectrum>` of a BSDF, and [`crate::bsdf::measured`], the spectral RGL files, which both use it).
+#[must_use]
+pub fn reflectance_to_rgb(wavelengths: &[f64], values: &[f64]) -> Rgb {
+    let n = wavelengths.len().min(values.len());
+    clamped_rgb(SpectrumToRgb::new(&wavelengths[..n]).reflectance_rgb(&values[..n]))
+}
+
+#[allow(clippy::cast_possible_truncation)] // gonio renders in f32
+fn clamped_rgb(rgb: [f64; 3]) -> Rgb {
     Rgb::new(rgb[0].max(0.0) as f32, rgb[1].max(0.0) as f32, rgb[2].max(0.0) as f32)
+}
+
+/// The reduction of [`spectrum_to_rgb`] for one fixed list of wavelengths, as the linear map it is: the
+/// linear sRGB of a piecewise-linear spectrum is Σₖ vₖ Wₖ, with Wₖ the (unclamped) sRGB of the k-th "hat"
+/// basis function (1 at λₖ, 0 at the other nodes). The weights are computed once by the four steps of the
+/// module docs; reducing a spectrum is then 3 multiply–adds per wavelength, which is what a table of
+/// thousands of spectra (a spectral RGL file) needs.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SpectrumToRgb {
+    /// Wₖ: the linear sRGB of the k-th hat function.
+    weights: Vec<[f64; 3]>,
+}
+
+impl SpectrumToRgb {
+    /// The reduction for spectra tabulated at `wavelengths` (nm, ascending). Fewer than two wavelengths,
+    /// or none inside [[`CIE_MIN`], [`CIE_MAX`]], give a reduction to black.
+    #[must_use]
+    pub fn new(wavelengths: &[f64]) -> Self {
+        debug_assert!(wavelengths.windows(2).all(|w| w[0] <= w[1]), "wavelengths must ascend");
+        let n = wavelengths.len();
+        let mut xyz = vec![[0.0_f64; 3]; n];
+        if n >= 2 {
+            let (first, last) = (wavelengths[0], wavelengths[n - 1]);
+            for i in 0..SPECTRUM_TO_RGB_STEPS {
+                // Step 1: 1000 wavelengths spanning the CIE range, both ends included.
+                let lambda = CIE_MIN + (i as f64 / (SPECTRUM_TO_RGB_STEPS - 1) as f64) * (CIE_MAX - CIE_MIN);
+                // Step 2: outside the table the spectrum counts as 0.
+                if !(first..=last).contains(&lambda) {
+                    continue;
+                }
+                // Step 3: the interval [x0, x1] holding λ (the last one for λ = last); the linear
+                // interpolant puts weight 1 − t on the left node and t on the right one.
+                let i0 = (wavelengths.partition_point(|&w| w <= lambda).saturating_sub(1)).min(n - 2);
+                let (x0, x1) = (wavelengths[i0], wavelengths[i0 + 1]);
+                let t = if x1 > x0 { (lambda - x0) / (x1 - x0) } else { 1.0 };
+                let cmf = cie1931_xyz(lambda);
+                for c in 0..3 {
+                    xyz[i0][c] += (1.0 - t) * cmf[c];
+                    xyz[i0 + 1][c] += t * cmf[c];
+                }
+            }
+        }
+        // Step 4: Mitsuba's scale is 470 nm / 1000 (not / 999), then 1/∫ȳ; XYZ → linear sRGB is linear too.
+        let scale = (CIE_MAX - CIE_MIN) / SPECTRUM_TO_RGB_STEPS as f64 * CIE_Y_NORMALIZATION;
+        SpectrumToRgb { weights: xyz.into_iter().map(|w| xyz_to_linear_srgb(w.map(|v| v * scale))).collect() }
+    }
+
+    /// Number of wavelengths the reduction expects.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.weights.len()
+    }
+
+    /// Whether it expects no wavelengths.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.weights.is_empty()
+    }
+
+    /// Whether every spectrum reduces to black (fewer than two wavelengths, or none in the CIE range).
+    #[must_use]
+    pub fn is_black(&self) -> bool {
+        self.weights.iter().all(|w| *w == [0.0; 3])
+    }
+
+    /// Linear sRGB of the spectrum with `values` at the wavelengths, unclamped (negative where the
+    /// spectrum is out of the sRGB gamut). `values` has one entry per wavelength.
+    #[must_use]
+    pub fn linear_rgb(&self, values: &[f64]) -> [f64; 3] {
+        debug_assert_eq!(values.len(), self.weights.len(), "one value per wavelength");
+        let mut rgb = [0.0_f64; 3];
+        for (w, v) in self.weights.iter().zip(values) {
+            for c in 0..3 {
+                rgb[c] += w[c] * v;
+            }
+        }
+        rgb
+    }
+
+    /// [`Self::linear_rgb`] of a reflectance spectrum, divided by the response to the equal-energy white
+    /// (see [`reflectance_to_rgb`]), unclamped.
+    #[must_use]
+    pub fn reflectance_rgb(&self, values: &[f64]) -> [f64; 3] {
+        let white = equal_energy_white();
+        let rgb = self.linear_rgb(values);
+        std::array::from_fn(|c| rgb[c] / white[c])
+    }
+}
+
+/// The unclamped linear sRGB of 1 over [[`CIE_MIN`], [`CIE_MAX`]]: ≈ (1.2049, 0.9482, 0.9093).
+fn equal_energy_white() -> [f64; 3] {
+    static WHITE: OnceLock<[f64; 3]> = OnceLock::new();
+    *WHITE.get_or_init(|| SpectrumToRgb::new(&[CIE_MIN, CIE_MAX]).linear_rgb(&[1.0, 1.0]))
 }
 
 /// CIE XYZ → linear sRGB (Rec. 709 primaries, D65 white), with the coefficients Mitsuba 3 uses
