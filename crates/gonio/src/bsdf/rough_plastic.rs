@@ -33,8 +33,8 @@
 //! gonio computes both in f64 at construction (T on 64 values of μ = k/63 interpolated linearly, as
 //! Mitsuba does; T and Rᵢ(μ) by a 128 × 128 Gauss–Legendre rule over the visible normals — total
 //! internal reflection makes the integrands discontinuous — and R̄ᵢ by 48-point Gauss–Legendre in μ on either side of the critical angle) and caches them per
-//! (distribution, α, η) on a grid of α (64 nodes per decade, each integrated on first use), interpolating
-//! linearly in log α between nodes (error below 1e-4 in T and R̄ᵢ; see `CoatingTables::cached`). Mitsuba averages Rᵢ μ over its 64 table points instead of integrating: its R̄ᵢ is
+//! (distribution, α, η); a fit, which asks for hundreds of nearby α, uses a grid of α instead (64 nodes per
+//! decade, interpolated linearly in log α, error below 1e-4 in T and R̄ᵢ; see `AlphaGridScope`). Mitsuba averages Rᵢ μ over its 64 table points instead of integrating: its R̄ᵢ is
 //! lower by 1.5e-3 (GGX α = 1) to 8.7e-3 (α = 0.05) at η = 1.5, which scales the diffuse term by 1.0014 to
 //! 1.021 (measured in crates/gonio-py/tests/test_mitsuba.py, `test_roughplastic_diffuse`, 2026-11).
 //!
@@ -75,6 +75,7 @@ use crate::spectrum::Rgb;
 use crate::verify::energy::direction;
 use rayon::prelude::*;
 use std::collections::HashMap;
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, OnceLock};
 
 /// Points of the transmittance table (Mitsuba's resolution).
@@ -130,13 +131,35 @@ impl CoatingTables {
         (1.0 - t) * self.transmittance[k] + t * self.transmittance[k + 1]
     }
 
-    /// The tables for (kind, α, η): interpolated linearly in log α between the two nearest nodes of a
-    /// grid of [`ALPHA_NODES_PER_DECADE`] values of α per decade, each node integrated once per process, on
-    /// first use ([`Self::node`]). (2026-11: integrating the tables anew for every α made `gonio fit
-    /// --model roughplastic` take minutes per material, as Levenberg–Marquardt asks for a new α at every
-    /// step; on the grid a fit integrates a few dozen nodes and reuses them. The interpolation error is
-    /// bounded in the `alpha_grid_interpolation_is_accurate` test.)
+    /// The tables for (kind, α, η): integrated at α itself and cached per process, or, while an
+    /// [`AlphaGridScope`] is alive, taken from the α grid ([`Self::on_alpha_grid`]).
     fn cached(distribution: MicrofacetDistribution, eta: f32) -> Arc<CoatingTables> {
+        if ALPHA_GRID_SCOPES.load(Ordering::Relaxed) > 0 {
+            return Self::on_alpha_grid(distribution, eta);
+        }
+        type Key = (MicrofacetKind, u32, u32);
+        static CACHE: OnceLock<Mutex<HashMap<Key, Arc<CoatingTables>>>> = OnceLock::new();
+        let key = (distribution.kind, distribution.alpha_x.to_bits(), eta.to_bits());
+        let cache = CACHE.get_or_init(|| Mutex::new(HashMap::new()));
+        if let Some(t) = cache.lock().ok().and_then(|c| c.get(&key).cloned()) {
+            return t;
+        }
+        let tables = Arc::new(CoatingTables::compute(distribution, eta));
+        if let Ok(mut c) = cache.lock() {
+            c.insert(key, tables.clone());
+        }
+        tables
+    }
+
+    /// The tables for (kind, α, η) interpolated linearly in log α between the two nearest nodes of a
+    /// grid of [`ALPHA_NODES_PER_DECADE`] values of α per decade, each node integrated once per process, on
+    /// first use ([`Self::node`]). For callers that ask for many nearby α: integrating the tables anew
+    /// for every α made `gonio fit --model roughplastic` take minutes per material (2026-11), as
+    /// Levenberg–Marquardt asks for a new α at every step; on the grid a fit integrates a few dozen nodes
+    /// and reuses them. The interpolation error (below 1e-4 in T and R̄ᵢ) is bounded in the
+    /// `alpha_grid_interpolation_is_accurate` test; everything else uses the exact tables ([`Self::cached`]),
+    /// which are within 1e-5 of an independent f64 integral (crates/gonio-py/tests/test_mitsuba.py).
+    fn on_alpha_grid(distribution: MicrofacetDistribution, eta: f32) -> Arc<CoatingTables> {
         let x = f64::from(distribution.alpha_x).log10() * ALPHA_NODES_PER_DECADE;
         let j = x.floor();
         let t = x - j;
@@ -178,8 +201,36 @@ impl CoatingTables {
     }
 }
 
-/// Nodes of the α grid of the coating tables per decade of α (see [`CoatingTables::cached`]).
+/// Nodes of the α grid of the coating tables per decade of α (see [`CoatingTables::on_alpha_grid`]).
 pub const ALPHA_NODES_PER_DECADE: f64 = 64.0;
+
+/// How many [`AlphaGridScope`]s are alive in the process.
+static ALPHA_GRID_SCOPES: AtomicUsize = AtomicUsize::new(0);
+
+/// While one is alive, every `roughplastic` built in the process takes its coating tables from the α grid
+/// ([`CoatingTables::on_alpha_grid`]) rather than integrating them at its own α: for a fit, which builds
+/// the model at hundreds of nearby α. Dropping the last scope restores exact tables for later builds.
+#[must_use = "the grid is used only while the scope is alive"]
+pub struct AlphaGridScope(());
+
+impl AlphaGridScope {
+    pub fn new() -> Self {
+        ALPHA_GRID_SCOPES.fetch_add(1, Ordering::Relaxed);
+        AlphaGridScope(())
+    }
+}
+
+impl Default for AlphaGridScope {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Drop for AlphaGridScope {
+    fn drop(&mut self) {
+        ALPHA_GRID_SCOPES.fetch_sub(1, Ordering::Relaxed);
+    }
+}
 
 /// Mitsuba's rough plastic.
 #[derive(Clone, Debug, PartialEq)]
@@ -524,7 +575,7 @@ mod tests {
             let mut worst = (0f32, 0f32);
             for alpha in alphas {
                 let d = MicrofacetDistribution::new(kind, alpha, alpha);
-                let (grid, exact) = (CoatingTables::cached(d, 1.49), CoatingTables::compute(d, 1.49));
+                let (grid, exact) = (CoatingTables::on_alpha_grid(d, 1.49), CoatingTables::compute(d, 1.49));
                 let t = grid.transmittance.iter().zip(&exact.transmittance).map(|(a, b)| (a - b).abs()).fold(0.0, f32::max);
                 let r = (grid.internal_reflectance - exact.internal_reflectance).abs();
                 worst = (worst.0.max(t), worst.1.max(r));
@@ -534,7 +585,7 @@ mod tests {
         }
         // A node itself is integrated at its α.
         let d = MicrofacetDistribution::new(MicrofacetKind::Ggx, 0.1, 0.1);
-        assert_eq!(*CoatingTables::cached(d, 1.49), CoatingTables::compute(d, 1.49));
+        assert_eq!(*CoatingTables::on_alpha_grid(d, 1.49), CoatingTables::compute(d, 1.49));
     }
 
     #[test]
