@@ -477,6 +477,11 @@ impl crate::bsdf::Examples for RoughDielectric {
         r#"{"type": "roughdielectric", "distribution": "ggx", "alpha": 0.001, "int_ior": 1.0, "ext_ior": 1.5}"#,
         r#"{"type": "roughdielectric", "distribution": "beckmann", "alpha_u": 0.02, "alpha_v": 0.4}"#,
         r#"{"type": "roughdielectric", "distribution": "beckmann", "alpha": 0.001}"#,
+        // Energy compensation (bsdf::energy_compensation), both distributions, both sides of the interface.
+        r#"{"type": "roughdielectric", "distribution": "ggx", "alpha": 0.05, "energy_compensation": true}"#,
+        r#"{"type": "roughdielectric", "distribution": "beckmann", "alpha": 0.3, "int_ior": 1.0, "ext_ior": 1.5, "energy_compensation": true}"#,
+        r#"{"type": "roughdielectric", "distribution": "ggx", "alpha": 1.0, "int_ior": 1.0, "ext_ior": 1.33, "energy_compensation": true}"#,
+        r#"{"type": "roughdielectric", "distribution": "beckmann", "alpha": 1.0, "int_ior": 2.0, "ext_ior": 1.0, "energy_compensation": true}"#,
     ];
 }
 
