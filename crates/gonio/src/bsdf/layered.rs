@@ -463,6 +463,7 @@ impl crate::bsdf::Examples for Layered {
         r#"{"type": "layered", "coating": {"type": "dielectric", "int_ior": 1.5}, "base": {"type": "diffuse", "reflectance": 0.5}}"#,
         r#"{"type": "layered", "coating": {"type": "roughdielectric", "distribution": "ggx", "alpha": 0.3, "int_ior": 1.5}, "base": {"type": "diffuse", "reflectance": 0.5}}"#,
         r#"{"type": "layered", "thickness": 0.5, "albedo": [0.9, 0.6, 0.3], "g": 0.3, "coating": {"type": "dielectric", "int_ior": 1.5}, "base": {"type": "diffuse", "reflectance": 0.8}}"#,
+        r#"{"type": "layered", "coating": {"type": "dielectric", "int_ior": 1.5}, "base": {"type": "roughconductor", "distribution": "ggx", "alpha": 0.2, "material": "Cu"}}"#,
     ];
 }
 

@@ -31,7 +31,7 @@
 //! - R̄ᵢ = 2 ∫₀¹ Rᵢ(μ) μ dμ is the hemispherical average of the rough interface's reflectance from inside.
 //!
 //! gonio computes both in f64 at construction (T on 64 values of μ = k/63 interpolated linearly, as
-//! Mitsuba does; T and Rᵢ(μ) by a 128 × 128 Gauss–Legendre rule over the visible normals — total
+//! Mitsuba does — for η < 1 with more nodes around the critical angle, see `GradedTransmittance`; T and Rᵢ(μ) by a 128 × 128 Gauss–Legendre rule over the visible normals — total
 //! internal reflection makes the integrands discontinuous — and R̄ᵢ by 48-point Gauss–Legendre in μ on either side of the critical angle) and caches them per
 //! (distribution, α, η); a fit, which asks for hundreds of nearby α, uses a grid of α instead (64 nodes per
 //! decade, interpolated linearly in log α, error below 1e-4 in T and R̄ᵢ; see `AlphaGridScope`). Mitsuba averages Rᵢ μ over its 64 table points instead of integrating: its R̄ᵢ is
@@ -86,8 +86,54 @@ const TABLE_SIZE: usize = 64;
 pub struct CoatingTables {
     /// T(k/63), k = 0..64 (an array: its fixed length lets lookups go without bounds checks).
     pub transmittance: [f32; TABLE_SIZE],
+    /// For a coating less dense than the outside (η < 1): T on nodes graded towards the critical angle,
+    /// which lookups use instead of the even table (see [`GradedTransmittance`]).
+    graded: Option<GradedTransmittance>,
     /// R̄ᵢ.
     pub internal_reflectance: f32,
+}
+
+/// T(μ) on nodes graded towards the critical angle μc = √(1 − η²) of a coating less dense than the
+/// outside (η < 1). Light from outside is totally reflected below μc, where the glossy lobe alone returns
+/// it all; T falls from 1 − F to almost 0 within a few α of μc, and a linear interpolant between nodes
+/// 1/63 apart lets light in where none enters (2026-12: albedo 1.03–1.07 just below μc at α = 0.001, 1.07 at
+/// GGX α = 0.01, in `gonio check`). The nodes are the even ones k/63, μc, and μc ± α·2^(j/16) for
+/// j = −64, −63, … while the offset is below 2/63 (ratio 1.044 between neighbours: the interpolant of a
+/// tail falling like δ⁻² is then within 3·10⁻⁴ of it).
+#[derive(Debug, PartialEq)]
+struct GradedTransmittance {
+    /// Increasing μ of the nodes, from 0 to 1.
+    mu: Vec<f32>,
+    /// T at those nodes.
+    t: Vec<f32>,
+}
+
+impl GradedTransmittance {
+    /// The nodes for roughness `alpha` around the critical angle `mu_c`.
+    fn nodes(alpha: f32, mu_c: f32) -> Vec<f32> {
+        let mut mu: Vec<f32> = (0..TABLE_SIZE).map(|k| k as f32 / (TABLE_SIZE - 1) as f32).collect();
+        mu.push(mu_c);
+        let reach = 2.0 / (TABLE_SIZE - 1) as f32;
+        for j in -64..i32::MAX {
+            let delta = alpha * (j as f32 / 16.0).exp2();
+            if delta >= reach {
+                break;
+            }
+            mu.extend([mu_c - delta, mu_c + delta].into_iter().filter(|m| (0.0..=1.0).contains(m)));
+        }
+        mu.sort_by(f32::total_cmp);
+        mu.dedup_by(|a, b| (*a - *b).abs() < 1e-7);
+        mu
+    }
+
+    /// T(μ) by linear interpolation between the nodes around μ.
+    fn lookup(&self, mu: f32) -> f32 {
+        let n = self.mu.len();
+        let k = self.mu.partition_point(|m| *m <= mu).clamp(1, n - 1) - 1;
+        let (m0, m1) = (self.mu[k], self.mu[k + 1]);
+        let t = ((mu - m0) / (m1 - m0)).clamp(0.0, 1.0);
+        (1.0 - t) * self.t[k] + t * self.t[k + 1]
+    }
 }
 
 impl CoatingTables {
@@ -98,7 +144,12 @@ impl CoatingTables {
         let (gl_x, gl_w) = crate::verify::chi2::gauss_legendre(128);
         // T(0) is the limit μ → 0, which is not 0: tilted microfacets still let light in. The horizon
         // itself is degenerate; μ = 1e-6 stands for it (2026-11: as Mitsuba does).
-        let table_mu = (0..TABLE_SIZE).map(|k| (k as f32 / (TABLE_SIZE - 1) as f32).max(1e-6));
+        let graded_mu = (eta < 1.0).then(|| GradedTransmittance::nodes(distribution.alpha_x, (1.0 - eta * eta).sqrt()));
+        let table_mu: Vec<f32> = match &graded_mu {
+            Some(mu) => mu.iter().map(|m| m.max(1e-6)).collect(),
+            None => (0..TABLE_SIZE).map(|k| (k as f32 / (TABLE_SIZE - 1) as f32).max(1e-6)).collect(),
+        };
+        let table_len = table_mu.len();
         // R̄ᵢ = 2 ∫ Rᵢ(μ) μ dμ, light arriving from inside (wo below the surface). Rᵢ turns steeply at the
         // smooth interface's critical angle μc = √(1 − 1/η²) (η > 1): integrate either side of it.
         let (nodes, weights) = crate::verify::chi2::gauss_legendre(48);
@@ -114,17 +165,27 @@ impl CoatingTables {
         // Every integral is independent: all of them in parallel (2026-11: the table is built at scene load;
         // this halves its wall time on two cores). The results are summed in a fixed order.
         let wos: Vec<Vec3> =
-            table_mu.map(|mu| direction(mu, 0.0)).chain(inside.iter().map(|&(mu, _)| direction(-(mu as f32), 0.0))).collect();
+            table_mu.iter().map(|&mu| direction(mu, 0.0)).chain(inside.iter().map(|&(mu, _)| direction(-(mu as f32), 0.0))).collect();
         let splits: Vec<_> = wos.par_iter().map(|&wo| interface.energy_split_with(wo, &gl_x, &gl_w)).collect();
-        let transmittance = std::array::from_fn(|k| splits[k].transmitted as f32);
-        let internal: f64 = splits[TABLE_SIZE..].iter().zip(&inside).map(|(s, &(mu, w))| w * 2.0 * s.reflected * mu).sum();
-        CoatingTables { transmittance, internal_reflectance: internal as f32 }
+        let t: Vec<f32> = splits[..table_len].iter().map(|s| s.transmitted as f32).collect();
+        let internal: f64 = splits[table_len..].iter().zip(&inside).map(|(s, &(mu, w))| w * 2.0 * s.reflected * mu).sum();
+        let (transmittance, graded) = match graded_mu {
+            Some(mu) => {
+                let graded = GradedTransmittance { mu, t };
+                (std::array::from_fn(|k| graded.lookup(k as f32 / (TABLE_SIZE - 1) as f32)), Some(graded))
+            }
+            None => (std::array::from_fn(|k| t[k]), None),
+        };
+        CoatingTables { transmittance, graded, internal_reflectance: internal as f32 }
     }
 
     /// T(μ) by linear interpolation in the table.
     #[must_use]
     #[inline(always)]
     pub fn transmittance(&self, mu: f32) -> f32 {
+        if let Some(graded) = &self.graded {
+            return graded.lookup(mu.clamp(0.0, 1.0));
+        }
         let x = mu.clamp(0.0, 1.0) * (TABLE_SIZE - 1) as f32;
         let k = (x as usize).min(TABLE_SIZE - 2);
         let t = x - k as f32;
@@ -137,6 +198,11 @@ impl CoatingTables {
         if ALPHA_GRID_SCOPES.load(Ordering::Relaxed) > 0 {
             return Self::on_alpha_grid(distribution, eta);
         }
+        Self::exact(distribution, eta)
+    }
+
+    /// The tables integrated at (kind, α, η), cached per process.
+    fn exact(distribution: MicrofacetDistribution, eta: f32) -> Arc<CoatingTables> {
         type Key = (MicrofacetKind, u32, u32);
         static CACHE: OnceLock<Mutex<HashMap<Key, Arc<CoatingTables>>>> = OnceLock::new();
         let key = (distribution.kind, distribution.alpha_x.to_bits(), eta.to_bits());
@@ -160,6 +226,10 @@ impl CoatingTables {
     /// `alpha_grid_interpolation_is_accurate` test; everything else uses the exact tables ([`Self::cached`]),
     /// which are within 1e-5 of an independent f64 integral (crates/gonio-py/tests/test_mitsuba.py).
     fn on_alpha_grid(distribution: MicrofacetDistribution, eta: f32) -> Arc<CoatingTables> {
+        // Graded tables (η < 1) have nodes that depend on α: no grid; integrated at α itself.
+        if eta < 1.0 {
+            return Self::exact(distribution, eta);
+        }
         let x = f64::from(distribution.alpha_x).log10() * ALPHA_NODES_PER_DECADE;
         let j = x.floor();
         let t = x - j;
@@ -177,6 +247,7 @@ impl CoatingTables {
         let t = t as f32;
         Arc::new(CoatingTables {
             transmittance: std::array::from_fn(|k| (1.0 - t) * a.transmittance[k] + t * b.transmittance[k]),
+            graded: None,
             internal_reflectance: (1.0 - t) * a.internal_reflectance + t * b.internal_reflectance,
         })
     }
@@ -512,6 +583,8 @@ impl crate::bsdf::Examples for RoughPlastic {
     const EXAMPLES: &'static [&'static str] = &[
         r#"{"type": "roughplastic"}"#,
         r#"{"type": "roughplastic", "distribution": "ggx", "alpha": 0.01}"#,
+        r#"{"type": "roughplastic", "distribution": "beckmann", "alpha": 0.001}"#,
+        r#"{"type": "roughplastic", "distribution": "ggx", "alpha": 0.001, "int_ior": 1.0, "ext_ior": 1.5}"#,
         r#"{"type": "roughplastic", "alpha": 0.3}"#,
         r#"{"type": "roughplastic", "distribution": "ggx", "alpha": 0.3, "diffuse_reflectance": [0.9, 0.4, 0.1], "nonlinear": true}"#,
         r#"{"type": "roughplastic", "distribution": "ggx", "alpha": 1.0, "diffuse_reflectance": 1.0}"#,
@@ -563,6 +636,28 @@ mod tests {
                 assert!(a <= 1.0 + 2e-3, "α={alpha} μ={mu}: {a}");
             }
         }
+    }
+
+    /// A coating less dense than the outside (η = 1/1.5) reflects everything from outside below the critical
+    /// angle; the albedo must not exceed 1 there or just above it, at any α (2026-12: with the even table
+    /// alone it reached 1.03–1.07 within 0.02 of μc for α = 0.001 and GGX α = 0.01).
+    #[test]
+    fn no_energy_gain_at_the_critical_angle_of_an_inverted_coating() {
+        let eta = 1.0f32 / 1.5;
+        let mu_c = (1.0 - eta * eta).sqrt();
+        for kind in [MicrofacetKind::Ggx, MicrofacetKind::Beckmann] {
+            for alpha in [0.001f32, 0.01, 0.03] {
+                let b = RoughPlastic::new(MicrofacetDistribution::new(kind, alpha, alpha), eta, Rgb::ONE, false);
+                let graded = b.tables.graded.as_ref().expect("η < 1: graded nodes");
+                assert!(graded.mu.contains(&mu_c) && graded.mu.windows(2).all(|w| w[0] < w[1]));
+                for mu in [mu_c - 0.02, mu_c - 0.011, mu_c - 0.005, mu_c - 0.001, mu_c - 0.0002, mu_c + 0.002, mu_c + 0.01] {
+                    let a = energy::albedo_at(&b, mu, 1 << 16, 7).r();
+                    assert!(a <= 1.0 + 1e-3, "{kind:?} α={alpha} μ={mu} (μc = {mu_c}): albedo {a}");
+                }
+            }
+        }
+        // η > 1: Mitsuba's even table, no grading.
+        assert!(CoatingTables::compute(MicrofacetDistribution::new(MicrofacetKind::Ggx, 0.01, 0.01), 1.49).graded.is_none());
     }
 
     /// The tables at an α between two nodes of the grid, interpolated, against the tables integrated at
