@@ -308,6 +308,7 @@ impl crate::bsdf::Examples for RoughConductor {
         r#"{"type": "roughconductor", "distribution": "beckmann", "alpha": 0.001}"#,
         r#"{"type": "roughconductor", "distribution": "beckmann", "alpha": 0.001, "sample_visible": false}"#,
         r#"{"type": "roughconductor", "distribution": "ggx", "alpha": 0.5, "energy_compensation": true}"#,
+        r#"{"type": "roughconductor", "distribution": "beckmann", "alpha": 1.0, "material": "Au", "energy_compensation": true}"#,
     ];
 }
 
