@@ -39,6 +39,15 @@ fn render_error(dir: &Path, name: &str, from: &str, to: &str, expected: &str) {
     assert!(!out_path.exists(), "{name}: an image was written");
 }
 
+/// [`render_error`] for each row (scene name, text to replace, replacement, expected message), in one
+/// scratch directory.
+fn render_errors(tag: &str, rows: &[(&str, &str, &str, &str)]) {
+    let dir = Scratch::new(tag);
+    for (name, from, to, expected) in rows {
+        render_error(&dir, name, from, to, expected);
+    }
+}
+
 const SPHERE: &str = r#"<shape type="sphere"/>"#;
 
 #[test]
@@ -107,53 +116,55 @@ fn wrong_type() {
 
 #[test]
 fn nan_and_negative_values() {
-    let dir = Scratch::new("errors-nan");
-    render_error(
-        &dir,
-        "nan.xml",
-        SPHERE,
-        r#"<shape type="sphere"><float name="radius" value="nan"/></shape>"#,
-        "DIR/nan.xml:9:26: parameter `radius` of `sphere` must be a number in [0, ∞), got NaN",
-    );
-    render_error(
-        &dir,
-        "negative.xml",
-        SPHERE,
-        r#"<shape type="sphere"><float name="radius" value="-1"/></shape>"#,
-        "DIR/negative.xml:9:26: parameter `radius` of `sphere` must be a number in [0, ∞), got -1",
-    );
-    render_error(
-        &dir,
-        "inf.xml",
-        "<emitter type=\"constant\"/>",
-        r#"<emitter type="constant"><rgb name="radiance" value="inf"/></emitter>"#,
-        "DIR/inf.xml:8:30: parameter `radiance` of `constant` must have every channel in [0, ∞), got [inf, inf, inf]",
+    render_errors(
+        "errors-nan",
+        &[
+            (
+                "nan.xml",
+                SPHERE,
+                r#"<shape type="sphere"><float name="radius" value="nan"/></shape>"#,
+                "DIR/nan.xml:9:26: parameter `radius` of `sphere` must be a number in [0, ∞), got NaN",
+            ),
+            (
+                "negative.xml",
+                SPHERE,
+                r#"<shape type="sphere"><float name="radius" value="-1"/></shape>"#,
+                "DIR/negative.xml:9:26: parameter `radius` of `sphere` must be a number in [0, ∞), got -1",
+            ),
+            (
+                "inf.xml",
+                "<emitter type=\"constant\"/>",
+                r#"<emitter type="constant"><rgb name="radiance" value="inf"/></emitter>"#,
+                "DIR/inf.xml:8:30: parameter `radiance` of `constant` must have every channel in [0, ∞), got [inf, inf, inf]",
+            ),
+        ],
     );
 }
 
 #[test]
 fn missing_mesh_texture_and_envmap() {
-    let dir = Scratch::new("errors-refs");
-    render_error(
-        &dir,
-        "mesh.xml",
-        SPHERE,
-        r#"<shape type="ply"><string name="filename" value="missing.ply"/></shape>"#,
-        "DIR/mesh.xml:9:23: file `missing.ply` not found (searched: DIR)",
-    );
-    render_error(
-        &dir,
-        "texture.xml",
-        SPHERE,
-        r#"<shape type="sphere"><bsdf type="diffuse"><texture name="reflectance" type="bitmap"><string name="filename" value="missing.png"/></texture></bsdf></shape>"#,
-        "DIR/texture.xml:9:89: file `missing.png` not found (searched: DIR)",
-    );
-    render_error(
-        &dir,
-        "envmap.xml",
-        "<emitter type=\"constant\"/>",
-        r#"<emitter type="envmap"><string name="filename" value="/no/such/sky.exr"/></emitter>"#,
-        "DIR/envmap.xml:8:28: file `/no/such/sky.exr` does not exist",
+    render_errors(
+        "errors-refs",
+        &[
+            (
+                "mesh.xml",
+                SPHERE,
+                r#"<shape type="ply"><string name="filename" value="missing.ply"/></shape>"#,
+                "DIR/mesh.xml:9:23: file `missing.ply` not found (searched: DIR)",
+            ),
+            (
+                "texture.xml",
+                SPHERE,
+                r#"<shape type="sphere"><bsdf type="diffuse"><texture name="reflectance" type="bitmap"><string name="filename" value="missing.png"/></texture></bsdf></shape>"#,
+                "DIR/texture.xml:9:89: file `missing.png` not found (searched: DIR)",
+            ),
+            (
+                "envmap.xml",
+                "<emitter type=\"constant\"/>",
+                r#"<emitter type="envmap"><string name="filename" value="/no/such/sky.exr"/></emitter>"#,
+                "DIR/envmap.xml:8:28: file `/no/such/sky.exr` does not exist",
+            ),
+        ],
     );
 }
 
