@@ -1,10 +1,15 @@
 //! `gonio` — the command line of the gonio reflectance toolkit.
 //!
-//! Exit codes: 0 success, 1 a check failed, 2 bad input (the message names the file or parameter).
+//! Exit codes: 0 success, 1 a check failed, 2 bad input (the message names the file or parameter),
+//! 141 standard output was closed by its reader (`gonio check --all | head -1`; see [`stdout`]).
+
+// Every command writes through `stdout::out!`/`outln!`, which end gonio quietly on a closed pipe.
+#![deny(clippy::print_stdout)]
 
 mod cmd;
 mod figure;
 mod spec;
+mod stdout;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;

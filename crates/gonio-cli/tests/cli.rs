@@ -1,10 +1,10 @@
 //! The `gonio` binary end to end: good input passes, bad input gets one clear line and exit code 2.
 
-use std::process::{Command, Output};
+mod common;
 
-fn gonio(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_gonio")).args(args).output().expect("run gonio")
-}
+use common::{assert_one_line_error, gonio, gonio_command, ok, Scratch};
+use std::path::Path;
+use std::process::{Command, Stdio};
 
 fn data(name: &str) -> String {
     format!("{}/tests/data/{name}", env!("CARGO_MANIFEST_DIR"))
@@ -46,12 +46,7 @@ fn bad_input_is_one_line_and_exit_code_two() {
         (&["check", "/no/such/file.xml"], "/no/such/file.xml"),
     ];
     for (args, expect) in cases {
-        let out = gonio(args);
-        let stderr = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
-        assert!(stderr.contains(expect), "{args:?}: expected {expect:?} in {stderr:?}");
-        assert_eq!(stderr.trim_end().lines().count(), 1, "{args:?}: {stderr}");
-        assert!(!stderr.contains("panicked"));
+        assert_one_line_error(args, expect);
     }
 }
 
@@ -98,16 +93,14 @@ fn check_all_passes_at_the_full_standard() {
 /// (by its `.binary` extension) and compare directional albedos with the model's.
 #[test]
 fn measure_then_load_round_trips() {
-    let dir = std::env::temp_dir().join(format!("gonio-cli-measure-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = Scratch::new("measure");
     let out = dir.join("plastic.binary");
     let spec = r#"{"type": "roughplastic", "distribution": "ggx", "alpha": 0.3, "diffuse_reflectance": [0.5, 0.3, 0.1]}"#;
-    let m = gonio(&["measure", spec, "-o", out.to_str().unwrap(), "--supersample", "1"]);
-    assert_eq!(m.status.code(), Some(0), "{}", String::from_utf8_lossy(&m.stderr));
+    ok(&gonio(&["measure", spec, "-o", out.to_str().unwrap(), "--supersample", "1"]));
     assert_eq!(std::fs::metadata(&out).unwrap().len(), 34_992_012);
     let albedos = |arg: &str| -> Vec<[f64; 3]> {
         let o = gonio(&["albedo", arg, "--angles", "4", "--samples", "40000"]);
-        assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+        ok(&o);
         String::from_utf8_lossy(&o.stdout)
             .lines()
             .filter_map(|l| {
@@ -131,15 +124,13 @@ fn measure_then_load_round_trips() {
         assert_eq!(o.status.code(), Some(2));
         assert!(String::from_utf8_lossy(&o.stderr).contains(expect));
     }
-    std::fs::remove_dir_all(dir).unwrap();
 }
 
 /// `gonio fit` recovers the parameters of a known model and writes XML that loads as the fitted model;
 /// a misspelt model name is a one-line error before any work.
 #[test]
 fn fit_recovers_a_known_model_and_writes_loadable_xml() {
-    let dir = std::env::temp_dir().join(format!("gonio-fit-test-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = Scratch::new("fit");
     let out_path = dir.join("fit.xml");
     let target = r#"{"type": "sum", "weights": [1, 1], "a": {"type": "diffuse", "reflectance": [0.3, 0.2, 0.1]},
         "b": {"type": "roughconductor", "distribution": "ggx", "alpha": 0.25, "material": "Au"}}"#;
@@ -156,16 +147,77 @@ fn fit_recovers_a_known_model_and_writes_loadable_xml() {
         .unwrap_or_else(|| panic!("no alpha in {xml}"));
     assert!((alpha - 0.25).abs() < 0.02 * 0.25, "α = {alpha}\n{stdout}");
     // The written file is a <bsdf> that `gonio check` reads.
-    let albedo = gonio(&["albedo", out_path.to_str().unwrap()]);
-    assert_eq!(albedo.status.code(), Some(0), "{}", String::from_utf8_lossy(&albedo.stderr));
+    ok(&gonio(&["albedo", out_path.to_str().unwrap()]));
     let bad = gonio(&["fit", target, "--model", "gxx"]);
     assert_eq!(bad.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&bad.stderr).contains("unknown model `gxx`"));
     // `gonio fit --list` needs no measured BSDF (bench/fit_rgl_table.sh reads the model names from it).
     let list = gonio(&["fit", "--list"]);
-    assert_eq!(list.status.code(), Some(0), "{}", String::from_utf8_lossy(&list.stderr));
+    ok(&list);
     let names: Vec<String> =
         String::from_utf8_lossy(&list.stdout).lines().filter_map(|l| l.split_whitespace().next().map(str::to_string)).collect();
     assert_eq!(names, gonio::fit::MODELS.iter().map(|m| m.name).collect::<Vec<_>>());
-    std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// The exit code of a gonio whose reader closed standard output (128 + SIGPIPE).
+const CLOSED_STDOUT: i32 = 141;
+
+/// `gonio check --all | head -1`: the reader takes one line and closes the pipe while gonio still has
+/// models to check (the sweep alone, to keep the test short; the tables go through the same writer). gonio must end quietly (exit code 141, nothing on stderr), never with a panic about a
+/// broken pipe.
+#[test]
+fn a_reader_that_stops_after_one_line_ends_gonio_quietly() {
+    use std::io::BufRead;
+    let mut child = gonio_command()
+        .args(["check", "--all", "--sweep-only", "--sweep", "200000"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("run gonio");
+    let mut first = String::new();
+    std::io::BufReader::new(child.stdout.take().unwrap()).read_line(&mut first).unwrap();
+    assert!(!first.is_empty(), "no first line");
+    // The reader is dropped here: the pipe is closed while the second model is being swept.
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert_eq!(stderr, "", "a closed pipe is not an error worth a message");
+    assert_eq!(out.status.code(), Some(CLOSED_STDOUT));
+}
+
+/// Standard output a pipe whose reader has already gone (deterministic: the reader, `true`, has exited
+/// before gonio starts), for every command that prints to stdout; and a full device (`> /dev/full`) is
+/// one line of error, not a panic. (`--all`, which loads every example model first, is the test above.)
+#[test]
+fn every_command_ends_quietly_when_stdout_is_closed() {
+    let diffuse = r#"{"type": "diffuse"}"#;
+    let commands: &[&[&str]] = &[
+        &["check", diffuse, "--sweep-only", "--sweep", "20000"],
+        &["check", diffuse, "--samples", "20000", "--sweep", "1000"],
+        &["check", diffuse, "--json", "--samples", "20000", "--sweep", "1000"],
+        &["albedo", diffuse, "--angles", "4", "--samples", "64"],
+        &["fit", "--list"],
+    ];
+    for args in commands {
+        let mut reader = Command::new("true").stdin(Stdio::piped()).spawn().expect("run true");
+        let closed = reader.stdin.take().unwrap();
+        reader.wait().unwrap();
+        let out = gonio_command().args(*args).stdout(closed).output().expect("run gonio");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+        assert_eq!(stderr, "", "{args:?}");
+        assert_eq!(out.status.code(), Some(CLOSED_STDOUT), "{args:?}");
+
+        if Path::new("/dev/full").exists() {
+            let full = std::fs::OpenOptions::new().write(true).open("/dev/full").unwrap();
+            let out = gonio_command().args(*args).stdout(full).output().expect("run gonio");
+            let stderr = String::from_utf8_lossy(&out.stderr);
+            assert_eq!(
+                stderr.trim_end(),
+                "gonio: error: cannot write to standard output: No space left on device (os error 28)",
+                "{args:?}"
+            );
+            assert_eq!(out.status.code(), Some(2), "{args:?}");
+        }
+    }
 }

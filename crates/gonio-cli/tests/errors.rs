@@ -5,30 +5,11 @@
 //! Every bad input must give exit code 2 and one line on stderr with the exact text of the catalogue —
 //! never a panic.
 
-use std::path::{Path, PathBuf};
+mod common;
+
+use common::{gonio, gonio_command, ok, Scratch, SCENE};
+use std::path::Path;
 use std::process::{Command, Output};
-
-fn gonio(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_gonio")).args(args).output().expect("run gonio")
-}
-
-const SCENE: &str = r#"<scene version="3.0.0">
-    <default name="res" value="4"/>
-    <integrator type="path"><integer name="max_depth" value="3"/></integrator>
-    <sensor type="perspective">
-        <transform name="to_world"><lookat origin="0, 0, 4" target="0, 0, 0" up="0, 1, 0"/></transform>
-        <film type="hdrfilm"><integer name="width" value="$res"/><integer name="height" value="$res"/></film>
-    </sensor>
-    <emitter type="constant"/>
-    <shape type="sphere"/>
-</scene>"#;
-
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("gonio-errors-test-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
 
 /// Write `SCENE` with `from` replaced by `to` as `dir/name`.
 fn scene_with(dir: &Path, name: &str, from: &str, to: &str) -> String {
@@ -58,11 +39,20 @@ fn render_error(dir: &Path, name: &str, from: &str, to: &str, expected: &str) {
     assert!(!out_path.exists(), "{name}: an image was written");
 }
 
+/// [`render_error`] for each row (scene name, text to replace, replacement, expected message), in one
+/// scratch directory.
+fn render_errors(tag: &str, rows: &[(&str, &str, &str, &str)]) {
+    let dir = Scratch::new(tag);
+    for (name, from, to, expected) in rows {
+        render_error(&dir, name, from, to, expected);
+    }
+}
+
 const SPHERE: &str = r#"<shape type="sphere"/>"#;
 
 #[test]
 fn missing_scene_file() {
-    let dir = temp_dir("missing");
+    let dir = Scratch::new("errors-missing");
     let out = gonio(&["render", dir.join("nope.xml").to_str().unwrap(), "-o", dir.join("o.exr").to_str().unwrap()]);
     assert_error(&out, &dir, "DIR/nope.xml: No such file or directory (os error 2)");
 }
@@ -71,7 +61,7 @@ fn missing_scene_file() {
 #[test]
 fn unreadable_scene_file() {
     use std::os::unix::fs::PermissionsExt;
-    let dir = temp_dir("unreadable");
+    let dir = Scratch::new("errors-unreadable");
     let scene = scene_with(&dir, "locked.xml", "", "");
     std::fs::set_permissions(&scene, std::fs::Permissions::from_mode(0o000)).unwrap();
     if std::fs::read(&scene).is_ok() {
@@ -84,7 +74,7 @@ fn unreadable_scene_file() {
 
 #[test]
 fn not_xml() {
-    let dir = temp_dir("notxml");
+    let dir = Scratch::new("errors-notxml");
     let path = dir.join("hello.xml");
     std::fs::write(&path, "hello").unwrap();
     let out = gonio(&["render", path.to_str().unwrap(), "-o", dir.join("o.exr").to_str().unwrap()]);
@@ -94,7 +84,7 @@ fn not_xml() {
 #[test]
 fn unknown_plugin() {
     render_error(
-        &temp_dir("plugin"),
+        &Scratch::new("errors-plugin"),
         "blob.xml",
         SPHERE,
         r#"<shape type="blob"/>"#,
@@ -105,7 +95,7 @@ fn unknown_plugin() {
 #[test]
 fn unknown_parameter() {
     render_error(
-        &temp_dir("param"),
+        &Scratch::new("errors-param"),
         "typo.xml",
         SPHERE,
         r#"<shape type="sphere"><float name="radiuss" value="1"/></shape>"#,
@@ -116,7 +106,7 @@ fn unknown_parameter() {
 #[test]
 fn wrong_type() {
     render_error(
-        &temp_dir("type"),
+        &Scratch::new("errors-type"),
         "type.xml",
         SPHERE,
         r#"<shape type="sphere"><string name="radius" value="big"/></shape>"#,
@@ -126,118 +116,139 @@ fn wrong_type() {
 
 #[test]
 fn nan_and_negative_values() {
-    let dir = temp_dir("nan");
-    render_error(
-        &dir,
-        "nan.xml",
-        SPHERE,
-        r#"<shape type="sphere"><float name="radius" value="nan"/></shape>"#,
-        "DIR/nan.xml:9:26: parameter `radius` of `sphere` must be a number in [0, ∞), got NaN",
-    );
-    render_error(
-        &dir,
-        "negative.xml",
-        SPHERE,
-        r#"<shape type="sphere"><float name="radius" value="-1"/></shape>"#,
-        "DIR/negative.xml:9:26: parameter `radius` of `sphere` must be a number in [0, ∞), got -1",
-    );
-    render_error(
-        &dir,
-        "inf.xml",
-        "<emitter type=\"constant\"/>",
-        r#"<emitter type="constant"><rgb name="radiance" value="inf"/></emitter>"#,
-        "DIR/inf.xml:8:30: parameter `radiance` of `constant` must have every channel in [0, ∞), got [inf, inf, inf]",
+    render_errors(
+        "errors-nan",
+        &[
+            (
+                "nan.xml",
+                SPHERE,
+                r#"<shape type="sphere"><float name="radius" value="nan"/></shape>"#,
+                "DIR/nan.xml:9:26: parameter `radius` of `sphere` must be a number in [0, ∞), got NaN",
+            ),
+            (
+                "negative.xml",
+                SPHERE,
+                r#"<shape type="sphere"><float name="radius" value="-1"/></shape>"#,
+                "DIR/negative.xml:9:26: parameter `radius` of `sphere` must be a number in [0, ∞), got -1",
+            ),
+            (
+                "inf.xml",
+                "<emitter type=\"constant\"/>",
+                r#"<emitter type="constant"><rgb name="radiance" value="inf"/></emitter>"#,
+                "DIR/inf.xml:8:30: parameter `radiance` of `constant` must have every channel in [0, ∞), got [inf, inf, inf]",
+            ),
+        ],
     );
 }
 
 #[test]
 fn missing_mesh_texture_and_envmap() {
-    let dir = temp_dir("refs");
-    render_error(
-        &dir,
-        "mesh.xml",
-        SPHERE,
-        r#"<shape type="ply"><string name="filename" value="missing.ply"/></shape>"#,
-        "DIR/mesh.xml:9:23: file `missing.ply` not found (searched: DIR)",
-    );
-    render_error(
-        &dir,
-        "texture.xml",
-        SPHERE,
-        r#"<shape type="sphere"><bsdf type="diffuse"><texture name="reflectance" type="bitmap"><string name="filename" value="missing.png"/></texture></bsdf></shape>"#,
-        "DIR/texture.xml:9:89: file `missing.png` not found (searched: DIR)",
-    );
-    render_error(
-        &dir,
-        "envmap.xml",
-        "<emitter type=\"constant\"/>",
-        r#"<emitter type="envmap"><string name="filename" value="/no/such/sky.exr"/></emitter>"#,
-        "DIR/envmap.xml:8:28: file `/no/such/sky.exr` does not exist",
+    render_errors(
+        "errors-refs",
+        &[
+            (
+                "mesh.xml",
+                SPHERE,
+                r#"<shape type="ply"><string name="filename" value="missing.ply"/></shape>"#,
+                "DIR/mesh.xml:9:23: file `missing.ply` not found (searched: DIR)",
+            ),
+            (
+                "texture.xml",
+                SPHERE,
+                r#"<shape type="sphere"><bsdf type="diffuse"><texture name="reflectance" type="bitmap"><string name="filename" value="missing.png"/></texture></bsdf></shape>"#,
+                "DIR/texture.xml:9:89: file `missing.png` not found (searched: DIR)",
+            ),
+            (
+                "envmap.xml",
+                "<emitter type=\"constant\"/>",
+                r#"<emitter type="envmap"><string name="filename" value="/no/such/sky.exr"/></emitter>"#,
+                "DIR/envmap.xml:8:28: file `/no/such/sky.exr` does not exist",
+            ),
+        ],
     );
 }
 
 const DATA: &str = "/work/shared/data";
 
-/// The first `n` bytes of a shared data file, written to `dir/name`; `None` (and a note) when the data is
-/// missing and GONIO_SKIP_MISSING_DATA is set.
-fn truncated(dir: &Path, source: &str, n: usize, name: &str) -> Option<PathBuf> {
-    let Ok(bytes) = std::fs::read(format!("{DATA}/{source}")) else {
+/// The first `n` bytes of a shared data file; `None` (and a note) when the data is missing and
+/// GONIO_SKIP_MISSING_DATA is set.
+fn shared_prefix(source: &str, n: usize) -> Option<Vec<u8>> {
+    let Ok(mut bytes) = std::fs::read(format!("{DATA}/{source}")) else {
         assert!(std::env::var_os("GONIO_SKIP_MISSING_DATA").is_some(), "{DATA}/{source} is missing");
         eprintln!("skipped: {DATA}/{source} is missing");
         return None;
     };
-    let path = dir.join(name);
-    std::fs::write(&path, &bytes[..n.min(bytes.len())]).unwrap();
-    Some(path)
+    bytes.truncate(n);
+    Some(bytes)
 }
 
+/// What a truncated file is made from.
+enum Content {
+    /// The first bytes of a file in the shared data.
+    Prefix(&'static str, usize),
+    Bytes(Vec<u8>),
+}
+
+/// How gonio meets it: a scene whose element (replacing the first string) names the file, rendered as
+/// `EXT.xml`, or `gonio check FILE`.
+enum Via {
+    Scene(&'static str, &'static str),
+    Check,
+}
+
+/// One row per truncated format: the file, how it is read, the exact message.
 #[test]
 fn truncated_binary_files() {
-    let dir = temp_dir("truncated");
-    if truncated(&dir, "mitsuba/common/meshes/sphere.ply", 5000, "t.ply").is_some() {
-        render_error(
-            &dir,
-            "ply.xml",
-            SPHERE,
-            r#"<shape type="ply"><string name="filename" value="t.ply"/></shape>"#,
-            "DIR/ply.xml:9:23: cannot load the ply mesh: DIR/t.ply: line 431: element `face` declares 840 records, more than the 176 bytes left can hold",
-        );
-    }
-    if truncated(&dir, "mitsuba/common/meshes/matpreview.serialized", 400_000, "t.serialized").is_some() {
-        render_error(
-            &dir,
-            "serialized.xml",
-            SPHERE,
-            r#"<shape type="serialized"><string name="filename" value="t.serialized"/></shape>"#,
-            "DIR/serialized.xml:9:30: cannot load the serialized mesh: DIR/t.serialized: byte 399996: mesh count 3031104048 does not fit the file of 400000 bytes",
-        );
-    }
-    if truncated(&dir, "envmaps/museum.exr", 20_000, "t.exr").is_some() {
-        render_error(
-            &dir,
-            "exr.xml",
-            "<emitter type=\"constant\"/>",
-            r#"<emitter type="envmap"><string name="filename" value="t.exr"/></emitter>"#,
-            "DIR/exr.xml:8:28: cannot load the environment map: DIR/t.exr: OpenEXR data: invalid: reference to missing bytes",
-        );
-    }
-    if let Some(bsdf) = truncated(&dir, "rgl/paper_white_rgb.bsdf", 300_000, "t.bsdf") {
-        assert_error(
-            &gonio(&["check", bsdf.to_str().unwrap()]),
-            &dir,
-            "DIR/t.bsdf: field `vndf` (byte 198): f32 data of shape [1, 8, 128, 128] (524288 bytes at byte 2536) runs past the end of the file (300000 bytes): truncated?",
-        );
-    }
+    use Content::{Bytes, Prefix};
+    let dir = Scratch::new("errors-truncated");
     // A MERL header (90 × 90 × 180) followed by 1000 of the 34,992,000 bytes of data.
-    let merl = dir.join("t.binary");
-    let mut bytes: Vec<u8> = [90i32, 90, 180].iter().flat_map(|v| v.to_le_bytes()).collect();
-    bytes.resize(1012, 0);
-    std::fs::write(&merl, bytes).unwrap();
-    assert_error(
-        &gonio(&["check", merl.to_str().unwrap()]),
-        &dir,
-        "DIR/t.binary: byte 1012: truncated: the file has 1012 bytes, expected 34992012",
-    );
+    let mut merl: Vec<u8> = [90i32, 90, 180].iter().flat_map(|v| v.to_le_bytes()).collect();
+    merl.resize(1012, 0);
+    let envmap = "<emitter type=\"constant\"/>";
+    let rows = [
+        (
+            Prefix("mitsuba/common/meshes/sphere.ply", 5000),
+            "t.ply",
+            Via::Scene(SPHERE, r#"<shape type="ply"><string name="filename" value="t.ply"/></shape>"#),
+            "DIR/ply.xml:9:23: cannot load the ply mesh: DIR/t.ply: line 431: element `face` declares 840 records, more than the 176 bytes left can hold",
+        ),
+        (
+            Prefix("mitsuba/common/meshes/matpreview.serialized", 400_000),
+            "t.serialized",
+            Via::Scene(SPHERE, r#"<shape type="serialized"><string name="filename" value="t.serialized"/></shape>"#),
+            "DIR/serialized.xml:9:30: cannot load the serialized mesh: DIR/t.serialized: byte 399996: mesh count 3031104048 does not fit the file of 400000 bytes",
+        ),
+        (
+            Prefix("envmaps/museum.exr", 20_000),
+            "t.exr",
+            Via::Scene(envmap, r#"<emitter type="envmap"><string name="filename" value="t.exr"/></emitter>"#),
+            "DIR/exr.xml:8:28: cannot load the environment map: DIR/t.exr: OpenEXR data: invalid: reference to missing bytes",
+        ),
+        (
+            Prefix("rgl/paper_white_rgb.bsdf", 300_000),
+            "t.bsdf",
+            Via::Check,
+            "DIR/t.bsdf: field `vndf` (byte 198): f32 data of shape [1, 8, 128, 128] (524288 bytes at byte 2536) runs past the end of the file (300000 bytes): truncated?",
+        ),
+        (Bytes(merl), "t.binary", Via::Check, "DIR/t.binary: byte 1012: truncated: the file has 1012 bytes, expected 34992012"),
+    ];
+    for (content, name, via, expected) in rows {
+        let bytes = match content {
+            Prefix(source, n) => match shared_prefix(source, n) {
+                Some(bytes) => bytes,
+                None => continue,
+            },
+            Bytes(bytes) => bytes,
+        };
+        std::fs::write(dir.join(name), bytes).unwrap();
+        match via {
+            Via::Scene(from, to) => {
+                let extension = name.rsplit('.').next().unwrap();
+                render_error(&dir, &format!("{extension}.xml"), from, to, expected);
+            }
+            Via::Check => assert_error(&gonio(&["check", &dir.arg(name)]), &dir, expected),
+        }
+    }
 }
 
 /// Zero-area shapes: a sphere of radius 0 and a scale of 0 are errors; a mesh whose triangles are all
@@ -245,7 +256,7 @@ fn truncated_binary_files() {
 /// samples.
 #[test]
 fn zero_area_shapes() {
-    let dir = temp_dir("zero");
+    let dir = Scratch::new("errors-zero");
     render_error(
         &dir,
         "sphere.xml",
@@ -280,7 +291,7 @@ fn zero_area_shapes() {
 /// a two-sided one is lit by a light inside.
 #[test]
 fn camera_inside_geometry_renders() {
-    let dir = temp_dir("inside");
+    let dir = Scratch::new("errors-inside");
     let mut means = Vec::new();
     for (name, bsdf) in [("one", r#"<bsdf type="diffuse"/>"#), ("two", r#"<bsdf type="twosided"><bsdf type="diffuse"/></bsdf>"#)] {
         let scene = scene_with(
@@ -293,8 +304,7 @@ fn camera_inside_geometry_renders() {
             ),
         );
         let image = dir.join(format!("{name}.exr"));
-        let out = gonio(&["render", &scene, "-o", image.to_str().unwrap(), "--spp", "4", "--quiet"]);
-        assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+        ok(&gonio(&["render", &scene, "-o", image.to_str().unwrap(), "--spp", "4", "--quiet"]));
         let img = gonio::image::read_image(&image).unwrap();
         assert!(img.data.iter().all(|v| v.is_finite()));
         means.push(img.mean().luminance());
@@ -305,7 +315,7 @@ fn camera_inside_geometry_renders() {
 
 #[test]
 fn zero_spp() {
-    let dir = temp_dir("spp");
+    let dir = Scratch::new("errors-spp");
     let scene = scene_with(&dir, "ok.xml", "", "");
     assert_error(&gonio(&["render", &scene, "--spp", "0"]), &dir, "command line: --spp must be at least 1");
     let zero = scene_with(
@@ -323,7 +333,7 @@ fn zero_spp() {
 
 #[test]
 fn absurd_resolutions() {
-    let dir = temp_dir("res");
+    let dir = Scratch::new("errors-res");
     let scene = scene_with(&dir, "ok.xml", "", "");
     for (res, expected) in [
         ("res=0", "DIR/ok.xml:6:30: parameter `width` of `hdrfilm` must be an integer in [1, 65536], got 0"),
@@ -338,7 +348,7 @@ fn absurd_resolutions() {
 /// The output path is checked before the scene is even loaded.
 #[test]
 fn output_not_writable() {
-    let dir = temp_dir("output");
+    let dir = Scratch::new("errors-output");
     let scene = scene_with(&dir, "ok.xml", "", "");
     for (output, expected) in [
         (dir.join("no/such/dir/out.exr"), "DIR/no/such/dir/out.exr: No such file or directory (os error 2)"),
@@ -356,11 +366,10 @@ fn output_not_writable() {
 #[test]
 fn a_failed_render_leaves_the_old_image_untouched() {
     use std::os::unix::fs::PermissionsExt;
-    let dir = temp_dir("keep");
+    let dir = Scratch::new("errors-keep");
     let scene = scene_with(&dir, "ok.xml", "", "");
     let image = dir.join("keep.exr");
-    let out = gonio(&["render", &scene, "-o", image.to_str().unwrap(), "--spp", "2", "--quiet"]);
-    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    ok(&gonio(&["render", &scene, "-o", image.to_str().unwrap(), "--spp", "2", "--quiet"]));
     let good = std::fs::read(&image).unwrap();
     let bad = scene_with(&dir, "bad.xml", SPHERE, r#"<shape type="sphere"><float name="radius" value="-1"/></shape>"#);
     for args in [vec!["render", &bad], vec!["render", &scene, "-D", "res=0"], vec!["render", &scene, "-D", "oops"]] {
@@ -389,11 +398,11 @@ fn a_failed_render_leaves_the_old_image_untouched() {
 /// comes on a loaded machine; then nothing is written and the test waits longer.
 #[test]
 fn sigterm_writes_the_samples_so_far() {
-    let dir = temp_dir("sigterm");
+    let dir = Scratch::new("errors-sigterm");
     let scene = scene_with(&dir, "long.xml", "", "");
     let image = dir.join("long.exr");
     for wait in [1.0f64, 2.0, 4.0, 8.0] {
-        let child = Command::new(env!("CARGO_BIN_EXE_gonio"))
+        let child = gonio_command()
             .args(["render", &scene, "-D", "res=32", "--spp", "100000000", "--threads", "1", "-o", image.to_str().unwrap()])
             .stderr(std::process::Stdio::piped())
             .spawn()
@@ -434,7 +443,7 @@ fn sigterm_writes_the_samples_so_far() {
 /// counted on stderr and in the EXR notes, and the image is finite.
 #[test]
 fn non_finite_samples_are_reported() {
-    let dir = temp_dir("nonfinite");
+    let dir = Scratch::new("errors-nonfinite");
     let scene = scene_with(
         &dir,
         "hot.xml",
@@ -458,4 +467,18 @@ fn non_finite_samples_are_reported() {
     let notes = gonio::image::read_notes(&image).unwrap();
     assert!(notes.contains(&("gonio.nonfinite_samples".to_string(), count.to_string())), "{notes:?}");
     assert!(notes.contains(&("gonio.interrupted".to_string(), "false".to_string())), "{notes:?}");
+}
+
+#[test]
+fn scratch_directories_remove_themselves() {
+    let kept;
+    {
+        let dir = Scratch::new("self");
+        std::fs::create_dir_all(dir.join("a/b")).unwrap();
+        std::fs::write(dir.join("a/b/c.txt"), "x").unwrap();
+        assert_ne!(*dir, *Scratch::new("self"), "two scratch directories are distinct");
+        kept = dir.to_path_buf();
+        assert!(kept.is_dir());
+    }
+    assert!(!kept.exists(), "{} was left behind", kept.display());
 }

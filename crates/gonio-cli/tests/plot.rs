@@ -1,22 +1,13 @@
 //! `gonio plot` end to end: figures that decode and are not blank, legends, the numbers behind them,
 //! measured files through the shared loader, and bad input with exit code 2.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
 
-fn gonio(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_gonio")).args(args).output().expect("run gonio")
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("gonio-plot-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
-}
+use common::{assert_bad_input, gonio, Scratch};
+use std::path::Path;
 
 fn ok(args: &[&str]) {
-    let out = gonio(args);
-    assert_eq!(out.status.code(), Some(0), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
+    common::ok(&gonio(args));
 }
 
 const DIFFUSE: &str = r#"{"type": "diffuse", "reflectance": [0.2, 0.5, 0.8]}"#;
@@ -48,10 +39,11 @@ fn assert_png_is_a_figure(path: &Path, width: usize, curve: bool) {
 
 #[test]
 fn polar_png_and_svg_with_two_models() {
-    let png = scratch("polar.png");
+    let dir = Scratch::new("plot");
+    let png = dir.join("polar.png");
     ok(&["plot", DIFFUSE, GGX, "--theta-o", "30", "--kind", "polar", "-o", png.to_str().unwrap()]);
     assert_png_is_a_figure(&png, 1360, true);
-    let svg = scratch("polar.svg");
+    let svg = dir.join("polar.svg");
     ok(&["plot", DIFFUSE, GGX, "--theta-o", "30", "-o", svg.to_str().unwrap(), "--log"]);
     let text = std::fs::read_to_string(&svg).unwrap();
     assert!(text.starts_with("<?xml") && text.trim_end().ends_with("</svg>"));
@@ -68,8 +60,9 @@ fn polar_png_and_svg_with_two_models() {
 
 #[test]
 fn every_kind_draws() {
+    let dir = Scratch::new("plot");
     for (kind, width) in [("3d", 960), ("slice", 1030), ("albedo", 1000)] {
-        let png = scratch(&format!("{kind}.png"));
+        let png = dir.join(format!("{kind}.png"));
         ok(&["plot", GGX, DIFFUSE, "--theta-o", "45", "--kind", kind, "-o", png.to_str().unwrap(), "--samples", "1024"]);
         assert_png_is_a_figure(&png, width, kind != "slice");
     }
@@ -77,7 +70,8 @@ fn every_kind_draws() {
 
 #[test]
 fn csv_holds_the_plotted_numbers() {
-    let csv = scratch("polar.csv");
+    let dir = Scratch::new("plot");
+    let csv = dir.join("polar.csv");
     ok(&["plot", DIFFUSE, "--theta-o", "30", "--channel", "b", "-o", csv.to_str().unwrap()]);
     let text = std::fs::read_to_string(&csv).unwrap();
     let mut lines = text.lines();
@@ -104,19 +98,21 @@ fn csv_holds_the_plotted_numbers() {
 
 #[test]
 fn measured_files_use_the_shared_loader() {
+    let dir = Scratch::new("plot");
     let rgl = "/work/shared/data/rgl/paper_white_rgb.bsdf";
-    if !std::path::Path::new(rgl).exists() {
+    if !Path::new(rgl).exists() {
         eprintln!("skipped: {rgl} not present");
         return;
     }
-    let svg = scratch("measured.svg");
+    let svg = dir.join("measured.svg");
     ok(&["plot", rgl, "--kind", "slice", "-o", svg.to_str().unwrap()]);
     assert!(std::fs::read_to_string(&svg).unwrap().contains(">measured</text>"));
 }
 
 #[test]
 fn bad_input_is_exit_code_two() {
-    let out = scratch("bad.png");
+    let dir = Scratch::new("plot");
+    let out = dir.join("bad.png");
     let out = out.to_str().unwrap();
     let cases: &[(&[&str], &str)] = &[
         (&["plot", DIFFUSE, "--theta-o", "95", "-o", out], "--theta-o"),
@@ -132,11 +128,7 @@ fn bad_input_is_exit_code_two() {
         (&["plot", DIFFUSE, "--theta-o", "10", "-o", "/no/such/dir/x.png"], "/no/such/dir/x.png"),
     ];
     for (args, expect) in cases {
-        let o = gonio(args);
-        let stderr = String::from_utf8_lossy(&o.stderr);
-        assert_eq!(o.status.code(), Some(2), "{args:?}: {stderr}");
-        assert!(stderr.contains(expect), "{args:?}: expected {expect:?} in {stderr:?}");
-        assert!(!stderr.contains("panicked"));
+        assert_bad_input(args, expect);
     }
-    assert!(!std::path::Path::new(out).exists(), "a failed plot left a file");
+    assert!(!Path::new(out).exists(), "a failed plot left a file");
 }

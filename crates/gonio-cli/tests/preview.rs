@@ -1,24 +1,11 @@
 //! `gonio preview` end to end: the image has the right size, the sphere is lit and the background is the
 //! environment; a white Lambertian sphere in the white furnace renders as the furnace; bad input exits 2.
 
+mod common;
+
+use common::{assert_one_line_error, gonio, ok, Scratch};
 use gonio::image::read_image;
 use gonio::Rgb;
-use std::path::PathBuf;
-use std::process::{Command, Output};
-
-fn gonio(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_gonio")).args(args).output().expect("run gonio")
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("gonio-preview-test-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn ok(out: &Output) {
-    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
-}
 
 /// The mean over the central half of a square image (all on the sphere, which fills 90 % of the width).
 fn centre_mean(img: &gonio::image::Image) -> Rgb {
@@ -34,7 +21,7 @@ fn centre_mean(img: &gonio::image::Image) -> Rgb {
 
 #[test]
 fn diffuse_sphere_png_has_the_size_a_lit_sphere_and_the_sky_behind() {
-    let dir = temp_dir("png");
+    let dir = Scratch::new("preview-png");
     let png = dir.join("ball.png");
     let p = png.to_str().unwrap();
     ok(&gonio(&[
@@ -61,14 +48,13 @@ fn diffuse_sphere_png_has_the_size_a_lit_sphere_and_the_sky_behind() {
     ok(&gonio(&["preview", r#"{"type": "diffuse"}"#, "--light", "1,0,0.2", "--size", "32", "--spp", "4", "-o", p, "--quiet"]));
     let img = read_image(&png).unwrap();
     assert!(img.get(24, 16).r() > 4.0 * img.get(7, 16).r(), "{} vs {}", img.get(24, 16), img.get(7, 16));
-    let _ = std::fs::remove_dir_all(dir);
 }
 
 #[test]
 fn white_diffuse_sphere_in_the_white_furnace_is_white() {
     // A convex white Lambertian sphere under uniform radiance 1 reflects radiance 1 everywhere. The mean
     // over 32² pixels × 16 spp has a standard error of a few tenths of a percent.
-    let dir = temp_dir("furnace");
+    let dir = Scratch::new("preview-furnace");
     let exr = dir.join("furnace.exr");
     let e = exr.to_str().unwrap();
     ok(&gonio(&["preview", r#"{"type": "diffuse", "reflectance": 1}"#, "--env", "constant", "--size", "64", "--spp", "16", "-o", e]));
@@ -94,12 +80,11 @@ fn white_diffuse_sphere_in_the_white_furnace_is_white() {
         e,
     ]));
     assert_eq!(read_image(&exr).unwrap().get(0, 0), Rgb::splat(0.5));
-    let _ = std::fs::remove_dir_all(dir);
 }
 
 #[test]
 fn grid_and_several_bsdfs_are_laid_out_in_rows_and_columns() {
-    let dir = temp_dir("grid");
+    let dir = Scratch::new("preview-grid");
     let exr = dir.join("grid.exr");
     let e = exr.to_str().unwrap();
     let a = r#"{"type": "roughconductor", "distribution": "ggx"}"#;
@@ -111,12 +96,11 @@ fn grid_and_several_bsdfs_are_laid_out_in_rows_and_columns() {
     assert_eq!(img.get(16, 5), Rgb::splat(0.02), "the gap");
     ok(&gonio(&["preview", a, b, "--env", "constant", "--size", "16", "--spp", "1", "-o", e]));
     assert_eq!(read_image(&exr).unwrap().width, 33);
-    let _ = std::fs::remove_dir_all(dir);
 }
 
 #[test]
 fn bad_input_is_one_line_and_exit_code_two() {
-    let dir = temp_dir("bad");
+    let dir = Scratch::new("preview-bad");
     let png = dir.join("x.png");
     let p = png.to_str().unwrap();
     let d = r#"{"type": "diffuse"}"#;
@@ -134,12 +118,7 @@ fn bad_input_is_one_line_and_exit_code_two() {
         (&["preview", "/no/such/material.xml", "-o", p], "/no/such/material.xml"),
     ];
     for (args, expect) in cases {
-        let out = gonio(args);
-        let stderr = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
-        assert!(stderr.contains(expect), "{args:?}: expected {expect:?} in {stderr:?}");
-        assert_eq!(stderr.trim_end().lines().count(), 1, "{args:?}: {stderr}");
+        assert_one_line_error(args, expect);
         assert!(!png.exists(), "{args:?} wrote an image");
     }
-    let _ = std::fs::remove_dir_all(dir);
 }

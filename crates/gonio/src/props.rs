@@ -15,7 +15,7 @@
 
 use crate::error::{Error, Result};
 use crate::spectrum::Rgb;
-use crate::xml::{parse_numbers, parse_spectrum, parse_transform, parse_vector, xml_at, XmlEnv};
+use crate::xml::{parse_numbers, parse_spectrum, parse_transform, parse_vector, xml_at, XmlEnv, XmlSource};
 use std::cell::{Cell, RefCell};
 
 /// One parameter value.
@@ -442,6 +442,7 @@ impl Props {
     /// Parse an XML document whose root is a `<bsdf>` element, or whose root holds exactly one.
     pub fn from_xml_bsdf(text: &str, source: &str) -> Result<Props> {
         let doc = crate::xml::parse_document(text, source)?;
+        let source = &XmlSource::new(source, text);
         let root = doc.root_element();
         let bsdf = if root.has_tag_name("bsdf") {
             root
@@ -460,19 +461,19 @@ impl Props {
 
     /// Build from one plugin element (`<bsdf type="…">`) of a Mitsuba XML document, outside a scene
     /// (no parameters, references or search paths).
-    pub fn from_xml_element(node: roxmltree::Node, source: &str) -> Result<Props> {
+    pub fn from_xml_element(node: roxmltree::Node, source: &XmlSource) -> Result<Props> {
         Props::from_xml_element_in(node, source, &XmlEnv::default())
     }
 
     /// Build from one plugin element within a scene: `$name` substituted, `<ref id>` resolved, file
     /// names resolved against the search paths, nested plugins of every kind, points, vectors,
     /// transforms and spectra read.
-    pub fn from_xml_element_in(node: roxmltree::Node, source: &str, env: &XmlEnv) -> Result<Props> {
+    pub fn from_xml_element_in(node: roxmltree::Node, source: &XmlSource, env: &XmlEnv) -> Result<Props> {
         Props::from_xml_nested(node, source, env, 1)
     }
 
     /// [`Props::from_xml_element_in`] for an element `depth` plugins deep.
-    fn from_xml_nested(node: roxmltree::Node, source: &str, env: &XmlEnv, depth: usize) -> Result<Props> {
+    fn from_xml_nested(node: roxmltree::Node, source: &XmlSource, env: &XmlEnv, depth: usize) -> Result<Props> {
         let at = xml_at(source, node);
         if depth > MAX_NESTING {
             return Err(Error::spec(at, format!("plugins nested more than {MAX_NESTING} deep")));

@@ -96,11 +96,111 @@ fn check_depth(text: &str, source: &str) -> Result<()> {
     Ok(())
 }
 
-/// "file:line:col" of a node.
+/// A document's name with an index of its text, so that "file:line:col" of any byte offset costs
+/// O(log n) (two binary searches) instead of a scan from the start.
+///
+/// `roxmltree::Document::text_pos_at` scans the text up to the offset on every call, and the loaders
+/// compute the place of every element and attribute they read (for their messages), so loading was
+/// quadratic in the file size: a 125 KB plugin with 5000 parameters took seconds (2026-11, issue 8).
+/// The index is built once per document, in one pass; positions are the same as `text_pos_at`'s (line =
+/// newlines before the offset + 1, column = characters since the last newline + 1).
+#[derive(Clone, Debug)]
+pub struct XmlSource<'t> {
+    name: &'t str,
+    len: usize,
+    /// Byte offsets of every `\n`.
+    newlines: Vec<usize>,
+    /// Byte offsets of every UTF-8 continuation byte (none in ASCII text), so that a column counts
+    /// characters even on a long line without scanning it.
+    continuations: Vec<usize>,
+}
+
+thread_local! {
+    /// Line indices built and binary-search steps taken on this thread: a deterministic measure of the
+    /// position work of a load, for the tests that it is linear in the file size.
+    static POSITION_WORK: Cell<PositionWork> = const { Cell::new(PositionWork { builds: 0, bytes_indexed: 0, lookups: 0, steps: 0 }) };
+}
+
+/// What the position lookups of this thread cost so far (see [`XmlSource`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PositionWork {
+    /// Line indices built, and the bytes they scanned.
+    pub builds: usize,
+    pub bytes_indexed: usize,
+    /// Positions looked up, and the binary-search steps they took.
+    pub lookups: usize,
+    pub steps: usize,
+}
+
+impl PositionWork {
+    /// The total on this thread so far.
+    #[must_use]
+    pub fn current() -> PositionWork {
+        POSITION_WORK.with(Cell::get)
+    }
+
+    fn add(f: impl FnOnce(&mut PositionWork)) {
+        POSITION_WORK.with(|w| {
+            let mut v = w.get();
+            f(&mut v);
+            w.set(v);
+        });
+    }
+}
+
+impl<'t> XmlSource<'t> {
+    /// Index `text` (one pass), which messages call `name`.
+    #[must_use]
+    pub fn new(name: &'t str, text: &str) -> Self {
+        let bytes = text.as_bytes();
+        let newlines = bytes.iter().enumerate().filter(|&(_, &b)| b == b'\n').map(|(i, _)| i).collect();
+        let continuations = bytes.iter().enumerate().filter(|&(_, &b)| b & 0xC0 == 0x80).map(|(i, _)| i).collect();
+        PositionWork::add(|w| {
+            w.builds += 1;
+            w.bytes_indexed += bytes.len();
+        });
+        XmlSource { name, len: bytes.len(), newlines, continuations }
+    }
+
+    /// The name messages give the document.
+    #[must_use]
+    pub fn name(&self) -> &'t str {
+        self.name
+    }
+
+    /// Line and column (both from 1, the column in characters) of byte `offset` (clamped to the text).
+    #[must_use]
+    pub fn line_col(&self, offset: usize) -> (usize, usize) {
+        let offset = offset.min(self.len);
+        // Newlines before the offset, and where its line starts.
+        let line = self.newlines.partition_point(|&n| n < offset);
+        let line_start = if line == 0 { 0 } else { self.newlines[line - 1] + 1 };
+        // Characters on the line before the offset: its bytes less their continuation bytes.
+        let continued = self.continuations.partition_point(|&c| c < offset) - self.continuations.partition_point(|&c| c < line_start);
+        PositionWork::add(|w| {
+            w.lookups += 1;
+            w.steps += log2_steps(self.newlines.len()) + 2 * log2_steps(self.continuations.len());
+        });
+        (line + 1, offset - line_start - continued + 1)
+    }
+
+    /// "file:line:col" of byte `offset`.
+    #[must_use]
+    pub fn at_offset(&self, offset: usize) -> String {
+        let (line, col) = self.line_col(offset);
+        format!("{}:{line}:{col}", self.name)
+    }
+}
+
+/// The steps of a binary search over `n` items.
+fn log2_steps(n: usize) -> usize {
+    (usize::BITS - n.leading_zeros()) as usize + 1
+}
+
+/// "file:line:col" of a node (O(log n), see [`XmlSource`]).
 #[must_use]
-pub fn xml_at(source: &str, node: roxmltree::Node) -> String {
-    let p = node.document().text_pos_at(node.range().start);
-    format!("{source}:{}:{}", p.row, p.col)
+pub fn xml_at(source: &XmlSource, node: roxmltree::Node) -> String {
+    source.at_offset(node.range().start)
 }
 
 impl XmlEnv {
@@ -135,12 +235,15 @@ impl XmlEnv {
     }
 
     /// An attribute with parameters substituted.
-    pub fn attr(&self, node: roxmltree::Node, name: &str, source: &str) -> Result<Option<String>> {
-        node.attribute(name).map(|raw| self.substitute(raw, &xml_at(source, node))).transpose()
+    pub fn attr(&self, node: roxmltree::Node, name: &str, source: &XmlSource) -> Result<Option<String>> {
+        // The place is only needed for a `$` (and costs a lookup).
+        node.attribute(name)
+            .map(|raw| if raw.contains('$') { self.substitute(raw, &xml_at(source, node)) } else { Ok(raw.to_string()) })
+            .transpose()
     }
 
     /// A required attribute with parameters substituted.
-    pub fn required(&self, node: roxmltree::Node, name: &str, source: &str) -> Result<String> {
+    pub fn required(&self, node: roxmltree::Node, name: &str, source: &XmlSource) -> Result<String> {
         self.attr(node, name, source)?
             .ok_or_else(|| Error::spec(xml_at(source, node), format!("<{}> needs a `{name}` attribute", node.tag_name().name())))
     }
@@ -170,7 +273,7 @@ pub fn parse_numbers(s: &str) -> Option<Vec<f64>> {
 
 /// A vector given as `value="x, y, z"` (or one number for all three) or as `x`, `y`, `z` attributes,
 /// each defaulting to `default` (0 for points, 1 for `<scale>`).
-pub fn parse_vector(node: roxmltree::Node, env: &XmlEnv, source: &str, default: f32) -> Result<Vec3> {
+pub fn parse_vector(node: roxmltree::Node, env: &XmlEnv, source: &XmlSource, default: f32) -> Result<Vec3> {
     let at = xml_at(source, node);
     if let Some(v) = env.attr(node, "value", source)? {
         return match parse_numbers(&v).as_deref() {
@@ -200,7 +303,7 @@ pub fn parse_vector(node: roxmltree::Node, env: &XmlEnv, source: &str, default: 
 /// reduction of reflectance spectra, also used by spectral RGL files; exact for flat spectra: a flat 0.78
 /// over 400–700 nm gives (0.777, 0.781, 0.775) here and (0.776, 0.780, 0.776) in Mitsuba 3.9.1; 2026-11,
 /// until a D65 table lands in `spectrum`).
-pub fn parse_spectrum(node: roxmltree::Node, env: &XmlEnv, source: &str, within_emitter: bool) -> Result<Rgb> {
+pub fn parse_spectrum(node: roxmltree::Node, env: &XmlEnv, source: &XmlSource, within_emitter: bool) -> Result<Rgb> {
     let reduce = |w: &[f64], v: &[f64]| if within_emitter { spectrum_to_rgb(w, v) } else { reflectance_to_rgb(w, v) };
     let at = xml_at(source, node);
     if let Some(file) = env.attr(node, "filename", source)? {
@@ -240,7 +343,7 @@ pub fn parse_spectrum(node: roxmltree::Node, env: &XmlEnv, source: &str, within_
 
 /// A `<transform>` element: its operations in document order, each left-multiplying the result so far
 /// (Mitsuba's order: the first operation is applied to the object first).
-pub fn parse_transform(node: roxmltree::Node, env: &XmlEnv, source: &str) -> Result<Transform> {
+pub fn parse_transform(node: roxmltree::Node, env: &XmlEnv, source: &XmlSource) -> Result<Transform> {
     let mut acc = Transform::IDENTITY;
     for op in node.children().filter(roxmltree::Node::is_element) {
         let at = xml_at(source, op);
@@ -304,15 +407,33 @@ mod tests {
     }
 
     #[test]
+    fn line_index_positions_equal_roxmltree() {
+        // Newlines, CRLF, multi-byte characters (2, 3 and 4 bytes), an empty line, and one long line.
+        let long = format!("<a>{}</a>", "<b x=\"é\"/>".repeat(500));
+        for text in ["<a>\n  <b/>\r\n\n<c x=\"ü€😀\"/>😀<d/>\n</a>", "<scène>\n\t<ü/></scène>\n", long.as_str(), "<a/>"] {
+            let doc = roxmltree::Document::parse(text).unwrap();
+            let source = XmlSource::new("p.xml", text);
+            for offset in (0..=text.len() + 2).filter(|&i| i > text.len() || text.is_char_boundary(i)) {
+                let want = doc.text_pos_at(offset);
+                assert_eq!(source.line_col(offset), (want.row as usize, want.col as usize), "offset {offset} of {text:?}");
+            }
+            for node in doc.descendants() {
+                let want = doc.text_pos_at(node.range().start);
+                assert_eq!(xml_at(&source, node), format!("p.xml:{}:{}", want.row, want.col));
+            }
+        }
+    }
+
+    #[test]
     fn transform_ops_compose_left() {
         let doc = roxmltree::Document::parse(
             "<transform name=\"to_world\"><scale value=\"2\"/><rotate z=\"1\" angle=\"90\"/><translate x=\"1\"/></transform>",
         )
         .unwrap();
-        let t = parse_transform(first(&doc), &XmlEnv::default(), "t.xml").unwrap();
+        let t = parse_transform(first(&doc), &XmlEnv::default(), &XmlSource::new("t.xml", doc.input_text())).unwrap();
         assert!((t.point(Vec3::X) - Vec3::new(1.0, 2.0, 0.0)).length() < 1e-5);
         let doc = roxmltree::Document::parse("<transform><matrix value=\"1 0 0 5  0 1 0 6  0 0 1 7  0 0 0 1\"/></transform>").unwrap();
-        let t = parse_transform(first(&doc), &XmlEnv::default(), "t.xml").unwrap();
+        let t = parse_transform(first(&doc), &XmlEnv::default(), &XmlSource::new("t.xml", doc.input_text())).unwrap();
         assert!((t.point(Vec3::ZERO) - Vec3::new(5.0, 6.0, 7.0)).length() < 1e-6);
     }
 
@@ -327,7 +448,7 @@ mod tests {
             ("<transform>\n<scale x=\"0\"/></transform>", "t.xml:2:1: <scale>: a scale factor is zero"),
         ] {
             let doc = roxmltree::Document::parse(xml).unwrap();
-            let e = parse_transform(first(&doc), &XmlEnv::default(), "t.xml").unwrap_err().to_string();
+            let e = parse_transform(first(&doc), &XmlEnv::default(), &XmlSource::new("t.xml", xml)).unwrap_err().to_string();
             assert!(e.starts_with(want), "{e}");
         }
     }
@@ -340,11 +461,11 @@ mod tests {
         assert_eq!(env.substitute("a$spp-b", "x").unwrap(), "a64-b");
         assert!(env.substitute("$nope", "f.xml:3:4").unwrap_err().to_string().starts_with("f.xml:3:4: `$nope` is not defined"));
         let doc = roxmltree::Document::parse("<spectrum name=\"r\" value=\"400:0.78, 500:0.78, 600:0.78, 700:0.78\"/>").unwrap();
-        let c = parse_spectrum(first(&doc), &env, "s.xml", false).unwrap();
+        let c = parse_spectrum(first(&doc), &env, &XmlSource::new("s.xml", doc.input_text()), false).unwrap();
         // Mitsuba 3.9.1 (scalar_rgb) loads this reflectance as (0.776367, 0.77981, 0.776029).
         assert!((c.r() - 0.776).abs() < 2e-3 && (c.g() - 0.780).abs() < 2e-3 && (c.b() - 0.776).abs() < 2e-3, "{c}");
         let doc = roxmltree::Document::parse("<spectrum name=\"radiance\" value=\"400:0, 500:8, 600:15.6, 700:18.4\"/>").unwrap();
-        let c = parse_spectrum(first(&doc), &env, "s.xml", true).unwrap();
+        let c = parse_spectrum(first(&doc), &env, &XmlSource::new("s.xml", doc.input_text()), true).unwrap();
         // Mitsuba 3.9.1 loads this area-light radiance as (20.7108, 10.8546, 2.77115).
         assert!(
             (c.r() / 20.7108 - 1.0).abs() < 2e-3 && (c.g() / 10.8546 - 1.0).abs() < 2e-3 && (c.b() / 2.77115 - 1.0).abs() < 5e-3,

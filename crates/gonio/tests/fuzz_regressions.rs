@@ -45,6 +45,30 @@ fn every_seed_and_regression_input_loads_without_panic() {
     assert!(failures.is_empty(), "{} of {total} inputs failed:\n{}", failures.len(), failures.join("\n"));
 }
 
+/// `roughplastic` is fuzzed (the targets skipped it until 2026-12) without integrating its coating
+/// tables, which costs seconds per α and η: inputs with many distinct α and η, valid and not, through
+/// both targets that build BSDFs, integrate none (a count, not a clock).
+#[test]
+fn roughplastic_inputs_are_built_without_integrating_tables() {
+    let before = gonio::bsdf::rough_plastic::table_integrations();
+    for (i, alpha) in [1e-4, 0.0123, 0.3, 0.77, 10.0, -1.0, 0.0].into_iter().enumerate() {
+        let eta = 1.0 + 0.137 * i as f64;
+        for distribution in ["ggx", "beckmann"] {
+            let spec = format!(
+                r#"{{"type": "roughplastic", "distribution": "{distribution}", "alpha": {alpha}, "int_ior": {eta}, "energy_compensation": {}}}"#,
+                i % 2 == 0
+            );
+            gonio::fuzz::bsdf_json(spec.as_bytes());
+            let scene = format!(
+                r#"<scene version="3.0.0"><shape type="sphere"><bsdf type="roughplastic"><string name="distribution" value="{distribution}"/>
+                   <float name="alpha" value="{alpha}"/><float name="int_ior" value="{eta}"/></bsdf></shape></scene>"#
+            );
+            gonio::fuzz::xml_scene(scene.as_bytes());
+        }
+    }
+    assert_eq!(gonio::bsdf::rough_plastic::table_integrations(), before);
+}
+
 // ------------------------------------------------------------------------------------------------
 // Seeds from real data, shrunk
 

@@ -1,6 +1,7 @@
 //! `gonio albedo BSDF`: the directional albedo against θo, and the white-furnace average.
 
 use crate::spec::load_bsdf;
+use crate::stdout::outln;
 use gonio::verify::energy::{albedo_curve, white_furnace};
 use gonio::verify::scatters_from_below;
 use gonio::Error;
@@ -23,12 +24,12 @@ pub fn run(args: Args) -> Result<ExitCode, Error> {
     let sides: &[f32] = if scatters_from_below(&bsdf) { &[1.0, -1.0] } else { &[1.0] };
     for &sign in sides {
         let curve = albedo_curve(&bsdf, args.angles, sign, args.samples, 0);
-        println!("{:>8} {:>9} {:>9} {:>9} {:>9}", "θo(deg)", "cosθo", "R", "G", "B");
+        outln!("{:>8} {:>9} {:>9} {:>9} {:>9}", "θo(deg)", "cosθo", "R", "G", "B");
         for (mu, a) in &curve {
-            println!("{:>8.2} {:>+9.4} {:>9.5} {:>9.5} {:>9.5}", mu.acos().to_degrees(), mu, a.r(), a.g(), a.b());
+            outln!("{:>8.2} {:>+9.4} {:>9.5} {:>9.5} {:>9.5}", mu.acos().to_degrees(), mu, a.r(), a.g(), a.b());
         }
         let w = white_furnace(&curve);
-        println!("white furnace ({}): [{:.5}, {:.5}, {:.5}]\n", if sign > 0.0 { "above" } else { "below" }, w.r(), w.g(), w.b());
+        outln!("white furnace ({}): [{:.5}, {:.5}, {:.5}]\n", if sign > 0.0 { "above" } else { "below" }, w.r(), w.g(), w.b());
     }
     Ok(ExitCode::SUCCESS)
 }

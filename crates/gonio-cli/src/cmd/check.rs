@@ -1,6 +1,7 @@
 //! `gonio check BSDF` and `gonio check --all`.
 
 use crate::spec::load_bsdf;
+use crate::stdout::{out, outln};
 use gonio::verify::{check_named, expect_violation, sweep::sweep, test_directions, CheckConfig, Report};
 use gonio::{Bsdf, Error};
 use std::path::PathBuf;
@@ -72,7 +73,7 @@ pub fn run(args: Args) -> Result<ExitCode, Error> {
         .map(|(name, bsdf)| {
             let report = check_named(bsdf, name, &cfg);
             if !args.json {
-                print!("{}", report.to_table());
+                out!("{}", report.to_table());
             }
             report
         })
@@ -80,7 +81,7 @@ pub fn run(args: Args) -> Result<ExitCode, Error> {
     let failed = reports.iter().filter(|r| !r.passed()).count();
 
     if !violations.is_empty() && !args.json {
-        println!("\nexpected violations (non-physical models kept for teaching)");
+        outln!("\nexpected violations (non-physical models kept for teaching)");
     }
     let detections: Vec<(Report, &str, Result<(), String>)> = violations
         .iter()
@@ -88,10 +89,10 @@ pub fn run(args: Args) -> Result<ExitCode, Error> {
             let report = check_named(bsdf, name, &cfg);
             let detected = expect_violation(&report, kind);
             if !args.json {
-                print!("{}", report.to_table());
+                out!("{}", report.to_table());
                 match &detected {
-                    Ok(()) => println!("  `{kind}`: violation detected"),
-                    Err(e) => println!("  `{kind}`: NOT DETECTED ({})", e.lines().next().unwrap_or_default()),
+                    Ok(()) => outln!("  `{kind}`: violation detected"),
+                    Err(e) => outln!("  `{kind}`: NOT DETECTED ({})", e.lines().next().unwrap_or_default()),
                 }
             }
             (report, *kind, detected)
@@ -115,11 +116,11 @@ pub fn run(args: Args) -> Result<ExitCode, Error> {
         } else {
             all.into_iter().next().unwrap_or_default()
         };
-        println!("{}", serde_json::to_string_pretty(&value).unwrap_or_default());
+        outln!("{}", serde_json::to_string_pretty(&value).unwrap_or_default());
     } else {
-        println!("{} of {} BSDFs passed every check", reports.len() - failed, reports.len());
+        outln!("{} of {} BSDFs passed every check", reports.len() - failed, reports.len());
         if !detections.is_empty() {
-            println!("{} of {} expected violations detected", detections.len() - missed, detections.len());
+            outln!("{} of {} expected violations detected", detections.len() - missed, detections.len());
         }
     }
     Ok(if failed == 0 && missed == 0 { ExitCode::SUCCESS } else { ExitCode::from(1) })
@@ -141,14 +142,14 @@ fn sweep_only<'a>(models: impl Iterator<Item = (&'a String, &'a Bsdf)>, cfg: &Ch
             all.push(serde_json::json!({ "name": name, "queries": r.queries, "bad": r.bad, "first_bad": r.first_bad, "seconds": seconds }));
         } else {
             let detail = r.first_bad.map(|d| format!("  ({d})")).unwrap_or_default();
-            println!("{:>10} queries {:>8} bad {seconds:>7.1} s  {name}{detail}", r.queries, r.bad);
+            outln!("{:>10} queries {:>8} bad {seconds:>7.1} s  {name}{detail}", r.queries, r.bad);
         }
     }
     if json {
         let v = serde_json::json!({ "sweeps": all, "models": count, "queries": queries, "bad": bad });
-        println!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
+        outln!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
     } else {
-        println!("NaN/Inf sweep: {count} models, {queries} queries, {bad} non-finite or negative; {failed} models failed");
+        outln!("NaN/Inf sweep: {count} models, {queries} queries, {bad} non-finite or negative; {failed} models failed");
     }
     if failed == 0 {
         ExitCode::SUCCESS

@@ -3,6 +3,7 @@
 //! (see `gonio::fit`), and write the fitted `<bsdf>` as Mitsuba XML.
 
 use crate::spec::load_bsdf;
+use crate::stdout::outln;
 use gonio::fit::{fit, model, pairs, spec_to_xml, MODELS};
 use gonio::Error;
 use std::path::PathBuf;
@@ -30,7 +31,7 @@ pub struct Args {
 pub fn run(args: Args) -> Result<ExitCode, Error> {
     if args.list {
         for m in MODELS {
-            println!("{:<26} {}", m.name, m.about);
+            outln!("{:<26} {}", m.name, m.about);
         }
         return Ok(ExitCode::SUCCESS);
     }
@@ -43,7 +44,7 @@ pub fn run(args: Args) -> Result<ExitCode, Error> {
     for m in models {
         let start = std::time::Instant::now();
         let result = fit(m, &set)?;
-        println!(
+        outln!(
             "{}: relative error {:.4} (E = {:.4e}) in {:.1} s",
             m.name,
             result.relative_error,
@@ -51,10 +52,10 @@ pub fn run(args: Args) -> Result<ExitCode, Error> {
             start.elapsed().as_secs_f64()
         );
         for (name, value) in &result.values {
-            println!("  {name:<10} {value:.6}");
+            outln!("  {name:<10} {value:.6}");
         }
         let bands: Vec<String> = result.per_angle.iter().map(|(deg, e)| format!("{deg:.0}°: {e:.3}")).collect();
-        println!("  error by θi band (RMS error / RMS signal): {}", bands.join(", "));
+        outln!("  error by θi band (RMS error / RMS signal): {}", bands.join(", "));
         let better = match &best {
             Some(b) => result.error < b.error,
             None => true,
@@ -73,7 +74,7 @@ pub fn run(args: Args) -> Result<ExitCode, Error> {
             set.len()
         );
         gonio::image::write_atomically(path, (comment + &spec_to_xml(&best.spec, None, 0)).as_bytes())?;
-        println!("wrote the best fit ({}) to {}", best.model, path.display());
+        outln!("wrote the best fit ({}) to {}", best.model, path.display());
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -2,6 +2,7 @@
 //! table, averaging f over k³ stratified points per cell (see `gonio::measured::gonioreflectometer`).
 
 use crate::spec::load_bsdf;
+use crate::stdout::outln;
 use gonio::measured::gonioreflectometer::measure;
 use gonio::Error;
 use std::path::PathBuf;
@@ -24,7 +25,7 @@ pub fn run(args: Args) -> Result<ExitCode, Error> {
     let start = std::time::Instant::now();
     let table = measure(&bsdf, args.supersample as usize, &args.bsdf)?;
     table.write(&args.output)?;
-    println!(
+    outln!(
         "measured {} into {} ({}³ points per cell, {} of {} cells below the horizon written as not measured) in {:.1} s",
         bsdf.plugin_name(),
         args.output.display(),

@@ -77,11 +77,29 @@ pub(crate) fn relative_ior(p: &Props) -> Result<f32> {
     relative_ior_with_default(p, 1.5046)
 }
 
+/// The relative index η = `int_ior` / `ext_ior` must lie in [1/`MAX_RELATIVE_IOR`, `MAX_RELATIVE_IOR`]
+/// (2026-12, issue 8). Each index alone may be anything in (0, 10000), so their ratio could reach 10⁸
+/// or underflow f32, and the NaN/Inf sweep found the models breaking inside that range: `plastic` at
+/// η = 1000 (f = inf at grazing angles), `roughdielectric` at η = 10⁻²⁰ (pdf = NaN), `dielectric` at
+/// η = 1/50 (a refracted direction 0.2 % off unit length from an input 10⁻⁶ off). Real interfaces stay
+/// far inside: germanium in air, the densest common dielectric, has η = 4.
+pub const MAX_RELATIVE_IOR: f32 = 20.0;
+
 /// [`relative_ior`] with another default for `int_ior` (the plastics default to polypropylene, 1.49).
 pub(crate) fn relative_ior_with_default(p: &Props, int_default: f32) -> Result<f32> {
     let int_ior = ior(p, "int_ior", int_default)?;
     let ext_ior = ior(p, "ext_ior", 1.000_277)?;
-    Ok(int_ior / ext_ior)
+    let eta = int_ior / ext_ior;
+    if !(1.0 / MAX_RELATIVE_IOR..=MAX_RELATIVE_IOR).contains(&eta) {
+        return Err(Error::spec(
+            p.at(),
+            format!(
+                "`{}`: the relative index int_ior / ext_ior = {int_ior} / {ext_ior} = {eta} must lie in [1/{MAX_RELATIVE_IOR}, {MAX_RELATIVE_IOR}]",
+                p.plugin_type()
+            ),
+        ));
+    }
+    Ok(eta)
 }
 
 fn ior(p: &Props, name: &'static str, default: f32) -> Result<f32> {
@@ -168,6 +186,36 @@ mod tests {
     #[allow(unused_imports)]
     use crate::bsdf::Examples;
     use crate::fresnel::fresnel_dielectric;
+
+    /// Every model with a dielectric interface is finite at both ends of the allowed relative index
+    /// (the NaN/Inf sweep, degenerate directions included), and a ratio beyond them is refused, naming
+    /// both indices. Before the limit, `plastic` at int_ior = 1000 returned f = inf, `roughdielectric` at
+    /// int_ior = 1e-44 a NaN pdf and `dielectric` at ext_ior = 50 directions 0.2 % off unit length.
+    #[test]
+    fn relative_index_is_finite_at_the_limits_and_refused_beyond() {
+        let models = [
+            "\"dielectric\"",
+            "\"thindielectric\"",
+            "\"roughdielectric\"",
+            "\"roughdielectric\", \"distribution\": \"beckmann\", \"alpha\": 1, \"energy_compensation\": true",
+            "\"plastic\"",
+            "\"roughplastic\", \"energy_compensation\": true",
+        ];
+        let limit = f64::from(MAX_RELATIVE_IOR);
+        for model in models {
+            for (int_ior, ext_ior) in [(limit, 1.0), (1.0, limit), (2.0 * limit, 2.0), (1.5, 1.5 * limit)] {
+                let spec = format!("{{\"type\": {model}, \"int_ior\": {int_ior}, \"ext_ior\": {ext_ior}}}");
+                let b = crate::bsdf::Bsdf::from_json(&spec).unwrap_or_else(|e| panic!("{spec}: {e}"));
+                let r = crate::verify::sweep::sweep(&b, 100_000, 3);
+                assert_eq!(r.bad, 0, "{spec}: {:?}", r.first_bad);
+            }
+            for (int_ior, ext_ior) in [(limit * 1.01, 1.0), (1.0, limit * 1.01), (1000.0, 1.0), (1e-44, 1.0), (9999.0, 1e-40)] {
+                let spec = format!("{{\"type\": {model}, \"int_ior\": {int_ior}, \"ext_ior\": {ext_ior}}}");
+                let e = crate::bsdf::Bsdf::from_json(&spec).map(|_| ()).unwrap_err().to_string();
+                assert!(e.contains("the relative index int_ior / ext_ior") && e.contains("must lie in [1/20, 20]"), "{spec}: {e}");
+            }
+        }
+    }
 
     fn glass() -> Dielectric {
         Dielectric::new(1.5)

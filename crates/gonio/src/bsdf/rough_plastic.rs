@@ -140,6 +140,7 @@ impl CoatingTables {
     /// Integrate the tables for a coating of `distribution` and relative index `eta` (see the module doc).
     #[must_use]
     pub fn compute(distribution: MicrofacetDistribution, eta: f32) -> Self {
+        INTEGRATIONS.fetch_add(1, Ordering::Relaxed);
         let interface = RoughDielectric::new(distribution, eta);
         let (gl_x, gl_w) = crate::verify::chi2::gauss_legendre(128);
         // T(0) is the limit μ → 0, which is not 0: tilted microfacets still let light in. The horizon
@@ -195,6 +196,9 @@ impl CoatingTables {
     /// The tables for (kind, α, η): integrated at α itself and cached per process, or, while an
     /// [`AlphaGridScope`] is alive, taken from the α grid ([`Self::on_alpha_grid`]).
     fn cached(distribution: MicrofacetDistribution, eta: f32) -> Arc<CoatingTables> {
+        if SMOOTH_TABLES_SCOPES.load(Ordering::Relaxed) > 0 {
+            return Arc::new(Self::smooth(eta));
+        }
         if ALPHA_GRID_SCOPES.load(Ordering::Relaxed) > 0 {
             return Self::on_alpha_grid(distribution, eta);
         }
@@ -215,6 +219,17 @@ impl CoatingTables {
             c.insert(key, tables.clone());
         }
         tables
+    }
+
+    /// The tables of a smooth coating of relative index `eta`, the α → 0 limit of [`Self::compute`], in
+    /// closed form: T(μ) = 1 − F(μ) at the same nodes, R̄ᵢ the smooth interface's hemispherical internal
+    /// reflectance (as `plastic` has). For [`SmoothTablesScope`] only.
+    fn smooth(eta: f32) -> Self {
+        let mu = |k: usize| (k as f32 / (TABLE_SIZE - 1) as f32).max(1e-6);
+        CoatingTables {
+            transmittance: std::array::from_fn(|k| 1.0 - crate::fresnel::fresnel_dielectric(mu(k), eta)),
+            internal_reflectance: crate::fresnel::fresnel_diffuse_reflectance(1.0 / eta) as f32,
+        }
     }
 
     /// The tables for (kind, α, η) interpolated linearly in log α between the two nearest nodes of a
@@ -300,6 +315,51 @@ impl Default for AlphaGridScope {
 impl Drop for AlphaGridScope {
     fn drop(&mut self) {
         ALPHA_GRID_SCOPES.fetch_sub(1, Ordering::Relaxed);
+    }
+}
+
+/// Coating tables integrated in the process so far ([`CoatingTables::compute`] calls).
+static INTEGRATIONS: AtomicUsize = AtomicUsize::new(0);
+
+/// How many coating tables the process has integrated (each costs seconds; for tests).
+#[doc(hidden)]
+#[must_use]
+pub fn table_integrations() -> usize {
+    INTEGRATIONS.load(Ordering::Relaxed)
+}
+
+/// How many [`SmoothTablesScope`]s are alive in the process.
+static SMOOTH_TABLES_SCOPES: AtomicUsize = AtomicUsize::new(0);
+
+/// While one is alive, every `roughplastic` built in the process takes the coating tables of a smooth
+/// coating of its η ([`CoatingTables::smooth`]: closed forms, microseconds) instead of integrating the
+/// rough interface's (3.2 s of CPU per (distribution, α, η) on the 2-core machine, 2026-12). Only for the
+/// fuzz targets (`gonio::fuzz`), which check that loading and evaluating never panics, hangs or returns
+/// non-finite values, not the tables' accuracy, and meet a new α or η at almost every input: with the
+/// integration they could not stay within their per-input time limits. The model's own α, η, lobes,
+/// sampling and energy compensation are unchanged; the tables stay in [0, 1] as the integrated ones do.
+/// The integration itself is tested at the ends of the parameter ranges
+/// (`tables_are_finite_at_the_parameter_extremes`).
+#[doc(hidden)]
+#[must_use = "the smooth tables are used only while the scope is alive"]
+pub struct SmoothTablesScope(());
+
+impl SmoothTablesScope {
+    pub fn new() -> Self {
+        SMOOTH_TABLES_SCOPES.fetch_add(1, Ordering::Relaxed);
+        SmoothTablesScope(())
+    }
+}
+
+impl Default for SmoothTablesScope {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Drop for SmoothTablesScope {
+    fn drop(&mut self) {
+        SMOOTH_TABLES_SCOPES.fetch_sub(1, Ordering::Relaxed);
     }
 }
 
@@ -662,6 +722,37 @@ mod tests {
 
     /// The tables at an α between two nodes of the grid, interpolated, against the tables integrated at
     /// that α (the bound: 1e-4 absolute in T(μ) and R̄ᵢ, for both distributions over α ∈ [0.002, 2]; 2026-11: 32 nodes per decade gave 2.3e-4 for GGX, hence 64, which gives 6.9e-5 over all six α for either distribution).
+    #[test]
+    fn tables_are_finite_at_the_parameter_extremes() {
+        // The corners of α ∈ [1e-4, 10] and η ∈ [1/20, 20] (the relative-index limit), both distributions:
+        // T(μ) and R̄ᵢ are energies, in [0, 1], and the sweep of the built model finds nothing.
+        for kind in [MicrofacetKind::Ggx, MicrofacetKind::Beckmann] {
+            for (alpha, eta) in [(1e-4, 20.0), (10.0, 1.0 / 20.0)] {
+                let t = CoatingTables::compute(MicrofacetDistribution::new(kind, alpha, alpha), eta);
+                let all = t.transmittance.iter().chain([&t.internal_reflectance]);
+                assert!(all.clone().all(|v| v.is_finite() && (0.0..=1.0 + 1e-4).contains(v)), "{kind:?} α={alpha} η={eta}: {t:?}");
+            }
+        }
+    }
+
+    /// The tables a [`SmoothTablesScope`] hands out are the smooth coating's, the α → 0 limit: close to
+    /// the integrated tables at α = 1e-4. (The scope itself is process-wide, so it is not taken here,
+    /// where other tests build rough plastics in parallel: `tests/fuzz_regressions.rs` runs under it.)
+    #[test]
+    fn smooth_tables_are_the_small_alpha_limit() {
+        let d = MicrofacetDistribution::new(MicrofacetKind::Ggx, 1e-4, 1e-4);
+        let (smooth, exact) = (CoatingTables::smooth(1.49), CoatingTables::compute(d, 1.49));
+        for k in 1..TABLE_SIZE {
+            assert!(
+                (smooth.transmittance[k] - exact.transmittance[k]).abs() < 2e-3,
+                "T[{k}]: {} vs {}",
+                smooth.transmittance[k],
+                exact.transmittance[k]
+            );
+        }
+        assert!((smooth.internal_reflectance - exact.internal_reflectance).abs() < 2e-3, "{smooth:?} vs {exact:?}");
+    }
+
     #[test]
     fn alpha_grid_interpolation_is_accurate() {
         // Three values of α per distribution, six in all across [0.002, 2] (each costs three integrations).

@@ -13,7 +13,7 @@
 
 use crate::error::{Error, Result};
 use crate::props::Props;
-use crate::xml::{xml_at, XmlEnv};
+use crate::xml::{xml_at, XmlEnv, XmlSource};
 use std::path::{Path, PathBuf};
 
 /// A parsed scene: the top-level plugins, not yet built.
@@ -93,7 +93,7 @@ impl Loader {
     }
 
     /// A top-level plugin element, counted against [`MAX_PLUGINS`].
-    fn plugin(&mut self, node: roxmltree::Node, source: &str, at: &str) -> Result<Props> {
+    fn plugin(&mut self, node: roxmltree::Node, source: &XmlSource, at: &str) -> Result<Props> {
         let props = Props::from_xml_element_in(node, source, &self.env)?;
         self.plugins += props.plugin_count();
         if self.plugins > MAX_PLUGINS {
@@ -104,6 +104,7 @@ impl Loader {
 
     fn document(&mut self, text: &str, source: &str, dir: &Path) -> Result<()> {
         let doc = crate::xml::parse_document(text, source)?;
+        let source = &XmlSource::new(source, text);
         let root = doc.root_element();
         let at = xml_at(source, root);
         if !root.has_tag_name("scene") {
@@ -255,6 +256,66 @@ mod tests {
         let params: String = (0..1100).map(|i| format!("<float name=\"p{i}\" value=\"1\"/>")).collect();
         let e = refused(&format!("{SCENE}<bsdf type=\"diffuse\">{params}</bsdf></scene>"), &dir);
         assert!(e.contains(&format!("more than {} parameters", crate::props::MAX_PARAMETERS)), "{e}");
+    }
+
+    /// A scene of `shapes` spheres, 4 elements each, on one line per shape; `broken` spoils the last one.
+    fn many_spheres(shapes: usize, broken: bool) -> String {
+        let mut text = format!("{SCENE}\n");
+        for i in 0..shapes {
+            let radius = if broken && i + 1 == shapes { "wide" } else { "0.01" };
+            text += &format!(
+                "<shape type=\"sphere\"><point name=\"center\" x=\"{i}\" y=\"0\" z=\"0\"/><float name=\"radius\" value=\"{radius}\"/>\
+                 <bsdf type=\"diffuse\"/></shape>\n"
+            );
+        }
+        text + "</scene>"
+    }
+
+    /// The position work (line-index builds, bytes indexed, lookups and binary-search steps) of `load`.
+    fn position_work<T>(load: impl FnOnce() -> T) -> (T, crate::xml::PositionWork) {
+        let before = crate::xml::PositionWork::current();
+        let out = load();
+        let after = crate::xml::PositionWork::current();
+        let work = crate::xml::PositionWork {
+            builds: after.builds - before.builds,
+            bytes_indexed: after.bytes_indexed - before.bytes_indexed,
+            lookups: after.lookups - before.lookups,
+            steps: after.steps - before.steps,
+        };
+        (out, work)
+    }
+
+    /// Every element's "file:line:col" is computed as it is read; with a scan from the start of the text
+    /// per lookup (`roxmltree`'s `text_pos_at`, used until 2026-11) a load was quadratic in the file size.
+    /// Now one line index is built per document and each lookup is two binary searches: the work counted
+    /// here (deterministic, not a clock) is linear in the size, for a scene that loads and for one whose
+    /// last element is an error.
+    #[test]
+    fn large_scenes_cost_linear_position_work() {
+        let mut per_byte = Vec::new();
+        for shapes in [25_000, 50_000] {
+            let text = many_spheres(shapes, false);
+            let (desc, work) = position_work(|| load_str(&text, "big.xml", Path::new("."), &[]));
+            assert_eq!(desc.unwrap().shapes.len(), shapes);
+            assert_eq!((work.builds, work.bytes_indexed), (1, text.len()), "one line index per document");
+            // 10⁵ elements or more, each looked up at least once...
+            assert!(work.lookups >= 4 * shapes, "{work:?}");
+            // ...each in O(log n) steps: ⌈log₂⌉ + 1 per binary search, three searches.
+            let log2 = (usize::BITS - text.len().leading_zeros()) as usize + 1;
+            assert!(work.steps <= 3 * log2 * work.lookups, "{work:?}");
+            // A scan from the start would cost about lookups × len / 2 bytes: ~10¹¹ here.
+            let total = work.bytes_indexed + work.steps;
+            eprintln!("{shapes} spheres, {} bytes: {work:?}, {:.2e} per byte", text.len(), total as f64 / text.len() as f64);
+            per_byte.push(total as f64 / text.len() as f64);
+        }
+        // Twice the file, the same work per byte (the steps grow by one per search: a log factor).
+        assert!(per_byte[1] < 1.1 * per_byte[0], "position work per byte {per_byte:?}");
+
+        let text = many_spheres(50_000, true);
+        let (result, work) = position_work(|| load_str(&text, "big.xml", Path::new("."), &[]));
+        let e = result.unwrap_err().to_string();
+        assert!(e.starts_with("big.xml:50001:66: <float name=\"radius\">: expected a number, got \"wide\""), "{e}");
+        assert_eq!(work.builds, 1);
     }
 
     #[test]
