@@ -468,17 +468,3 @@ fn non_finite_samples_are_reported() {
     assert!(notes.contains(&("gonio.nonfinite_samples".to_string(), count.to_string())), "{notes:?}");
     assert!(notes.contains(&("gonio.interrupted".to_string(), "false".to_string())), "{notes:?}");
 }
-
-#[test]
-fn scratch_directories_remove_themselves() {
-    let kept;
-    {
-        let dir = Scratch::new("self");
-        std::fs::create_dir_all(dir.join("a/b")).unwrap();
-        std::fs::write(dir.join("a/b/c.txt"), "x").unwrap();
-        assert_ne!(*dir, *Scratch::new("self"), "two scratch directories are distinct");
-        kept = dir.to_path_buf();
-        assert!(kept.is_dir());
-    }
-    assert!(!kept.exists(), "{} was left behind", kept.display());
-}

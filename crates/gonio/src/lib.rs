@@ -39,8 +39,9 @@ pub mod props;
 pub mod render;
 pub mod sampling;
 pub mod scene;
-#[cfg(test)]
-pub(crate) mod scratch;
+/// Scratch directories for the tests of this crate and of the crates built on it (not part of the API).
+#[doc(hidden)]
+pub mod scratch;
 pub mod spectrum;
 pub mod texture;
 pub mod verify;

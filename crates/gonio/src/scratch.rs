@@ -1,5 +1,5 @@
-//! A scratch directory for the unit tests: unique per process and use, removed when dropped, so that
-//! `cargo test` leaves nothing behind in the system's temporary directory.
+//! A scratch directory for tests (this crate's and the CLI's): unique per process and use, removed when
+//! dropped, also when the test fails, so that `cargo test` leaves nothing behind in the temporary directory.
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -29,6 +29,12 @@ impl ScratchDir {
     #[must_use]
     pub fn join(&self, name: impl AsRef<Path>) -> PathBuf {
         self.0.join(name)
+    }
+
+    /// The path of `name` inside, as a string for a command line.
+    #[must_use]
+    pub fn arg(&self, name: &str) -> String {
+        self.join(name).to_str().expect("a UTF-8 temporary directory").to_string()
     }
 }
 

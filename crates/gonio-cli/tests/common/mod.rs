@@ -4,10 +4,7 @@
 //! Each test file says `mod common;` and uses the part it needs.
 #![allow(dead_code)]
 
-use std::ops::Deref;
-use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// The `gonio` binary of this build.
 pub fn gonio_command() -> Command {
@@ -52,42 +49,5 @@ pub const SCENE: &str = r#"<scene version="3.0.0">
     <shape type="sphere"/>
 </scene>"#;
 
-/// A fresh directory under the system's temporary directory, removed with everything in it when dropped
-/// (also when the test fails: the drop runs during the unwind). Dereferences to its path.
-pub struct Scratch(PathBuf);
-
-impl Scratch {
-    /// `gonio-cli-test-TAG-PID-N`: unique per process and call, so tests running in parallel never share one.
-    pub fn new(tag: &str) -> Scratch {
-        static COUNT: AtomicUsize = AtomicUsize::new(0);
-        let n = COUNT.fetch_add(1, Ordering::Relaxed);
-        let dir = std::env::temp_dir().join(format!("gonio-cli-test-{tag}-{}-{n}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).expect("create a scratch directory");
-        Scratch(dir)
-    }
-
-    /// The path of `name` inside, as a string for a command line.
-    pub fn arg(&self, name: &str) -> String {
-        self.0.join(name).to_str().expect("a UTF-8 temporary directory").to_string()
-    }
-}
-
-impl Deref for Scratch {
-    type Target = Path;
-    fn deref(&self) -> &Path {
-        &self.0
-    }
-}
-
-impl AsRef<Path> for Scratch {
-    fn as_ref(&self) -> &Path {
-        &self.0
-    }
-}
-
-impl Drop for Scratch {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
+/// A fresh directory under the system's temporary directory, removed with everything in it when dropped.
+pub use gonio::scratch::ScratchDir as Scratch;
