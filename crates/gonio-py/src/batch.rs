@@ -126,7 +126,9 @@ impl Column<'_> {
         match self.data {
             Slice::F32(s) => {
                 let s = &s[3 * rows.start..3 * rows.end];
-                let ok = s.chunks_exact(3).fold(true, |ok, w| ok & crate::is_unit(f64::from(w[0]), f64::from(w[1]), f64::from(w[2])));
+                // The quick check settles rows of unit length; the exact one, in f64, any others.
+                let ok = surely_unit(s)
+                    || s.chunks_exact(3).fold(true, |ok, w| ok & crate::is_unit(f64::from(w[0]), f64::from(w[1]), f64::from(w[2])));
                 // SAFETY: `Vec3` is `#[repr(C)]` of three `f32` (size 12, alignment 4), and `s` holds
                 // exactly 3·len floats, so it is `len` `Vec3`s; the borrow keeps the array alive and unchanged.
                 ok.then(|| unsafe { std::slice::from_raw_parts(s.as_ptr().cast::<Vec3>(), rows.len()) })
@@ -148,7 +150,7 @@ impl Column<'_> {
         match self.data {
             Slice::F32(s) if !self.single => {
                 let s = &s[rows];
-                s.iter().fold(true, |ok, v| ok & (0.0..=1.0).contains(v)).then_some(s)
+                in_unit_interval(s).then_some(s)
             }
             _ => {
                 buf.clear();
@@ -169,7 +171,7 @@ impl Column<'_> {
         match self.data {
             Slice::F32(s) if !self.single => {
                 let s = &s[2 * rows.start..2 * rows.end];
-                let ok = s.iter().fold(true, |ok, v| ok & (0.0..=1.0).contains(v));
+                let ok = in_unit_interval(s);
                 // SAFETY: `Vec2` is `#[repr(C)]` of two `f32`; `s` holds 2·len floats (see `directions`).
                 ok.then(|| unsafe { std::slice::from_raw_parts(s.as_ptr().cast::<Vec2>(), rows.len()) })
             }
@@ -186,6 +188,57 @@ impl Column<'_> {
             }
         }
     }
+}
+
+/// Squared lengths in f32 within which a row is surely of unit length by [`crate::is_unit`]'s measure (in
+/// f64: |w|² in [(1 − 10⁻³)², (1 + 10⁻³)²]): that interval narrowed by 10⁻⁶ relative at either end. The
+/// f32 sum of three squares is within 3 roundings (2·10⁻⁷ relative) of the exact one, and a square that
+/// overflows or underflows lands far outside; NaN compares false.
+const SURELY_UNIT: (f32, f32) = (
+    ((1.0 - crate::UNIT_TOLERANCE) * (1.0 - crate::UNIT_TOLERANCE) * (1.0 + 1e-6)) as f32,
+    ((1.0 + crate::UNIT_TOLERANCE) * (1.0 + crate::UNIT_TOLERANCE) * (1.0 - 1e-6)) as f32,
+);
+
+/// Whether every row (x, y, z) of `s` has a squared length in [`SURELY_UNIT`], computed in f32. True means
+/// every row passes `is_unit`; false leaves it open (rows near the tolerance, or bad rows) for the exact
+/// check. A tight loop the compiler vectorises; with AVX2 (8 lanes) it costs about what reading the rows
+/// does (2026-11: 12 instead of 10 instructions per row for the f64 check alone).
+fn surely_unit(s: &[f32]) -> bool {
+    #[inline(always)]
+    fn check(s: &[f32]) -> bool {
+        let (lo, hi) = SURELY_UNIT;
+        s.chunks_exact(3).fold(true, |ok, w| {
+            let l2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
+            ok & (l2 >= lo) & (l2 <= hi)
+        })
+    }
+    simd(s, check)
+}
+
+/// Whether every number of `s` is in [0, 1] (NaN is not).
+fn in_unit_interval(s: &[f32]) -> bool {
+    #[inline(always)]
+    fn check(s: &[f32]) -> bool {
+        s.iter().fold(true, |ok, &v| ok & (v >= 0.0) & (v <= 1.0))
+    }
+    simd(s, check)
+}
+
+/// `check(s)` compiled for AVX2 where the CPU has it (detected at run time), else for the baseline.
+#[inline(always)]
+fn simd<F: Fn(&[f32]) -> bool>(s: &[f32], check: F) -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        #[target_feature(enable = "avx2")]
+        unsafe fn with_avx2<F: Fn(&[f32]) -> bool>(s: &[f32], check: F) -> bool {
+            check(s)
+        }
+        if std::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has AVX2 (checked just above).
+            return unsafe { with_avx2(s, check) };
+        }
+    }
+    check(s)
 }
 
 /// The common row count of several arguments (1-row arguments broadcast), and whether any was batched.
@@ -240,11 +293,144 @@ impl<T> Out<T> {
 
 /// A new, uninitialised, contiguous 1-D numpy array of `len` elements and a pointer to fill it.
 /// Every element must be written before the array is handed to Python.
-pub(crate) fn output<T: numpy::Element>(py: Python<'_>, len: usize) -> (Bound<'_, PyArray1<T>>, Out<T>) {
-    // SAFETY: the array is fresh and C-contiguous; callers write every element before returning it.
-    let a = unsafe { PyArray1::<T>::new(py, [len], false) };
-    let ptr = a.data();
-    (a, Out(ptr))
+///
+/// Arrays of at least [`POOLED_BYTES`] live in memory from [`pool`] (see there why); smaller ones are
+/// numpy's own.
+pub(crate) fn output<T: numpy::Element>(py: Python<'_>, len: usize) -> PyResult<(Bound<'_, PyArray1<T>>, Out<T>)> {
+    let bytes = len * std::mem::size_of::<T>();
+    if bytes < pool::POOLED_BYTES {
+        // SAFETY: the array is fresh and C-contiguous; callers write every element before returning it.
+        let a = unsafe { PyArray1::<T>::new(py, [len], false) };
+        let ptr = a.data();
+        return Ok((a, Out(ptr)));
+    }
+    let block = pool::take(bytes);
+    let ptr = block.as_ptr().cast::<T>();
+    let container = Bound::new(py, block)?;
+    // SAFETY: the block holds `bytes` = len·size_of::<T>() bytes aligned to 64 (more than any element
+    // needs), and it is not freed nor reused before `container`, the array's base object, is dropped. The
+    // view is only used to describe the memory to numpy (its elements are not read here).
+    let view = unsafe { numpy::ndarray::ArrayView1::from_shape_ptr(len, ptr.cast_const()) };
+    let a = unsafe { PyArray1::<T>::borrow_from_array(&view, container.into_any()) };
+    Ok((a, Out(ptr)))
+}
+
+/// The memory of large result arrays, kept for reuse.
+///
+/// Why: a 10⁶-row `sample` returns 49 MB in seven arrays. From numpy's allocator (glibc `malloc`) that
+/// memory goes back to the kernel when the arrays are freed (it is the top of the heap, beyond the trim
+/// threshold), so every call faulted its pages in again: 4 800 page faults, 18–25 ms of a call whose
+/// arithmetic takes 4 (2026-11, measured with `getrusage` and `perf`: `clear_page_erms` and fault
+/// handling). Mitsuba's Dr.Jit keeps its allocations in a cache for the same reason. Here a freed result's
+/// block returns to a small pool, and the next call's arrays of about the same size take it (best fit,
+/// at most a quarter larger), so repeated calls touch warm, mapped pages. The pool keeps at most
+/// [`CACHED_BYTES`] (older blocks are freed first); [`release`] empties it.
+pub(crate) mod pool {
+    use pyo3::prelude::*;
+    use std::alloc::{alloc, dealloc, handle_alloc_error, Layout};
+    use std::cmp::Reverse;
+    use std::ptr::NonNull;
+    use std::sync::Mutex;
+
+    /// Arrays from this size on use the pool (smaller ones are recycled by `malloc` itself: glibc serves
+    /// them from its heap, whose top is only trimmed beyond 128 KiB and more).
+    pub(crate) const POOLED_BYTES: usize = 256 << 10;
+    /// The most memory the pool keeps while no array uses it.
+    pub(crate) const CACHED_BYTES: usize = 256 << 20;
+    /// Alignment of a block: a cache line, and enough for any numpy element type.
+    const ALIGN: usize = 64;
+
+    /// A block of memory from [`take`]: freed explicitly, by [`free`] (no `Drop`).
+    struct Memory {
+        ptr: NonNull<u8>,
+        bytes: usize,
+    }
+
+    // SAFETY: plain memory, owned by exactly one `Memory` (or the `Block` holding it).
+    unsafe impl Send for Memory {}
+    unsafe impl Sync for Memory {}
+
+    fn layout(bytes: usize) -> Layout {
+        Layout::from_size_align(bytes, ALIGN).expect("array size fits in memory")
+    }
+
+    /// The memory of one result array (the array's base object): back to the cache when the array goes.
+    #[pyclass(module = "gonio._gonio", name = "_Block", frozen)]
+    pub(crate) struct Block(Memory);
+
+    impl Block {
+        /// The first byte.
+        pub(crate) fn as_ptr(&self) -> *mut u8 {
+            self.0.ptr.as_ptr()
+        }
+    }
+
+    impl Drop for Block {
+        fn drop(&mut self) {
+            give_back(Memory { ptr: self.0.ptr, bytes: self.0.bytes });
+        }
+    }
+
+    /// Cached memory, oldest first, and its total size.
+    static CACHE: Mutex<(Vec<Memory>, usize)> = Mutex::new((Vec::new(), 0));
+
+    fn free(m: Memory) {
+        // SAFETY: allocated in `take` with this layout, and owned by `m` alone.
+        unsafe { dealloc(m.ptr.as_ptr(), layout(m.bytes)) };
+    }
+
+    /// A block of at least `bytes` bytes (contents unspecified): the smallest cached one that is at most a
+    /// quarter larger, of those the last returned (the likeliest still in the CPU's caches), else a new
+    /// allocation.
+    pub(crate) fn take(bytes: usize) -> Block {
+        let bytes = bytes.max(1);
+        {
+            let mut cache = CACHE.lock().unwrap_or_else(|e| e.into_inner());
+            let fits = |m: &Memory| m.bytes >= bytes && m.bytes - bytes <= bytes / 4;
+            let best = cache.0.iter().enumerate().filter(|(_, m)| fits(m)).min_by_key(|&(i, m)| (m.bytes, Reverse(i))).map(|(i, _)| i);
+            if let Some(i) = best {
+                let m = cache.0.remove(i);
+                cache.1 -= m.bytes;
+                return Block(m);
+            }
+        }
+        let layout = layout(bytes);
+        // SAFETY: the layout has a non-zero size.
+        let ptr = NonNull::new(unsafe { alloc(layout) }).unwrap_or_else(|| handle_alloc_error(layout));
+        Block(Memory { ptr, bytes })
+    }
+
+    /// Keep `m` for reuse, freeing the oldest cached memory beyond [`CACHED_BYTES`].
+    fn give_back(m: Memory) {
+        if m.bytes > CACHED_BYTES {
+            return free(m);
+        }
+        let evicted = {
+            let mut cache = CACHE.lock().unwrap_or_else(|e| e.into_inner());
+            cache.1 += m.bytes;
+            cache.0.push(m);
+            let mut evicted = Vec::new();
+            while cache.1 > CACHED_BYTES {
+                let old = cache.0.remove(0);
+                cache.1 -= old.bytes;
+                evicted.push(old);
+            }
+            evicted
+        };
+        evicted.into_iter().for_each(free);
+    }
+
+    /// Free every cached block; the number of bytes freed.
+    pub(crate) fn release() -> usize {
+        let (cached, bytes) = std::mem::take(&mut *CACHE.lock().unwrap_or_else(|e| e.into_inner()));
+        cached.into_iter().for_each(free);
+        bytes
+    }
+
+    /// The number of bytes cached (not in use by any array).
+    pub(crate) fn cached() -> usize {
+        CACHE.lock().unwrap_or_else(|e| e.into_inner()).1
+    }
 }
 
 /// Shape a filled output: (N, width) when `batched`, else the single row ((width,), or a numpy scalar

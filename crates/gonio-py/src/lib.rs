@@ -36,7 +36,7 @@ create_exception!(
 
 /// Largest accepted deviation of |w| from 1 before a direction is rejected (f32 inputs round-tripped
 /// through text or float32 arrays are typically within 1e-7; 1e-3 catches forgotten normalisation).
-const UNIT_TOLERANCE: f64 = 1e-3;
+pub(crate) const UNIT_TOLERANCE: f64 = 1e-3;
 
 fn spec_error(e: gonio::Error) -> PyErr {
     SpecError::new_err(e.to_string())
@@ -169,7 +169,7 @@ fn over_pairs<'py>(
 ) -> PyResult<Bound<'py, PyAny>> {
     let (ao, ai) = (Arg::read(wo, "wo", 3)?, Arg::read(wi, "wi", 3)?);
     let (n, batched) = broadcast(&[&ao, &ai])?;
-    let (out, ptr) = output::<f32>(py, width * n);
+    let (out, ptr) = output::<f32>(py, width * n)?;
     let (co, ci) = (ao.column(), ai.column());
     over_rows(py, n, &[&ao, &ai], &[], normalize, |rows| {
         let (mut bo, mut bi) = (Vec::new(), Vec::new());
@@ -232,13 +232,13 @@ impl PyBsdf {
     ) -> PyResult<PySample> {
         let (ao, auc, au) = (Arg::read(wo, "wo", 3)?, Arg::read(uc, "uc", 1)?, Arg::read(u, "u", 2)?);
         let (n, batched) = broadcast(&[&ao, &auc, &au])?;
-        let (wi_out, wi_ptr) = output::<f32>(py, 3 * n);
-        let (f_out, f_ptr) = output::<f32>(py, 3 * n);
-        let (pdf_out, pdf_ptr) = output::<f32>(py, n);
-        let (weight_out, weight_ptr) = output::<f32>(py, 3 * n);
-        let (flags_out, flags_ptr) = output::<u32>(py, n);
-        let (eta_out, eta_ptr) = output::<f32>(py, n);
-        let (valid_out, valid_ptr) = output::<bool>(py, n);
+        let (wi_out, wi_ptr) = output::<f32>(py, 3 * n)?;
+        let (f_out, f_ptr) = output::<f32>(py, 3 * n)?;
+        let (pdf_out, pdf_ptr) = output::<f32>(py, n)?;
+        let (weight_out, weight_ptr) = output::<f32>(py, 3 * n)?;
+        let (flags_out, flags_ptr) = output::<u32>(py, n)?;
+        let (eta_out, eta_ptr) = output::<f32>(py, n)?;
+        let (valid_out, valid_ptr) = output::<bool>(py, n)?;
         let (co, cuc, cu, bsdf) = (ao.column(), auc.column(), au.column(), &self.bsdf);
         over_rows(py, n, &[&ao], &[&auc, &au], normalize, |rows| {
             let (mut wo_buf, mut uc_buf, mut u_buf) = (Vec::new(), Vec::new(), Vec::new());
@@ -407,6 +407,18 @@ fn from_xml(py: Python<'_>, text: &str, source: &str) -> PyResult<PyBsdf> {
     Ok(PyBsdf { bsdf, spec: text.to_owned() })
 }
 
+/// Free the memory kept for reuse by large result arrays (see `batch::pool`); the number of bytes freed.
+#[pyfunction]
+fn _release_buffers() -> usize {
+    batch::pool::release()
+}
+
+/// The number of bytes kept for reuse by large result arrays and not in use.
+#[pyfunction]
+fn _cached_buffer_bytes() -> usize {
+    batch::pool::cached()
+}
+
 /// The plugin names gonio understands.
 #[pyfunction]
 fn plugins(py: Python<'_>) -> PyResult<Bound<'_, PyTuple>> {
@@ -429,6 +441,9 @@ fn _gonio(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(from_xml, m)?)?;
     m.add_function(wrap_pyfunction!(plugins, m)?)?;
     m.add_function(wrap_pyfunction!(examples, m)?)?;
+    m.add_function(wrap_pyfunction!(_release_buffers, m)?)?;
+    m.add_function(wrap_pyfunction!(_cached_buffer_bytes, m)?)?;
+    m.add_class::<batch::pool::Block>()?;
     verify::register(m)?;
     scene::register(m)?;
     image::register(m)?;

@@ -12,7 +12,7 @@
 //! --release --example batch_rows`): see the table in that example's doc.
 
 use super::{BsdfFlags, BsdfSample, SampleColumns};
-use crate::math::lanes::{channels, F32x8, Real, V3};
+use crate::math::lanes::{channels, F32x8, Real, Rows8, V3};
 use crate::math::{Vec2, Vec3};
 use crate::spectrum::Rgb;
 
@@ -95,39 +95,90 @@ pub fn sample_one<K: LaneModel>(k: &K, wo: Vec3, uc: f32, u: Vec2) -> Option<Bsd
     })
 }
 
-/// `out[k] = f(wo[k], wi[k])` for `k` below the shortest length, eight rows at a time.
+/// Rows of three numbers (`Vec3`, `Rgb`) as `[f32; 3]`s, to be overwritten.
 #[inline(always)]
-pub fn f_rows<K: LaneModel>(k: &K, wo: &[Vec3], wi: &[Vec3], out: &mut [Rgb]) {
+fn triples<T: Triple>(rows: &mut [T]) -> &mut [[f32; 3]] {
+    // SAFETY: `Triple` types are three `f32`s laid out as `[f32; 3]` (size 12, alignment 4).
+    unsafe { std::slice::from_raw_parts_mut(rows.as_mut_ptr().cast::<[f32; 3]>(), rows.len()) }
+}
+
+/// # Safety
+/// Implementors are laid out exactly as `[f32; 3]`.
+unsafe trait Triple {}
+// SAFETY: `glam::Vec3` is `#[repr(C)]` of x, y, z; `Rgb` is `#[repr(transparent)]` over `[f32; 3]`.
+unsafe impl Triple for Vec3 {}
+unsafe impl Triple for Rgb {}
+const _: () = assert!(std::mem::size_of::<Vec3>() == 12 && std::mem::align_of::<Vec3>() == 4);
+const _: () = assert!(std::mem::size_of::<Rgb>() == 12 && std::mem::align_of::<Rgb>() == 4);
+
+/// Defines the public driver `$name`, which runs `$generic` on [`Avx8`](crate::math::avx2) lanes inside a
+/// function compiled for AVX2 + FMA when the CPU has them (so that each lane operation is inlined as its
+/// instruction whoever calls the driver), else on [`F32x8`].
+macro_rules! driver {
+    ($(#[$doc:meta])* $name:ident => $generic:ident($($arg:ident: $ty:ty),*)) => {
+        $(#[$doc])*
+        #[inline(always)]
+        pub fn $name<K: LaneModel>(k: &K, $($arg: $ty),*) {
+            #[cfg(target_arch = "x86_64")]
+            {
+                #[target_feature(enable = "avx2,fma")]
+                unsafe fn with_avx2<K: LaneModel>(k: &K, $($arg: $ty),*) {
+                    $generic::<crate::math::avx2::Avx8, K>(k, $($arg),*)
+                }
+                if crate::math::avx2::detected() {
+                    // SAFETY: the CPU has the features `with_avx2` is compiled for (checked just above);
+                    // `Avx8` values exist only inside it (see `math::avx2`).
+                    return unsafe { with_avx2(k, $($arg),*) };
+                }
+            }
+            $generic::<F32x8, K>(k, $($arg),*)
+        }
+    };
+}
+
+driver!(
+    /// `out[k] = f(wo[k], wi[k])` for `k` below the shortest length, eight rows at a time.
+    f_rows => f_rows_in(wo: &[Vec3], wi: &[Vec3], out: &mut [Rgb])
+);
+
+#[inline(always)]
+fn f_rows_in<R: Rows8, K: LaneModel>(k: &K, wo: &[Vec3], wi: &[Vec3], out: &mut [Rgb]) {
     let n = wo.len().min(wi.len()).min(out.len());
     let full = n - n % 8;
-    for ((o, i), r) in wo[..full].chunks_exact(8).zip(wi[..full].chunks_exact(8)).zip(out[..full].chunks_exact_mut(8)) {
-        let f = k.f_lanes(V3::load(o), V3::load(i));
-        for (l, r) in r.iter_mut().enumerate() {
-            *r = Rgb([f[0].0[l], f[1].0[l], f[2].0[l]]);
-        }
+    for ((o, i), r) in wo[..full].chunks_exact(8).zip(wi[..full].chunks_exact(8)).zip(triples(&mut out[..full]).chunks_exact_mut(8)) {
+        let [r0, r1, r2] = k.f_lanes(R::load3(o), R::load3(i));
+        R::store3(r0, r1, r2, r);
     }
     for j in full..n {
         out[j] = f_one(k, wo[j], wi[j]);
     }
 }
 
-/// `out[k] = pdf(wo[k], wi[k])` for `k` below the shortest length, eight rows at a time.
+driver!(
+    /// `out[k] = pdf(wo[k], wi[k])` for `k` below the shortest length, eight rows at a time.
+    pdf_rows => pdf_rows_in(wo: &[Vec3], wi: &[Vec3], out: &mut [f32])
+);
+
 #[inline(always)]
-pub fn pdf_rows<K: LaneModel>(k: &K, wo: &[Vec3], wi: &[Vec3], out: &mut [f32]) {
+fn pdf_rows_in<R: Rows8, K: LaneModel>(k: &K, wo: &[Vec3], wi: &[Vec3], out: &mut [f32]) {
     let n = wo.len().min(wi.len()).min(out.len());
     let full = n - n % 8;
     for ((o, i), r) in wo[..full].chunks_exact(8).zip(wi[..full].chunks_exact(8)).zip(out[..full].chunks_exact_mut(8)) {
-        r.copy_from_slice(&k.pdf_lanes(V3::load(o), V3::load(i)).0);
+        k.pdf_lanes(R::load3(o), R::load3(i)).store(r);
     }
     for j in full..n {
         out[j] = pdf_one(k, wo[j], wi[j]);
     }
 }
 
-/// Row `k` of `out` = sample(wo[k], uc[k], u[k]) (zeros and `valid = false` where `None`), for `k` below
-/// the shortest length, eight rows at a time.
+driver!(
+    /// Row `k` of `out` = sample(wo[k], uc[k], u[k]) (zeros and `valid = false` where `None`), for `k` below
+    /// the shortest length, eight rows at a time.
+    sample_rows => sample_rows_in(wo: &[Vec3], uc: &[f32], u: &[Vec2], out: &mut SampleColumns<'_>)
+);
+
 #[inline(always)]
-pub fn sample_rows<K: LaneModel>(k: &K, wo: &[Vec3], uc: &[f32], u: &[Vec2], out: &mut SampleColumns<'_>) {
+fn sample_rows_in<R: Rows8, K: LaneModel>(k: &K, wo: &[Vec3], uc: &[f32], u: &[Vec2], out: &mut SampleColumns<'_>) {
     let n = [
         wo.len(),
         uc.len(),
@@ -144,28 +195,29 @@ pub fn sample_rows<K: LaneModel>(k: &K, wo: &[Vec3], uc: &[f32], u: &[Vec2], out
     .min()
     .unwrap_or(0);
     let full = n - n % 8;
-    for start in (0..full).step_by(8) {
-        let rows = start..start + 8;
-        let (ux, uy) = F32x8::load2(&u[rows.clone()]);
-        let s = k.sample_lanes(V3::load(&wo[rows.clone()]), F32x8::load(&uc[rows.clone()]), ux, uy);
+    // Zipped chunks of eight: no bounds checks in the loop.
+    let inputs = wo[..full].chunks_exact(8).zip(uc[..full].chunks_exact(8)).zip(u[..full].chunks_exact(8));
+    let vectors = triples(&mut out.wi[..full])
+        .chunks_exact_mut(8)
+        .zip(triples(&mut out.f[..full]).chunks_exact_mut(8))
+        .zip(triples(&mut out.weight[..full]).chunks_exact_mut(8));
+    let numbers = out.pdf[..full]
+        .chunks_exact_mut(8)
+        .zip(out.flags[..full].chunks_exact_mut(8))
+        .zip(out.eta[..full].chunks_exact_mut(8))
+        .zip(out.valid[..full].chunks_exact_mut(8));
+    for (((wo, uc), u), (((wi_out, f_out), weight_out), (((pdf_out, flags_out), eta_out), valid_out))) in inputs.zip(vectors.zip(numbers)) {
+        let (ux, uy) = R::load2(u);
+        let s = k.sample_lanes(R::load3(wo), R::load(uc), ux, uy);
         // Invalid lanes are zero in every field.
-        let zero = F32x8::splat(0.0);
-        let (wx, wy, wz) =
-            (F32x8::select(s.valid, s.wi.x, zero), F32x8::select(s.valid, s.wi.y, zero), F32x8::select(s.valid, s.wi.z, zero));
-        let f = channels!(|c| F32x8::select(s.valid, s.f[c], zero));
-        let weight = channels!(|c| F32x8::select(s.valid, s.weight[c], zero));
-        let (pdf, flags, eta) =
-            (F32x8::select(s.valid, s.pdf, zero), F32x8::select(s.valid, s.flags, zero), F32x8::select(s.valid, s.eta, zero));
-        for l in 0..8 {
-            let j = start + l;
-            out.wi[j] = Vec3::new(wx.0[l], wy.0[l], wz.0[l]);
-            out.f[j] = Rgb([f[0].0[l], f[1].0[l], f[2].0[l]]);
-            out.weight[j] = Rgb([weight[0].0[l], weight[1].0[l], weight[2].0[l]]);
-            out.pdf[j] = pdf.0[l];
-            out.flags[j] = flags.0[l] as u32;
-            out.eta[j] = eta.0[l];
-            out.valid[j] = s.valid.get(l);
-        }
+        let keep = |v: R| R::select(s.valid, v, R::splat(0.0));
+        R::store3(keep(s.wi.x), keep(s.wi.y), keep(s.wi.z), wi_out);
+        R::store3(keep(s.f[0]), keep(s.f[1]), keep(s.f[2]), f_out);
+        R::store3(keep(s.weight[0]), keep(s.weight[1]), keep(s.weight[2]), weight_out);
+        keep(s.pdf).store(pdf_out);
+        keep(s.flags).store_u32(flags_out);
+        keep(s.eta).store(eta_out);
+        R::store_mask(s.valid, valid_out);
     }
     for j in full..n {
         let s = sample_one(k, wo[j], uc[j], u[j]);

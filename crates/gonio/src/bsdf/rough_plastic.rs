@@ -187,10 +187,7 @@ impl CoatingTables {
         if let Some(graded) = &self.graded {
             return graded.lookup(mu.clamp(0.0, 1.0));
         }
-        let x = mu.clamp(0.0, 1.0) * (TABLE_SIZE - 1) as f32;
-        let k = (x as usize).min(TABLE_SIZE - 2);
-        let t = x - k as f32;
-        (1.0 - t) * self.transmittance[k] + t * self.transmittance[k + 1]
+        mu.lerp_table(&self.transmittance)
     }
 
     /// The tables for (kind, α, η): integrated at α itself and cached per process, or, while an
@@ -551,10 +548,14 @@ impl RoughPlastic {
 }
 
 impl GgxPlastic<'_> {
-    /// T(μ) per lane (a table lookup).
+    /// T(μ) per lane ([`CoatingTables::transmittance`]): the even table by [`Real::lerp_table`] (gathers in
+    /// the AVX lanes), graded nodes (η < 1) by a search per lane.
     #[inline(always)]
     fn transmittance<R: Real>(&self, mu: R) -> R {
-        mu.map(|m| self.tables.transmittance(m))
+        if self.tables.graded.is_some() {
+            return mu.map(|m| self.tables.transmittance(m));
+        }
+        mu.lerp_table(&self.tables.transmittance)
     }
 
     /// [`RoughPlastic::specular_probability`].

@@ -43,16 +43,23 @@ pub trait Real:
     fn splat(v: f32) -> Self;
     fn sqrt(self) -> Self;
     fn abs(self) -> Self;
-    /// `f32::min`: the other operand where one is NaN.
+    /// self < o ? self : o, and `self` where `o` is NaN: `f32::min` (the other operand where one is NaN),
+    /// with ties of ±0 settled as x86's `minss(self, o)` does (`o`), which is what `f32::min(x, c)` with a
+    /// constant `c` — the only form the kernels use — compiles to. Written out so that every lane type
+    /// gives the same bits whatever the compiler knows about `o`.
     fn min(self, o: Self) -> Self;
+    /// As [`Self::min`], with self > o.
     fn max(self, o: Self) -> Self;
     fn clamp(self, lo: f32, hi: f32) -> Self;
     /// `f32::mul_add`: self · a + b with one rounding.
     fn mul_add(self, a: Self, b: Self) -> Self;
     /// `f32::round`: to the nearest integer, halves away from zero.
     fn round(self) -> Self;
-    /// `f(lane)` in every lane: for a table lookup or other scalar code (not vectorised, same results).
+    /// `f(lane)` in every lane: for scalar code (not vectorised, same results).
     fn map(self, f: impl Fn(f32) -> f32) -> Self;
+    /// The piecewise-linear function through `table[k]` at k/(N − 1), on [0, 1] (arguments are clamped to
+    /// it; NaN gives NaN): with x·(N − 1) = k + t, (1 − t)·table[k] + t·table[k + 1].
+    fn lerp_table<const N: usize>(self, table: &[f32; N]) -> Self;
     fn lt(self, o: Self) -> Self::Mask;
     fn le(self, o: Self) -> Self::Mask;
     fn gt(self, o: Self) -> Self::Mask;
@@ -85,11 +92,19 @@ impl Real for f32 {
     }
     #[inline(always)]
     fn min(self, o: Self) -> Self {
-        f32::min(self, o)
+        if self < o || o.is_nan() {
+            self
+        } else {
+            o
+        }
     }
     #[inline(always)]
     fn max(self, o: Self) -> Self {
-        f32::max(self, o)
+        if self > o || o.is_nan() {
+            self
+        } else {
+            o
+        }
     }
     #[inline(always)]
     fn clamp(self, lo: f32, hi: f32) -> Self {
@@ -106,6 +121,13 @@ impl Real for f32 {
     #[inline(always)]
     fn map(self, f: impl Fn(f32) -> f32) -> Self {
         f(self)
+    }
+    #[inline(always)]
+    fn lerp_table<const N: usize>(self, table: &[f32; N]) -> Self {
+        let x = self.clamp(0.0, 1.0) * (N - 1) as f32;
+        let k = (x as usize).min(N - 2);
+        let t = x - k as f32;
+        (1.0 - t) * table[k] + t * table[k + 1]
     }
     #[inline(always)]
     fn lt(self, o: Self) -> bool {
@@ -256,11 +278,11 @@ impl Real for F32x8 {
     }
     #[inline(always)]
     fn min(self, o: Self) -> Self {
-        lanes!(F32x8, |i| self.0[i].min(o.0[i]))
+        lanes!(F32x8, |i| Real::min(self.0[i], o.0[i]))
     }
     #[inline(always)]
     fn max(self, o: Self) -> Self {
-        lanes!(F32x8, |i| self.0[i].max(o.0[i]))
+        lanes!(F32x8, |i| Real::max(self.0[i], o.0[i]))
     }
     #[inline(always)]
     fn clamp(self, lo: f32, hi: f32) -> Self {
@@ -277,6 +299,10 @@ impl Real for F32x8 {
     #[inline(always)]
     fn map(self, f: impl Fn(f32) -> f32) -> Self {
         lanes!(F32x8, |i| f(self.0[i]))
+    }
+    #[inline(always)]
+    fn lerp_table<const N: usize>(self, table: &[f32; N]) -> Self {
+        self.map(|x| x.lerp_table(table))
     }
     #[inline(always)]
     fn lt(self, o: Self) -> M32x8 {
@@ -446,6 +472,63 @@ impl From<V3<f32>> for Vec3 {
     }
 }
 
+/// Eight lanes that the batch drivers (`bsdf::lanes`) fill from slices of rows and empty into them: exactly
+/// eight rows each (the slices' lengths are checked). Implemented by [`F32x8`] (element by element) and, on
+/// x86-64 with AVX2, by `avx2::Avx8` (shuffles); either moves the same numbers.
+pub(crate) trait Rows8: Real {
+    fn load(v: &[f32]) -> Self;
+    fn store(self, out: &mut [f32]);
+    /// The x, y and z of eight rows.
+    fn load3(v: &[Vec3]) -> V3<Self>;
+    /// The x and y of eight rows.
+    fn load2(v: &[Vec2]) -> (Self, Self);
+    /// Lanes x, y and z as eight rows of three numbers.
+    fn store3(x: Self, y: Self, z: Self, out: &mut [[f32; 3]]);
+    /// `v as u32` per lane, for whole numbers in [0, 2³¹) (flag bits).
+    fn store_u32(self, out: &mut [u32]);
+    fn store_mask(m: Self::Mask, out: &mut [bool]);
+}
+
+impl Rows8 for F32x8 {
+    #[inline(always)]
+    fn load(v: &[f32]) -> Self {
+        F32x8::load(v)
+    }
+    #[inline(always)]
+    fn store(self, out: &mut [f32]) {
+        out.copy_from_slice(&self.0);
+    }
+    #[inline(always)]
+    fn load3(v: &[Vec3]) -> V3<Self> {
+        V3::load(v)
+    }
+    #[inline(always)]
+    fn load2(v: &[Vec2]) -> (Self, Self) {
+        F32x8::load2(v)
+    }
+    #[inline(always)]
+    fn store3(x: Self, y: Self, z: Self, out: &mut [[f32; 3]]) {
+        let out: &mut [[f32; 3]; 8] = out.try_into().expect("eight rows");
+        for (l, r) in out.iter_mut().enumerate() {
+            *r = [x.0[l], y.0[l], z.0[l]];
+        }
+    }
+    #[inline(always)]
+    fn store_u32(self, out: &mut [u32]) {
+        let out: &mut [u32; 8] = out.try_into().expect("eight numbers");
+        for (l, o) in out.iter_mut().enumerate() {
+            *o = self.0[l] as u32;
+        }
+    }
+    #[inline(always)]
+    fn store_mask(m: M32x8, out: &mut [bool]) {
+        let out: &mut [bool; 8] = out.try_into().expect("eight flags");
+        for (l, o) in out.iter_mut().enumerate() {
+            *o = m.get(l);
+        }
+    }
+}
+
 impl V3<F32x8> {
     /// Eight `Vec3`s (exactly eight) as lanes.
     #[inline(always)]
@@ -485,6 +568,25 @@ impl F32x8 {
 mod tests {
     use super::*;
 
+    /// `Real::min` and `max` on `f32` are what `f32::min(x, c)` and `max` with a constant `c` (the form the
+    /// kernels use) give, ties of ±0 and NaN included.
+    #[test]
+    fn min_and_max_are_std_with_constants() {
+        use std::hint::black_box;
+        for x in [-0.0f32, 0.0, 1.0, -1.0, 0.5, f32::NAN, f32::INFINITY, f32::NEG_INFINITY, 1e-40] {
+            let x = black_box(x);
+            for (real, std) in [
+                (Real::max(x, 0.0), x.max(0.0)),
+                (Real::min(x, 0.0), x.min(0.0)),
+                (Real::min(x, 1.0), x.min(1.0)),
+                (Real::max(x, -0.0), x.max(-0.0)),
+                (Real::min(x, -0.0), x.min(-0.0)),
+            ] {
+                assert_eq!(real.to_bits(), std.to_bits(), "{x}");
+            }
+        }
+    }
+
     /// Every operation of `F32x8` is the `f32` operation per lane, bit for bit, NaN and infinities included.
     #[test]
     fn lanes_are_scalar_operations() {
@@ -493,7 +595,7 @@ mod tests {
         let (x, y) = (F32x8(a), F32x8(b));
         let same = |l: F32x8, f: &dyn Fn(f32, f32) -> f32| (0..8).all(|i| l.0[i].to_bits() == f(a[i], b[i]).to_bits());
         assert!(same(x + y, &|p, q| p + q) && same(x - y, &|p, q| p - q) && same(x * y, &|p, q| p * q));
-        assert!(same(x / y, &|p, q| p / q) && same(x.min(y), &f32::min) && same(x.max(y), &f32::max));
+        assert!(same(x / y, &|p, q| p / q) && same(x.min(y), &Real::min) && same(x.max(y), &Real::max));
         assert!(
             same(x.sqrt(), &|p, _| p.sqrt()) && same(x.round(), &|p, _| p.round()) && same(x.clamp(0.0, 1.0), &|p, _| p.clamp(0.0, 1.0))
         );

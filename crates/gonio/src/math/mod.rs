@@ -1,5 +1,7 @@
 //! Vectors (re-exported from `glam`), the shading frame and spherical coordinates.
 
+#[cfg(target_arch = "x86_64")]
+pub mod avx2;
 pub mod frame;
 pub mod lanes;
 pub mod spherical;
