@@ -1,10 +1,12 @@
 //! The batched loops behind `Bsdf.f`, `pdf` and `sample`: arguments are read in place from numpy
 //! (contiguous float32 rows are used as `Vec3`/`Vec2` slices without a copy; float64 and broadcast rows
-//! are converted per chunk), checked in one tight pass, and handed a chunk at a time to the model's batch
-//! methods ([`gonio::bsdf::BsdfModel::f_batch`] and friends: one `match` on the model per chunk, loops
-//! compiled for AVX2 + FMA where the CPU has them), which write straight into freshly allocated numpy
-//! arrays. Chunks run in parallel on rayon's threads, without the GIL.
+//! are converted per chunk) and handed a chunk at a time to the model's batch methods
+//! ([`gonio::bsdf::BsdfModel::f_batch_checked`] and friends: one `match` on the model per chunk, SIMD
+//! loops), which write straight into the result arrays. Float32 rows are checked by those methods in the
+//! same pass ([`UNIT_BAND`]; a chunk they do not settle is checked row by row, exactly); converted rows are
+//! checked while converted. Chunks run in parallel on rayon's threads, without the GIL.
 
+use gonio::bsdf::RowCheck;
 use gonio::math::{Vec2, Vec3};
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
@@ -110,6 +112,35 @@ impl Column<'_> {
         [self.get(i, 0), self.get(i, 1), self.get(i, 2)]
     }
 
+    /// The numbers of a float32 argument with N rows, in place; `None` for other storage or one row.
+    fn in_place(&self) -> Option<&[f32]> {
+        match self.data {
+            Slice::F32(s) if !self.single => Some(s),
+            _ => None,
+        }
+    }
+
+    /// Rows `rows` of a float32 width-3 argument as `Vec3`s, in place and unchecked (see
+    /// [`Self::in_place`]).
+    pub(crate) fn vec3_in_place(&self, rows: Range<usize>) -> Option<&[Vec3]> {
+        let s = &self.in_place()?[3 * rows.start..3 * rows.end];
+        // SAFETY: `Vec3` is `#[repr(C)]` of three `f32` (size 12, alignment 4), and `s` holds exactly
+        // 3·len floats, so it is `len` `Vec3`s; the borrow keeps the array alive and unchanged.
+        Some(unsafe { std::slice::from_raw_parts(s.as_ptr().cast::<Vec3>(), rows.len()) })
+    }
+
+    /// Rows `rows` of a float32 width-1 argument, in place and unchecked.
+    pub(crate) fn f32_in_place(&self, rows: Range<usize>) -> Option<&[f32]> {
+        Some(&self.in_place()?[rows])
+    }
+
+    /// Rows `rows` of a float32 width-2 argument as `Vec2`s, in place and unchecked.
+    pub(crate) fn vec2_in_place(&self, rows: Range<usize>) -> Option<&[Vec2]> {
+        let s = &self.in_place()?[2 * rows.start..2 * rows.end];
+        // SAFETY: `Vec2` is `#[repr(C)]` of two `f32`; `s` holds 2·len floats (see `vec3_in_place`).
+        Some(unsafe { std::slice::from_raw_parts(s.as_ptr().cast::<Vec2>(), rows.len()) })
+    }
+
     /// Rows `rows` as directions (see [`crate::to_direction`]), or `None` when any is not acceptable.
     /// Unit float32 rows are read in place (a numpy row of three float32 is laid out as a `Vec3`); other
     /// storage is converted into `buf`. One tight loop per storage type, without per-row dispatch, so that
@@ -126,9 +157,7 @@ impl Column<'_> {
         match self.data {
             Slice::F32(s) => {
                 let s = &s[3 * rows.start..3 * rows.end];
-                // The quick check settles rows of unit length; the exact one, in f64, any others.
-                let ok = surely_unit(s)
-                    || s.chunks_exact(3).fold(true, |ok, w| ok & crate::is_unit(f64::from(w[0]), f64::from(w[1]), f64::from(w[2])));
+                let ok = s.chunks_exact(3).fold(true, |ok, w| ok & crate::is_unit(f64::from(w[0]), f64::from(w[1]), f64::from(w[2])));
                 // SAFETY: `Vec3` is `#[repr(C)]` of three `f32` (size 12, alignment 4), and `s` holds
                 // exactly 3·len floats, so it is `len` `Vec3`s; the borrow keeps the array alive and unchanged.
                 ok.then(|| unsafe { std::slice::from_raw_parts(s.as_ptr().cast::<Vec3>(), rows.len()) })
@@ -150,7 +179,7 @@ impl Column<'_> {
         match self.data {
             Slice::F32(s) if !self.single => {
                 let s = &s[rows];
-                in_unit_interval(s).then_some(s)
+                s.iter().fold(true, |ok, v| ok & (0.0..=1.0).contains(v)).then_some(s)
             }
             _ => {
                 buf.clear();
@@ -171,7 +200,7 @@ impl Column<'_> {
         match self.data {
             Slice::F32(s) if !self.single => {
                 let s = &s[2 * rows.start..2 * rows.end];
-                let ok = in_unit_interval(s);
+                let ok = s.iter().fold(true, |ok, v| ok & (0.0..=1.0).contains(v));
                 // SAFETY: `Vec2` is `#[repr(C)]` of two `f32`; `s` holds 2·len floats (see `directions`).
                 ok.then(|| unsafe { std::slice::from_raw_parts(s.as_ptr().cast::<Vec2>(), rows.len()) })
             }
@@ -190,56 +219,15 @@ impl Column<'_> {
     }
 }
 
-/// Squared lengths in f32 within which a row is surely of unit length by [`crate::is_unit`]'s measure (in
-/// f64: |w|² in [(1 − 10⁻³)², (1 + 10⁻³)²]): that interval narrowed by 10⁻⁶ relative at either end. The
-/// f32 sum of three squares is within 3 roundings (2·10⁻⁷ relative) of the exact one, and a square that
-/// overflows or underflows lands far outside; NaN compares false.
-const SURELY_UNIT: (f32, f32) = (
-    ((1.0 - crate::UNIT_TOLERANCE) * (1.0 - crate::UNIT_TOLERANCE) * (1.0 + 1e-6)) as f32,
-    ((1.0 + crate::UNIT_TOLERANCE) * (1.0 + crate::UNIT_TOLERANCE) * (1.0 - 1e-6)) as f32,
-);
-
-/// Whether every row (x, y, z) of `s` has a squared length in [`SURELY_UNIT`], computed in f32. True means
-/// every row passes `is_unit`; false leaves it open (rows near the tolerance, or bad rows) for the exact
-/// check. A tight loop the compiler vectorises; with AVX2 (8 lanes) it costs about what reading the rows
-/// does (2026-11: 12 instead of 10 instructions per row for the f64 check alone).
-fn surely_unit(s: &[f32]) -> bool {
-    #[inline(always)]
-    fn check(s: &[f32]) -> bool {
-        let (lo, hi) = SURELY_UNIT;
-        s.chunks_exact(3).fold(true, |ok, w| {
-            let l2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
-            ok & (l2 >= lo) & (l2 <= hi)
-        })
-    }
-    simd(s, check)
-}
-
-/// Whether every number of `s` is in [0, 1] (NaN is not).
-fn in_unit_interval(s: &[f32]) -> bool {
-    #[inline(always)]
-    fn check(s: &[f32]) -> bool {
-        s.iter().fold(true, |ok, &v| ok & (v >= 0.0) & (v <= 1.0))
-    }
-    simd(s, check)
-}
-
-/// `check(s)` compiled for AVX2 where the CPU has it (detected at run time), else for the baseline.
-#[inline(always)]
-fn simd<F: Fn(&[f32]) -> bool>(s: &[f32], check: F) -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        #[target_feature(enable = "avx2")]
-        unsafe fn with_avx2<F: Fn(&[f32]) -> bool>(s: &[f32], check: F) -> bool {
-            check(s)
-        }
-        if std::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU has AVX2 (checked just above).
-            return unsafe { with_avx2(s, check) };
-        }
-    }
-    check(s)
-}
+/// The squared lengths, computed in f32, of directions that surely pass [`crate::is_unit`] (in f64: |w|² in
+/// [(1 − 10⁻³)², (1 + 10⁻³)²]): that interval narrowed by 10⁻⁶ relative at either end. The f32 sum of three
+/// squares is within 3 roundings (2·10⁻⁷ relative) of the exact one, and a square that overflows or
+/// underflows lands far outside. The batch methods test float32 rows against it in their own pass; a chunk
+/// with a row outside is checked exactly.
+pub(crate) const UNIT_BAND: RowCheck = RowCheck {
+    lo: ((1.0 - crate::UNIT_TOLERANCE) * (1.0 - crate::UNIT_TOLERANCE) * (1.0 + 1e-6)) as f32,
+    hi: ((1.0 + crate::UNIT_TOLERANCE) * (1.0 + crate::UNIT_TOLERANCE) * (1.0 - 1e-6)) as f32,
+};
 
 /// The common row count of several arguments (1-row arguments broadcast), and whether any was batched.
 pub(crate) fn broadcast(args: &[&Arg<'_>]) -> PyResult<(usize, bool)> {

@@ -1,4 +1,4 @@
-//! Eight lanes in one AVX register: [`Avx8`], the [`Real`] that gonio's batch drivers run the kernels on
+//! Eight lanes in one AVX register: `Avx8`, the [`Real`] that gonio's batch drivers run the kernels on
 //! when the CPU has AVX2 and FMA ([`detected`], checked at run time, so one wheel runs everywhere).
 //!
 //! [`F32x8`](super::lanes::F32x8) writes each operation as a loop over eight `f32`s and leaves it to LLVM's
@@ -12,19 +12,19 @@
 //! |--------------------------------------------|----------------------------------------------------|
 //! | + − × ÷ √, `mul_add`, compares, `select`   | one instruction                                    |
 //! | `min`, `max`, `clamp`, `round`             | two to four                                        |
-//! | [`Rows8::load3`], [`Rows8::store3`]        | 6 loads or 3 stores and 5–9 shuffles (vs 24 scalar moves) |
-//! | [`Rows8::load2`]                           | 2 loads, 4 shuffles                                |
+//! | `Rows::load3`, `Rows::store3`        | 6 loads or 3 stores and 5–9 shuffles (vs 24 scalar moves) |
+//! | `Rows::load2`                           | 2 loads, 4 shuffles                                |
 //! | [`Real::lerp_table`]                       | 2 gathers and the arithmetic in lanes              |
 //!
 //! Each operation computes per lane exactly the IEEE operation the `f32` form ([`Real`] for `f32`) does,
 //! so a kernel on `Avx8` gives the single calls' results bit for bit (tests below, and
 //! `bsdf::tests::batches_equal_single_calls`).
 //!
-//! Safety: `Avx8` and [`Mask8`] are crate-private, and values of them exist only inside the batch
+//! Safety: `Avx8` and `Mask8` are crate-private, and values of them exist only inside the batch
 //! drivers' `#[target_feature(enable = "avx2,fma")]` functions, which are entered only when [`detected`]
 //! says the CPU has those features (`bsdf::lanes`). Their methods use the intrinsics on that basis.
 
-use super::lanes::{Real, Rows8, V3};
+use super::lanes::{Real, Rows, V3};
 use super::{Vec2, Vec3};
 use std::arch::x86_64::*;
 use std::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
@@ -33,6 +33,10 @@ use std::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
 #[inline(always)]
 #[must_use]
 pub fn detected() -> bool {
+    #[cfg(test)]
+    if !super::simd_level::allows(1) {
+        return false;
+    }
     std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma")
 }
 
@@ -61,7 +65,7 @@ macro_rules! avx {
 }
 
 impl Avx8 {
-    /// The lanes as an array (for tests and `map`).
+    /// The lanes as an array (for `map`).
     #[inline(always)]
     pub(crate) fn to_array(self) -> [f32; 8] {
         let mut a = [0.0; 8];
@@ -73,16 +77,6 @@ impl Avx8 {
     #[inline(always)]
     pub(crate) fn from_array(a: [f32; 8]) -> Self {
         Avx8(avx!(_mm256_loadu_ps(a.as_ptr())))
-    }
-}
-
-#[cfg(test)]
-impl Mask8 {
-    /// The lanes as `bool`s.
-    #[inline(always)]
-    pub(crate) fn to_array(self) -> [bool; 8] {
-        let bits = avx!(_mm256_movemask_ps(self.0));
-        std::array::from_fn(|i| bits >> i & 1 != 0)
     }
 }
 
@@ -251,7 +245,7 @@ impl Real for Avx8 {
     }
 }
 
-impl Rows8 for Avx8 {
+impl Rows for Avx8 {
     #[inline(always)]
     fn load(v: &[f32]) -> Self {
         let v: &[f32; 8] = v.try_into().expect("eight numbers");
@@ -344,116 +338,17 @@ impl Rows8 for Avx8 {
 mod tests {
     use super::*;
 
-    /// Runs `check` with AVX2 and FMA enabled, or not at all on CPUs without them.
-    fn with_avx2(check: fn()) {
+    /// The lane-type checks of `math::lanes` (every operation the `f32` one, bit for bit; rows move
+    /// exactly), run with AVX2 and FMA enabled, on CPUs that have them.
+    #[test]
+    fn avx8_is_a_lane_type() {
         #[target_feature(enable = "avx2,fma")]
-        unsafe fn run(check: fn()) {
-            check();
+        unsafe fn run() {
+            crate::math::lanes::check_lane_type::<Avx8>();
         }
         if detected() {
             // SAFETY: the CPU has the features.
-            unsafe { run(check) }
+            unsafe { run() }
         }
-    }
-
-    const A: [f32; 8] = [0.5, -1.5, 0.0, -0.0, f32::INFINITY, f32::NAN, 3.0e-39, 2.5];
-    const B: [f32; 8] = [2.0, -1.5, -0.0, 0.0, 1.0, 0.5, -7.0, f32::NEG_INFINITY];
-
-    /// Every operation is the `f32` one per lane, bit for bit, NaN, ±0, infinities and subnormals included.
-    #[test]
-    fn lanes_are_scalar_operations() {
-        with_avx2(|| {
-            for (a, b) in [(A, B), (B, A), (A, A)] {
-                let (x, y) = (Avx8::from_array(a), Avx8::from_array(b));
-                let same = |l: Avx8, f: &dyn Fn(f32, f32) -> f32| {
-                    let l = l.to_array();
-                    (0..8).all(|i| l[i].to_bits() == f(a[i], b[i]).to_bits())
-                };
-                assert!(same(x + y, &|p, q| p + q) && same(x - y, &|p, q| p - q) && same(x * y, &|p, q| p * q));
-                assert!(same(x / y, &|p, q| p / q) && same(x + 0.25, &|p, _| p + 0.25) && same(x / 3.0, &|p, _| p / 3.0));
-                assert!(same(x.min(y), &Real::min) && same(x.max(y), &Real::max) && same(-x, &|p, _| -p));
-                assert!(same(x.sqrt(), &|p, _| p.sqrt()) && same(x.abs(), &|p, _| p.abs()));
-                assert!(same(x.clamp(0.0, 1.0), &|p, _| p.clamp(0.0, 1.0)) && same(x.mul_add(y, x), &|p, q| p.mul_add(q, p)));
-                let mask = |m: Mask8, f: &dyn Fn(f32, f32) -> bool| {
-                    let m = m.to_array();
-                    (0..8).all(|i| m[i] == f(a[i], b[i]))
-                };
-                assert!(mask(x.lt(y), &|p, q| p < q) && mask(x.le(y), &|p, q| p <= q) && mask(x.gt(y), &|p, q| p > q));
-                assert!(mask(x.ge(y), &|p, q| p >= q) && mask(x.eq(y), &|p, q| p == q) && mask(x.ne(y), &|p, q| p != q));
-                assert!(mask(x.is_finite(), &|p, _| p.is_finite()) && mask(x.is_nan(), &|p, _| p.is_nan()));
-                assert!(mask(!x.lt(y) & x.is_finite() | x.is_nan(), &|p, q| !(p < q) && p.is_finite() || p.is_nan()));
-                assert!(same(Avx8::select(x.lt(y), x, y), &|p, q| if p < q { p } else { q }));
-                assert!(Avx8::any(x.is_nan() | y.is_nan()) && !Avx8::any(x.is_nan() & x.is_finite()));
-                assert!(same(x.map(|v| v * 2.0 + 1.0), &|p, _| p * 2.0 + 1.0));
-            }
-        });
-    }
-
-    /// `round` is `f32::round` (halves away from zero) at and between the halves, for large numbers,
-    /// signed zeros, infinities and NaN.
-    #[test]
-    fn round_is_f32_round() {
-        with_avx2(|| {
-            let mut xs: Vec<f32> = (-4000..=4000).map(|i| i as f32 / 8.0).collect();
-            xs.extend([0.499_999_97, -0.499_999_97, 8_388_607.5, -8_388_607.5, 16_777_217.0, 1e30, -0.0, 0.0]);
-            xs.extend([f32::INFINITY, f32::NEG_INFINITY, f32::NAN, 1e-40, -1e-40, 0.5, -0.5, 2.5, -2.5]);
-            while xs.len() % 8 != 0 {
-                xs.push(1.5);
-            }
-            for c in xs.chunks_exact(8) {
-                let r = Avx8::load(c).round().to_array();
-                for (l, &x) in c.iter().enumerate() {
-                    assert_eq!(r[l].to_bits(), x.round().to_bits(), "round({x})");
-                }
-            }
-        });
-    }
-
-    #[test]
-    fn rows_move_exactly() {
-        with_avx2(|| {
-            let v: Vec<Vec3> = (0..8).map(|i| Vec3::new(i as f32, -(i as f32) - 0.5, 100.0 + i as f32)).collect();
-            let l = Avx8::load3(&v);
-            let (x, y, z) = (l.x.to_array(), l.y.to_array(), l.z.to_array());
-            for i in 0..8 {
-                assert_eq!(Vec3::new(x[i], y[i], z[i]), v[i]);
-            }
-            let mut back = [[0.0; 3]; 8];
-            Avx8::store3(l.x, l.y, l.z, &mut back);
-            assert_eq!(back.to_vec(), v.iter().map(|w| w.to_array()).collect::<Vec<_>>());
-            let w: Vec<Vec2> = (0..8).map(|i| Vec2::new(i as f32 + 0.25, -(i as f32))).collect();
-            let (x, y) = Avx8::load2(&w);
-            let (x, y) = (x.to_array(), y.to_array());
-            for i in 0..8 {
-                assert_eq!(Vec2::new(x[i], y[i]), w[i]);
-            }
-            let mut flags = [7; 8];
-            Avx8::from_array([0.0, 1.0, 5.0, 9.0, 16.0, 31.0, 3.0, 0.0]).store_u32(&mut flags);
-            assert_eq!(flags, [0, 1, 5, 9, 16, 31, 3, 0]);
-            let mut b = [true; 8];
-            Avx8::store_mask(Avx8::from_array([1.0, -1.0, 2.0, f32::NAN, 0.5, 3.0, -0.0, 7.0]).gt(Avx8::splat(0.7)), &mut b);
-            assert_eq!(b.map(u8::from), [1, 0, 1, 0, 0, 1, 0, 1]);
-        });
-    }
-
-    /// The gathers give each lane the `f32` lookup, bit for bit, over the whole range and beyond it, at the
-    /// table's nodes, and for NaN and infinities.
-    #[test]
-    fn lerp_table_matches_single_lookups() {
-        with_avx2(|| {
-            let table: [f32; 64] = std::array::from_fn(|k| ((k as f32) * 0.37).sin() + 1.5);
-            let mut xs: Vec<f32> = (0..=6400).map(|i| i as f32 / 6400.0).collect();
-            xs.extend((0..64).map(|k| k as f32 / 63.0));
-            xs.extend([-1.0, -0.0, 1.0, 1.0 + f32::EPSILON, 2.0, f32::NAN, f32::INFINITY, f32::NEG_INFINITY, 1e-30, 0.999_999_9]);
-            while xs.len() % 8 != 0 {
-                xs.push(0.5);
-            }
-            for c in xs.chunks_exact(8) {
-                let got = Avx8::load(c).lerp_table(&table).to_array();
-                for (l, &x) in c.iter().enumerate() {
-                    assert_eq!(got[l].to_bits(), x.lerp_table(&table).to_bits(), "T({x})");
-                }
-            }
-        });
     }
 }
