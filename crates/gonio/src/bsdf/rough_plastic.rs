@@ -225,6 +225,7 @@ impl CoatingTables {
         let mu = |k: usize| (k as f32 / (TABLE_SIZE - 1) as f32).max(1e-6);
         CoatingTables {
             transmittance: std::array::from_fn(|k| 1.0 - crate::fresnel::fresnel_dielectric(mu(k), eta)),
+            graded: None,
             internal_reflectance: crate::fresnel::fresnel_diffuse_reflectance(1.0 / eta) as f32,
         }
     }
