@@ -752,11 +752,13 @@ mod tests {
         let uc: Vec<f32> = (0..n).map(|_| rng.next_f32()).collect();
         let u: Vec<Vec2> = (0..n).map(|_| Vec2::new(rng.next_f32(), rng.next_f32())).collect();
         let bits = |c: Rgb| c.0.map(f32::to_bits);
-        // Every example but the models whose construction integrates tables (seconds each), and two rough
-        // plastics (GGX, which has its own batch loops, and Beckmann, which does not).
+        // Every example but the models whose construction integrates tables (seconds each), and three rough
+        // plastics (GGX, which has its own batch loops, once with a coating less dense than the outside, whose
+        // tables have graded nodes, and Beckmann, which has no batch loops).
         let cheap = Bsdf::examples().into_iter().filter(|s| !["roughplastic", "layered", "measured", "merl"].iter().any(|p| s.contains(p)));
         let plastics = [
             r#"{"type": "roughplastic", "distribution": "ggx", "alpha": 0.3, "diffuse_reflectance": [0.9, 0.4, 0.1], "nonlinear": true}"#,
+            r#"{"type": "roughplastic", "distribution": "ggx", "alpha": 0.2, "int_ior": 1.0, "ext_ior": 1.5}"#,
             r#"{"type": "roughplastic", "alpha": 0.3}"#,
         ];
         for spec in cheap.chain(plastics) {
