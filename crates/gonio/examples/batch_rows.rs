@@ -23,7 +23,7 @@
 //! |-----------------------|----------------|---------------|-----------------|
 //! | diffuse               | 7 → 8 → 4.8    | 6 → 5 → 3.5   | 119 → 72 → 18.9 |
 //! | roughconductor (Au)   | 189 → 54 → 38.3 | 45 → 26 → 13.3 | 425 → 158 → 78.5 |
-//! | roughplastic          | 226 → 198 → 34.9 | 92 → 57 → 23.1 | 562 → 245 → 92.9 |
+//! | roughplastic          | 226 → 198 → 37.5 | 92 → 57 → 24.4 | 562 → 245 → 97.3 |
 //!
 //! roughplastic's `f` spent most of its 198 instructions in the per-lane lookup of the transmittance table.
 //! What remains is arithmetic; the glossy models' is bound by divisions and square roots (roughconductor's

@@ -528,6 +528,8 @@ pub struct GgxPlastic<'a> {
     /// The steering weight of the glossy lobe ([`specular_sampling_weight`]).
     weight: f32,
     tables: &'a CoatingTables,
+    /// The even table of T when the lookups use it (no graded nodes), chosen once per kernel.
+    even: Option<&'a [f32; TABLE_SIZE]>,
 }
 
 impl RoughPlastic {
@@ -544,6 +546,7 @@ impl RoughPlastic {
             nonlinear: self.nonlinear,
             weight: specular_sampling_weight(self.diffuse_reflectance, c.specular_reflectance),
             tables: &self.tables,
+            even: self.tables.graded.is_none().then_some(&self.tables.transmittance),
         })
     }
 }
@@ -553,10 +556,10 @@ impl GgxPlastic<'_> {
     /// the AVX lanes), graded nodes (η < 1) by a search per lane.
     #[inline(always)]
     fn transmittance<R: Real>(&self, mu: R) -> R {
-        if self.tables.graded.is_some() {
-            return mu.map(|m| self.tables.transmittance(m));
+        match self.even {
+            Some(table) => mu.lerp_table(table),
+            None => mu.map(|m| self.tables.transmittance(m)),
         }
-        mu.lerp_table(&self.tables.transmittance)
     }
 
     /// [`RoughPlastic::specular_probability`].
