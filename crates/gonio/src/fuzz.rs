@@ -18,7 +18,7 @@
 //! `xml_scene` and `bsdf_json` give `roughplastic` the smooth coating's tables in closed form instead of
 //! integrating them (seconds per α and η): see [`fast_coating_tables`].
 
-use crate::bsdf::rough_plastic::SmoothTablesScope;
+use crate::bsdf::rough_plastic::{TableScope, TableSource};
 use crate::bsdf::{Bsdf, BsdfModel, Measured};
 use crate::error::Result;
 use crate::geometry::mesh_io::{self, MeshData};
@@ -66,14 +66,14 @@ fn check_names<T>(result: Result<T>, name: &str) -> Option<T> {
 /// table on this machine, more than 5 s of wall time under load (2026-12), against the fuzzers' 10 s and
 /// the regression replay's 5 s per input. The first fuzz runs (2026-11) stopped on it and the targets then
 /// skipped every input mentioning `roughplastic`, so its parameter handling was never fuzzed. Caching
-/// does not help a fuzzer, which meets a new α or η at almost every input (and the α grid of
-/// [`crate::bsdf::rough_plastic::AlphaGridScope`] still integrates two nodes per new α), so the targets
-/// that build BSDFs hold a [`SmoothTablesScope`]: the tables are the smooth coating's, in closed form, and
+/// does not help a fuzzer, which meets a new α or η at almost every input (and the α grid,
+/// [`TableSource::AlphaGrid`], still integrates two nodes per new α), so the targets that build BSDFs
+/// hold a [`TableScope`] of [`TableSource::Smooth`]: the tables are the smooth coating's, in closed form, and
 /// everything else — parsing, range checks, the η = 1 and anisotropy refusals, energy compensation, f /
 /// sample / pdf at the model's own α and η — is the model's own code. The integration is tested at the
 /// ends of the parameter ranges instead (`rough_plastic::tests::tables_are_finite_at_the_parameter_extremes`).
-fn fast_coating_tables() -> SmoothTablesScope {
-    SmoothTablesScope::new()
+fn fast_coating_tables() -> TableScope {
+    TableScope::new(TableSource::Smooth)
 }
 
 /// A Mitsuba XML scene: defaults, `$` substitution, refs, includes, transforms, then the scene build

@@ -39,6 +39,8 @@ pub mod props;
 pub mod render;
 pub mod sampling;
 pub mod scene;
+#[cfg(test)]
+pub(crate) mod scratch;
 pub mod spectrum;
 pub mod texture;
 pub mod verify;

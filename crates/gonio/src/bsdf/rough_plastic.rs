@@ -34,7 +34,7 @@
 //! Mitsuba does — for η < 1 with more nodes around the critical angle, see `GradedTransmittance`; T and Rᵢ(μ) by a 128 × 128 Gauss–Legendre rule over the visible normals — total
 //! internal reflection makes the integrands discontinuous — and R̄ᵢ by 48-point Gauss–Legendre in μ on either side of the critical angle) and caches them per
 //! (distribution, α, η); a fit, which asks for hundreds of nearby α, uses a grid of α instead (64 nodes per
-//! decade, interpolated linearly in log α, error below 1e-4 in T and R̄ᵢ; see `AlphaGridScope`). Mitsuba averages Rᵢ μ over its 64 table points instead of integrating: its R̄ᵢ is
+//! decade, interpolated linearly in log α, error below 1e-4 in T and R̄ᵢ; see `TableScope`). Mitsuba averages Rᵢ μ over its 64 table points instead of integrating: its R̄ᵢ is
 //! lower by 1.5e-3 (GGX α = 1) to 8.7e-3 (α = 0.05) at η = 1.5, which scales the diffuse term by 1.0014 to
 //! 1.021 (measured in crates/gonio-py/tests/test_mitsuba.py, `test_roughplastic_diffuse`, 2026-11).
 //!
@@ -190,13 +190,13 @@ impl CoatingTables {
         mu.lerp_table(&self.transmittance)
     }
 
-    /// The tables for (kind, α, η): integrated at α itself and cached per process, or, while an
-    /// [`AlphaGridScope`] is alive, taken from the α grid ([`Self::on_alpha_grid`]).
+    /// The tables for (kind, α, η): integrated at α itself and cached per process, or, while a
+    /// [`TableScope`] is alive, taken from its [`TableSource`].
     fn cached(distribution: MicrofacetDistribution, eta: f32) -> Arc<CoatingTables> {
-        if SMOOTH_TABLES_SCOPES.load(Ordering::Relaxed) > 0 {
+        if TableScope::holds(TableSource::Smooth) {
             return Arc::new(Self::smooth(eta));
         }
-        if ALPHA_GRID_SCOPES.load(Ordering::Relaxed) > 0 {
+        if TableScope::holds(TableSource::AlphaGrid) {
             return Self::on_alpha_grid(distribution, eta);
         }
         Self::exact(distribution, eta)
@@ -220,7 +220,7 @@ impl CoatingTables {
 
     /// The tables of a smooth coating of relative index `eta`, the α → 0 limit of [`Self::compute`], in
     /// closed form: T(μ) = 1 − F(μ) at the same nodes, R̄ᵢ the smooth interface's hemispherical internal
-    /// reflectance (as `plastic` has). For [`SmoothTablesScope`] only.
+    /// reflectance (as `plastic` has). For [`TableSource::Smooth`] only.
     fn smooth(eta: f32) -> Self {
         let mu = |k: usize| (k as f32 / (TABLE_SIZE - 1) as f32).max(1e-6);
         CoatingTables {
@@ -288,34 +288,6 @@ impl CoatingTables {
 /// Nodes of the α grid of the coating tables per decade of α (see [`CoatingTables::on_alpha_grid`]).
 pub const ALPHA_NODES_PER_DECADE: f64 = 64.0;
 
-/// How many [`AlphaGridScope`]s are alive in the process.
-static ALPHA_GRID_SCOPES: AtomicUsize = AtomicUsize::new(0);
-
-/// While one is alive, every `roughplastic` built in the process takes its coating tables from the α grid
-/// ([`CoatingTables::on_alpha_grid`]) rather than integrating them at its own α: for a fit, which builds
-/// the model at hundreds of nearby α. Dropping the last scope restores exact tables for later builds.
-#[must_use = "the grid is used only while the scope is alive"]
-pub struct AlphaGridScope(());
-
-impl AlphaGridScope {
-    pub fn new() -> Self {
-        ALPHA_GRID_SCOPES.fetch_add(1, Ordering::Relaxed);
-        AlphaGridScope(())
-    }
-}
-
-impl Default for AlphaGridScope {
-    fn default() -> Self {
-        Self::new()
-    }
-}
-
-impl Drop for AlphaGridScope {
-    fn drop(&mut self) {
-        ALPHA_GRID_SCOPES.fetch_sub(1, Ordering::Relaxed);
-    }
-}
-
 /// Coating tables integrated in the process so far ([`CoatingTables::compute`] calls).
 static INTEGRATIONS: AtomicUsize = AtomicUsize::new(0);
 
@@ -326,38 +298,50 @@ pub fn table_integrations() -> usize {
     INTEGRATIONS.load(Ordering::Relaxed)
 }
 
-/// How many [`SmoothTablesScope`]s are alive in the process.
-static SMOOTH_TABLES_SCOPES: AtomicUsize = AtomicUsize::new(0);
+/// Where `roughplastic` takes its coating tables from while a [`TableScope`] of that kind is alive, instead
+/// of integrating them at the model's own (α, η) ([`CoatingTables::exact`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TableSource {
+    /// The α grid ([`CoatingTables::on_alpha_grid`]), error below 1e-4: for a fit, which builds the model at
+    /// hundreds of nearby α.
+    AlphaGrid = 0,
+    /// The smooth coating's tables of the same η ([`CoatingTables::smooth`]: closed forms, microseconds),
+    /// instead of the rough interface's (3.2 s of CPU per (distribution, α, η) on the 2-core machine,
+    /// 2026-12). Only for the fuzz targets (`gonio::fuzz`), which check that loading and evaluating never
+    /// panics, hangs or returns non-finite values, not the tables' accuracy, and meet a new α or η at
+    /// almost every input: with the integration they could not stay within their per-input time limits.
+    /// The model's own α, η, lobes, sampling and energy compensation are unchanged; the tables stay in
+    /// [0, 1] as the integrated ones do. The integration itself is tested at the ends of the parameter
+    /// ranges (`tables_are_finite_at_the_parameter_extremes`).
+    Smooth = 1,
+}
 
-/// While one is alive, every `roughplastic` built in the process takes the coating tables of a smooth
-/// coating of its η ([`CoatingTables::smooth`]: closed forms, microseconds) instead of integrating the
-/// rough interface's (3.2 s of CPU per (distribution, α, η) on the 2-core machine, 2026-12). Only for the
-/// fuzz targets (`gonio::fuzz`), which check that loading and evaluating never panics, hangs or returns
-/// non-finite values, not the tables' accuracy, and meet a new α or η at almost every input: with the
-/// integration they could not stay within their per-input time limits. The model's own α, η, lobes,
-/// sampling and energy compensation are unchanged; the tables stay in [0, 1] as the integrated ones do.
-/// The integration itself is tested at the ends of the parameter ranges
-/// (`tables_are_finite_at_the_parameter_extremes`).
-#[doc(hidden)]
-#[must_use = "the smooth tables are used only while the scope is alive"]
-pub struct SmoothTablesScope(());
+/// How many [`TableScope`]s of each [`TableSource`] are alive in the process.
+static TABLE_SCOPES: [AtomicUsize; 2] = [AtomicUsize::new(0), AtomicUsize::new(0)];
 
-impl SmoothTablesScope {
-    pub fn new() -> Self {
-        SMOOTH_TABLES_SCOPES.fetch_add(1, Ordering::Relaxed);
-        SmoothTablesScope(())
+/// While one is alive, every `roughplastic` built in the process (on any thread: fits and fuzz bodies
+/// build models on the thread pool) takes its coating tables from its [`TableSource`]; the smooth source
+/// wins over the grid when both are held. Dropping the last scope of a kind restores exact tables for
+/// later builds.
+#[must_use = "the table source is used only while the scope is alive"]
+pub struct TableScope(TableSource);
+
+impl TableScope {
+    #[must_use = "the table source is used only while the scope is alive"]
+    pub fn new(source: TableSource) -> Self {
+        TABLE_SCOPES[source as usize].fetch_add(1, Ordering::Relaxed);
+        TableScope(source)
+    }
+
+    /// Whether a scope of `source` is alive.
+    fn holds(source: TableSource) -> bool {
+        TABLE_SCOPES[source as usize].load(Ordering::Relaxed) > 0
     }
 }
 
-impl Default for SmoothTablesScope {
-    fn default() -> Self {
-        Self::new()
-    }
-}
-
-impl Drop for SmoothTablesScope {
+impl Drop for TableScope {
     fn drop(&mut self) {
-        SMOOTH_TABLES_SCOPES.fetch_sub(1, Ordering::Relaxed);
+        TABLE_SCOPES[self.0 as usize].fetch_sub(1, Ordering::Relaxed);
     }
 }
 
@@ -725,8 +709,6 @@ mod tests {
         assert!(CoatingTables::compute(MicrofacetDistribution::new(MicrofacetKind::Ggx, 0.01, 0.01), 1.49).graded.is_none());
     }
 
-    /// The tables at an α between two nodes of the grid, interpolated, against the tables integrated at
-    /// that α (the bound: 1e-4 absolute in T(μ) and R̄ᵢ, for both distributions over α ∈ [0.002, 2]; 2026-11: 32 nodes per decade gave 2.3e-4 for GGX, hence 64, which gives 6.9e-5 over all six α for either distribution).
     #[test]
     fn tables_are_finite_at_the_parameter_extremes() {
         // The corners of α ∈ [1e-4, 10] and η ∈ [1/20, 20] (the relative-index limit), both distributions:
@@ -740,7 +722,7 @@ mod tests {
         }
     }
 
-    /// The tables a [`SmoothTablesScope`] hands out are the smooth coating's, the α → 0 limit: close to
+    /// The tables a [`TableSource::Smooth`] scope hands out are the smooth coating's, the α → 0 limit: close to
     /// the integrated tables at α = 1e-4. (The scope itself is process-wide, so it is not taken here,
     /// where other tests build rough plastics in parallel: `tests/fuzz_regressions.rs` runs under it.)
     #[test]
@@ -758,6 +740,8 @@ mod tests {
         assert!((smooth.internal_reflectance - exact.internal_reflectance).abs() < 2e-3, "{smooth:?} vs {exact:?}");
     }
 
+    /// The tables at an α between two nodes of the grid, interpolated, against the tables integrated at
+    /// that α (the bound: 1e-4 absolute in T(μ) and R̄ᵢ, for both distributions over α ∈ [0.002, 2]; 2026-11: 32 nodes per decade gave 2.3e-4 for GGX, hence 64, which gives 6.9e-5 over all six α for either distribution).
     #[test]
     fn alpha_grid_interpolation_is_accurate() {
         // Three values of α per distribution, six in all across [0.002, 2] (each costs three integrations).

@@ -24,7 +24,7 @@
 
 pub mod lm;
 
-use crate::bsdf::rough_plastic::AlphaGridScope;
+use crate::bsdf::rough_plastic::{TableScope, TableSource};
 use crate::bsdf::{Bsdf, BsdfModel};
 use crate::error::{Error, Result};
 use crate::math::Vec3;
@@ -230,7 +230,7 @@ fn residuals_of(spec: &Value, pairs: &[Pair], out: &mut [f64]) -> bool {
 /// Fit `model` to `target` over `pairs` (see the module docs).
 pub fn fit(model: &'static FitModel, pairs: &[Pair]) -> Result<Fit> {
     // roughplastic's coating tables from the α grid: the search asks for hundreds of nearby α.
-    let _grid = AlphaGridScope::new();
+    let _grid = TableScope::new(TableSource::AlphaGrid);
     let m = 3 * pairs.len();
     let params = model.params;
     let residuals = |x: &[f64], out: &mut [f64]| {

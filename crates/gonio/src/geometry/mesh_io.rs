@@ -854,16 +854,11 @@ fn decode_serialized_mesh(path: &Path, compressed: &[u8], stream_at: usize, vers
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::path::PathBuf;
 
     const MESHES: &str = "/work/shared/data/mitsuba/common/meshes";
 
-    fn scratch(name: &str, contents: &[u8]) -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("gonio-mesh-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join(name);
-        std::fs::write(&path, contents).unwrap();
-        path
+    fn scratch(name: &str, contents: &[u8]) -> crate::scratch::ScratchFile {
+        crate::scratch::ScratchFile::new(name, contents)
     }
 
     fn assert_format_error(result: Result<MeshData>, needles: &[&str]) {

@@ -251,11 +251,8 @@ mod tests {
 
     const DATA: &str = "/work/shared/data";
 
-    fn scratch_dir(tag: &str) -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("gonio-image-{tag}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        dir
+    fn scratch_dir(tag: &str) -> crate::scratch::ScratchDir {
+        crate::scratch::ScratchDir::new(&format!("image-{tag}"))
     }
 
     fn test_pattern(width: usize, height: usize) -> Image {

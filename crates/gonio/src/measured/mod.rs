@@ -26,11 +26,33 @@ pub(crate) mod fixtures {
         "a": {"type": "diffuse", "reflectance": [0.2, 0.1, 0.05]},
         "b": {"type": "roughconductor", "distribution": "ggx", "alpha": 0.2, "material": "Cu"}}"#;
 
-    /// A scratch directory for this test process.
+    /// A scratch directory for this test process, shared by its tests (the tabulated fixture below is a
+    /// 35 MB file that several tests read, so it lives as long as the process). Statics are never
+    /// dropped, so the directory outlives the process; the first call removes those of test processes
+    /// that have ended (a `/proc/<pid>` check; elsewhere nothing is removed), so that `cargo test` does not
+    /// leave one 35 MB file behind per run (2026-12).
     pub fn scratch_dir() -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("gonio-merl-tests-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        dir
+        const PREFIX: &str = "gonio-merl-tests-";
+        static DIR: OnceLock<PathBuf> = OnceLock::new();
+        DIR.get_or_init(|| {
+            let tmp = std::env::temp_dir();
+            if std::path::Path::new("/proc/self").exists() {
+                for entry in std::fs::read_dir(&tmp).into_iter().flatten().flatten() {
+                    let name = entry.file_name().to_string_lossy().into_owned();
+                    let ended = name
+                        .strip_prefix(PREFIX)
+                        .and_then(|pid| pid.parse::<u32>().ok())
+                        .is_some_and(|pid| !std::path::Path::new(&format!("/proc/{pid}")).exists());
+                    if ended {
+                        let _ = std::fs::remove_dir_all(entry.path());
+                    }
+                }
+            }
+            let dir = tmp.join(format!("{PREFIX}{}", std::process::id()));
+            std::fs::create_dir_all(&dir).unwrap();
+            dir
+        })
+        .clone()
     }
 
     /// [`SMOOTH_SPEC`] tabulated at the cell centres, written with gonio's writer and read back: the

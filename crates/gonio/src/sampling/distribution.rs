@@ -574,11 +574,25 @@ mod tests {
     fn linear_chi2() {
         let t = [0.2_f32, 0.0, 3.0, 1.0, 0.0, 0.0, 2.5, 0.7];
         let d = PiecewiseLinear1D::new(&t);
-        let r = chi2_plane(|u| Vec2::new(d.sample(u.x), u.y), |p| f64::from(d.pdf(p.x)), Vec2::ZERO, Vec2::ONE, (8 * t.len(), 4), &Chi2Config::default());
+        let r = chi2_plane(
+            |u| Vec2::new(d.sample(u.x), u.y),
+            |p| f64::from(d.pdf(p.x)),
+            Vec2::ZERO,
+            Vec2::ONE,
+            (8 * t.len(), 4),
+            &Chi2Config::default(),
+        );
         assert!(r.passed, "{r}");
         // A wrong sampler (the piecewise-constant one over the same values) fails.
         let wrong = Distribution1D::new(&t);
-        let r = chi2_plane(|u| Vec2::new(wrong.sample(u.x).x, u.y), |p| f64::from(d.pdf(p.x)), Vec2::ZERO, Vec2::ONE, (8 * t.len(), 4), &Chi2Config::default());
+        let r = chi2_plane(
+            |u| Vec2::new(wrong.sample(u.x).x, u.y),
+            |p| f64::from(d.pdf(p.x)),
+            Vec2::ZERO,
+            Vec2::ONE,
+            (8 * t.len(), 4),
+            &Chi2Config::default(),
+        );
         assert!(!r.passed, "{r}");
     }
 

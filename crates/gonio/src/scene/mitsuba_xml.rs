@@ -172,11 +172,8 @@ mod tests {
     use super::*;
     use std::time::Instant;
 
-    fn scratch(tag: &str) -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("gonio-xml-{tag}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        dir
+    fn scratch(tag: &str) -> crate::scratch::ScratchDir {
+        crate::scratch::ScratchDir::new(&format!("xml-{tag}"))
     }
 
     /// The error of loading `text`, which must come in bounded time (a generous bound: the point is that

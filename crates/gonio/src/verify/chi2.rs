@@ -1384,8 +1384,7 @@ mod tests {
         let cfg = Chi2Config { samples: 20_000, theta_res: 4, phi_res: 6, ..Chi2Config::default() };
         let bsdf = Bsdf::from_json(r#"{"type":"blendbsdf","a":{"type":"diffuse"},"b":{"type":"conductor"}}"#).unwrap();
         let r = chi2_bsdf(&bsdf, Vec3::new(0.6, 0.0, 0.8), &cfg);
-        let dir = std::env::temp_dir().join(format!("gonio-chi2-test-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = crate::scratch::ScratchDir::new("chi2");
         let path = dir.join("chi2.txt");
         r.write_histograms(&path).unwrap();
         assert!(!dir.join("chi2.txt.tmp").exists());
@@ -1400,6 +1399,5 @@ mod tests {
         assert_eq!(observed, r.observed.iter().sum::<f64>());
         let expected: f64 = rows[cfg.theta_res..].iter().flatten().sum();
         assert!((expected - r.expected.iter().sum::<f64>()).abs() < 1.0);
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -379,8 +379,8 @@ mod tests {
 
     #[test]
     fn a_lying_pdf_fails_chi2_and_writes_histograms() {
-        let dir = std::env::temp_dir().join(format!("gonio-verify-test-{}", std::process::id()));
-        let cfg = CheckConfig { histogram_dir: Some(dir.clone()), ..CheckConfig::quick() };
+        let dir = crate::scratch::ScratchDir::new("verify");
+        let cfg = CheckConfig { histogram_dir: Some(dir.to_path_buf()), ..CheckConfig::quick() };
         let r = check_named(&Broken { gain: 0.5, skew: false, pdf_scale: 0.7 }, "lying pdf", &cfg);
         let failed = failed_rows(&r);
         // sample() reports the lying pdf consistently, so only the chi-square test can see the lie.
@@ -390,7 +390,6 @@ mod tests {
         let text = std::fs::read_to_string(&files[0]).unwrap();
         let numeric_rows = text.lines().filter(|l| !l.starts_with('#') && !l.trim().is_empty()).count();
         assert_eq!(numeric_rows, 2 * chi2::Chi2Config::default().theta_res, "observed and expected matrices");
-        std::fs::remove_dir_all(dir).unwrap();
     }
 
     #[test]
