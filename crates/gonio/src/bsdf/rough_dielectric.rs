@@ -171,7 +171,8 @@ impl RoughDielectric {
         if !(len > 0.0) || !len.is_finite() {
             return None;
         }
-        let wm = h / len;
+        // Times the reciprocal: one division, not three (2026-12; `GgxPlastic::half_vector` does the same).
+        let wm = h * (1.0 / len);
         Some(HalfVector { wm: if wm.z < 0.0 { -wm } else { wm }, reflection })
     }
 

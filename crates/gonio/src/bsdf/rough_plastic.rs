@@ -559,7 +559,7 @@ impl GgxPlastic<'_> {
         let zero = R::splat(0.0);
         let h = wo.add(wi);
         let len = h.length();
-        let wm = h.div(len);
+        let wm = h.scale(R::splat(1.0) / len);
         let wm = V3::select(wm.z.lt(zero), wm.neg(), wm);
         let defined = !(wo.z.le(zero) | wi.z.eq(zero)) & wi.z.gt(zero) & len.gt(zero) & len.is_finite();
         (wm, defined)

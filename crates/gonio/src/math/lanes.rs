@@ -629,11 +629,17 @@ pub(crate) fn check_lane_type<R: Rows>() {
     let mut ts: Vec<f32> = (0..=6400).map(|i| i as f32 / 6400.0).collect();
     ts.extend((0..64).map(|k| k as f32 / 63.0));
     ts.extend([-1.0, -0.0, 1.0, 1.0 + f32::EPSILON, 2.0, f32::NAN, f32::INFINITY, f32::NEG_INFINITY, 1e-30, 0.999_999_9]);
+    // And a table of another size (the AVX-512 lanes look a table of 64 up by permutes, others by gathers).
+    let short: [f32; 33] = std::array::from_fn(|k| ((k as f32) * 0.61).cos() + 2.5);
+    let mut ts_short = ts.clone();
     let round = (&|v: R| v.round()) as &dyn Fn(R) -> R;
     let lookup = (&|v: R| v.lerp_table(&table)) as &dyn Fn(R) -> R;
-    for (xs, lanes, one) in
-        [(&mut xs, round, (&|v: f32| v.round()) as &dyn Fn(f32) -> f32), (&mut ts, lookup, &|v: f32| v.lerp_table(&table))]
-    {
+    let lookup_short = (&|v: R| v.lerp_table(&short)) as &dyn Fn(R) -> R;
+    for (xs, lanes, one) in [
+        (&mut xs, round, (&|v: f32| v.round()) as &dyn Fn(f32) -> f32),
+        (&mut ts, lookup, &|v: f32| v.lerp_table(&table)),
+        (&mut ts_short, lookup_short, &|v: f32| v.lerp_table(&short)),
+    ] {
         while xs.len() % n != 0 {
             xs.push(0.5);
         }
