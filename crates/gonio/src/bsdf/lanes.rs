@@ -305,21 +305,7 @@ fn sample_rows_in<R: Rows, K: LaneModel, const CHECK: bool>(
     out: &mut SampleColumns<'_>,
     check: RowCheck,
 ) -> bool {
-    let n = [
-        wo.len(),
-        uc.len(),
-        u.len(),
-        out.wi.len(),
-        out.f.len(),
-        out.pdf.len(),
-        out.weight.len(),
-        out.flags.len(),
-        out.eta.len(),
-        out.valid.len(),
-    ]
-    .into_iter()
-    .min()
-    .unwrap_or(0);
+    let n = out.rows(wo, uc, u);
     let full = n - n % R::LANES;
     // Zipped chunks of a register each: no bounds checks in the loop.
     let inputs = wo[..full].chunks_exact(R::LANES).zip(uc[..full].chunks_exact(R::LANES)).zip(u[..full].chunks_exact(R::LANES));
@@ -354,10 +340,7 @@ fn sample_rows_in<R: Rows, K: LaneModel, const CHECK: bool>(
         if CHECK {
             ok &= check.direction(V3::from(wo[j])) & RowCheck::unit(uc[j]) & RowCheck::unit(u[j].x) & RowCheck::unit(u[j].y);
         }
-        let s = sample_one(k, wo[j], uc[j], u[j]);
-        out.valid[j] = s.is_some();
-        let s = s.unwrap_or(BsdfSample { wi: Vec3::ZERO, f: Rgb::ZERO, pdf: 0.0, weight: Rgb::ZERO, flags: BsdfFlags::NONE, eta: 0.0 });
-        (out.wi[j], out.f[j], out.pdf[j], out.weight[j], out.flags[j], out.eta[j]) = (s.wi, s.f, s.pdf, s.weight, s.flags.0, s.eta);
+        out.set(j, sample_one(k, wo[j], uc[j], u[j]));
     }
     ok
 }

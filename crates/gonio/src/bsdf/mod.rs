@@ -440,30 +440,42 @@ pub struct SampleColumns<'a> {
     pub valid: &'a mut [bool],
 }
 
+impl SampleColumns<'_> {
+    /// The number of rows a batch of `sample` over `wo`, `uc`, `u` into these columns computes: the
+    /// shortest length of all ten slices.
+    #[must_use]
+    pub fn rows(&self, wo: &[Vec3], uc: &[f32], u: &[Vec2]) -> usize {
+        [
+            wo.len(),
+            uc.len(),
+            u.len(),
+            self.wi.len(),
+            self.f.len(),
+            self.pdf.len(),
+            self.weight.len(),
+            self.flags.len(),
+            self.eta.len(),
+            self.valid.len(),
+        ]
+        .into_iter()
+        .min()
+        .unwrap_or(0)
+    }
+
+    /// Row `k` = `s`, or zeros and `valid = false` for `None`.
+    #[inline(always)]
+    pub fn set(&mut self, k: usize, s: Option<BsdfSample>) {
+        self.valid[k] = s.is_some();
+        let s = s.unwrap_or(BsdfSample { wi: Vec3::ZERO, f: Rgb::ZERO, pdf: 0.0, weight: Rgb::ZERO, flags: BsdfFlags::NONE, eta: 0.0 });
+        (self.wi[k], self.f[k], self.pdf[k], self.weight[k], self.flags[k], self.eta[k]) = (s.wi, s.f, s.pdf, s.weight, s.flags.0, s.eta);
+    }
+}
+
 /// The loop of [`BsdfModel::sample_batch`] (see [`f_each`]), for `k` below the shortest length.
 #[inline(always)]
 pub fn sample_each<M: BsdfModel + ?Sized>(m: &M, wo: &[Vec3], uc: &[f32], u: &[Vec2], out: &mut SampleColumns<'_>) {
-    let n = [
-        wo.len(),
-        uc.len(),
-        u.len(),
-        out.wi.len(),
-        out.f.len(),
-        out.pdf.len(),
-        out.weight.len(),
-        out.flags.len(),
-        out.eta.len(),
-        out.valid.len(),
-    ]
-    .into_iter()
-    .min()
-    .unwrap_or(0);
-    let none = BsdfSample { wi: Vec3::ZERO, f: Rgb::ZERO, pdf: 0.0, weight: Rgb::ZERO, flags: BsdfFlags::NONE, eta: 0.0 };
-    for k in 0..n {
-        let s = m.sample(wo[k], uc[k], u[k]);
-        out.valid[k] = s.is_some();
-        let s = s.unwrap_or(none);
-        (out.wi[k], out.f[k], out.pdf[k], out.weight[k], out.flags[k], out.eta[k]) = (s.wi, s.f, s.pdf, s.weight, s.flags.0, s.eta);
+    for k in 0..out.rows(wo, uc, u) {
+        out.set(k, m.sample(wo[k], uc[k], u[k]));
     }
 }
 
