@@ -171,8 +171,7 @@ impl RoughDielectric {
         if !(len > 0.0) || !len.is_finite() {
             return None;
         }
-        // Times the reciprocal: one division, not three (2026-12; `GgxPlastic::half_vector` does the same).
-        let wm = h * (1.0 / len);
+        let wm = h / len;
         Some(HalfVector { wm: if wm.z < 0.0 { -wm } else { wm }, reflection })
     }
 

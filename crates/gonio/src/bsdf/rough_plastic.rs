@@ -553,7 +553,10 @@ impl GgxPlastic<'_> {
     }
 
     /// The microfacet normal of a reflected pair with `wo` above ([`RoughDielectric`]'s half vector,
-    /// turned to +z), and the lanes where it is defined.
+    /// turned to +z), and the lanes where it is defined. Times the reciprocal length, where
+    /// `RoughDielectric` divides (one division instead of three, 2026-12): within a rounding of it, and
+    /// a plastic has no transmission lobe, whose 1 − F near the critical angle would magnify that rounding
+    /// (`RoughDielectric` keeps the division, which the Mitsuba comparison's floor was measured with).
     #[inline(always)]
     fn half_vector<R: Real>(wo: V3<R>, wi: V3<R>) -> (V3<R>, R::Mask) {
         let zero = R::splat(0.0);
