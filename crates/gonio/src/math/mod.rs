@@ -9,6 +9,7 @@ pub mod lanes;
 pub mod spherical;
 pub mod transform;
 pub mod trig;
+pub(crate) mod twice;
 
 pub use frame::Frame;
 pub use glam::{DVec3, Vec2, Vec3};
