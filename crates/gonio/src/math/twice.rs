@@ -8,6 +8,8 @@
 //! registers whose operations alternate, two chains are always in flight. Each lane is still computed by
 //! the same IEEE operations as an `f32`, so results are unchanged bit for bit.
 
+#![cfg_attr(not(all(target_arch = "x86_64", gonio_avx512)), allow(dead_code))] // used by the AVX-512 drivers (and its tests)
+
 use super::lanes::{Real, Rows, V3};
 use super::{Vec2, Vec3};
 use std::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
