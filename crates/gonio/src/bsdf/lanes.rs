@@ -6,7 +6,7 @@
 //! [`LaneModel`]; its `BsdfModel` methods call [`f_one`], [`pdf_one`], [`sample_one`] for that
 //! configuration, and its batch methods the drivers [`f_rows`], [`pdf_rows`], [`sample_rows`] and their
 //! `_checked` forms (through the `lane_batch_methods!` macro). A driver loads the rows into
-//! structure-of-arrays lanes ([`V3`] of the widest lane type the CPU runs: `Twice<Avx16>` with AVX-512, `Avx8`
+//! structure-of-arrays lanes ([`V3`] of the widest lane type the CPU runs: `Twice<Twice<Avx16>>` with AVX-512, `Avx8`
 //! with AVX2, else [`F32x8`]), runs the kernel and stores the lanes back; the last rows (fewer than a
 //! register) run on single `f32`s. The `_checked` forms also test the rows against a [`RowCheck`] on the
 //! lanes already loaded, so that checking a batch's inputs costs no pass of its own. Measured with callgrind
@@ -165,9 +165,9 @@ unsafe impl Triple for Rgb {}
 const _: () = assert!(std::mem::size_of::<Vec3>() == 12 && std::mem::align_of::<Vec3>() == 4);
 const _: () = assert!(std::mem::size_of::<Rgb>() == 12 && std::mem::align_of::<Rgb>() == 4);
 
-/// Defines `$name`, which runs `$generic` on the widest lanes the CPU has: 32 (two `Avx16` registers
-/// whose operations alternate, `Twice`: see `math::twice` for why, AVX-512F), 8 (`Avx8`, AVX2 + FMA), each
-/// inside a
+/// Defines `$name`, which runs `$generic` on the widest lanes the CPU has: 64 (four `Avx16` registers
+/// whose operations alternate, `Twice<Twice<Avx16>>`: see `math::twice` for why, AVX-512F), 8 (`Avx8`,
+/// AVX2 + FMA), each inside a
 /// function compiled for those features (so that every lane operation is inlined as its instruction,
 /// whoever calls the driver), else [`F32x8`]. `CHECK` selects whether the rows are tested against the
 /// [`RowCheck`] (the result: whether all passed; true when not checked).
@@ -179,7 +179,7 @@ macro_rules! driver {
             {
                 #[target_feature(enable = "avx512f,avx2,fma")]
                 unsafe fn with_avx512<K: LaneModel, const CHECK: bool>(k: &K, $($arg: $ty),*) -> bool {
-                    $generic::<crate::math::twice::Twice<crate::math::avx512::Avx16>, K, CHECK>(k, $($arg),*)
+                    $generic::<crate::math::twice::Twice<crate::math::twice::Twice<crate::math::avx512::Avx16>>, K, CHECK>(k, $($arg),*)
                 }
                 if crate::math::avx512::detected() {
                     // SAFETY: the CPU has the features `with_avx512` is compiled for (checked just above);
