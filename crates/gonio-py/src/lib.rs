@@ -10,8 +10,8 @@
 //! raised as `RuntimeError` rather than unwinding into the interpreter.
 
 use batch::{broadcast, finish, for_chunks, output, Arg, Out};
-use gonio::bsdf::{Bsdf, BsdfFlags, BsdfModel, SampleColumns, PLUGINS};
-use gonio::math::Vec3;
+use gonio::bsdf::{Bsdf, BsdfFlags, BsdfModel, RowCheck, SampleColumns, PLUGINS};
+use gonio::math::{Vec2, Vec3};
 use gonio::Rgb;
 use numpy::{PyArray1, PyArrayDyn, PyUntypedArrayMethods};
 use pyo3::create_exception;
@@ -36,7 +36,7 @@ create_exception!(
 
 /// Largest accepted deviation of |w| from 1 before a direction is rejected (f32 inputs round-tripped
 /// through text or float32 arrays are typically within 1e-7; 1e-3 catches forgotten normalisation).
-const UNIT_TOLERANCE: f64 = 1e-3;
+pub(crate) const UNIT_TOLERANCE: f64 = 1e-3;
 
 fn spec_error(e: gonio::Error) -> PyErr {
     SpecError::new_err(e.to_string())
@@ -157,8 +157,10 @@ fn over_rows(
     }
 }
 
-/// `f` and `pdf`: `eval(wo, wi, out)` on each chunk of the broadcast pairs, writing `width` numbers per pair
-/// straight into the result array; shaped (N, width), or the single row for unbatched arguments.
+/// `f` and `pdf`: on each chunk of the broadcast pairs, `eval_checked(wo, wi, out, band)` for float32
+/// arrays read in place (checking them in its pass, see [`batch::UNIT_BAND`]) or, for other arguments,
+/// `eval(wo, wi, out)` on the converted and checked rows; `width` numbers per pair go straight into the
+/// result array, shaped (N, width), or the single row for unbatched arguments.
 fn over_pairs<'py>(
     py: Python<'py>,
     wo: &Bound<'py, PyAny>,
@@ -166,22 +168,35 @@ fn over_pairs<'py>(
     normalize: bool,
     width: usize,
     eval: impl Fn(&[Vec3], &[Vec3], &mut [f32]) + Sync + Send,
+    eval_checked: impl Fn(&[Vec3], &[Vec3], &mut [f32], RowCheck) -> bool + Sync + Send,
 ) -> PyResult<Bound<'py, PyAny>> {
     let (ao, ai) = (Arg::read(wo, "wo", 3)?, Arg::read(wi, "wi", 3)?);
     let (n, batched) = broadcast(&[&ao, &ai])?;
-    let (out, ptr) = output::<f32>(py, width * n);
+    let (out, ptr) = output::<f32>(py, width * n)?;
     let (co, ci) = (ao.column(), ai.column());
     over_rows(py, n, &[&ao, &ai], &[], normalize, |rows| {
+        // SAFETY: rows `rows` of the output are this task's own and within the array.
+        let out = unsafe { ptr.slice(width * rows.start, width * rows.len()) };
         let (mut bo, mut bi) = (Vec::new(), Vec::new());
+        if let (false, Some(wo), Some(wi)) = (normalize, co.vec3_in_place(rows.clone()), ci.vec3_in_place(rows.clone())) {
+            // Checked in the batch's pass; exactly, row by row, only where that leaves doubt.
+            return eval_checked(wo, wi, out, batch::UNIT_BAND)
+                || (co.directions(rows.clone(), false, &mut bo).is_some() && ci.directions(rows, false, &mut bi).is_some());
+        }
         let (Some(wo), Some(wi)) = (co.directions(rows.clone(), normalize, &mut bo), ci.directions(rows.clone(), normalize, &mut bi))
         else {
             return false;
         };
-        // SAFETY: rows `rows` of the output are this task's own and within the array.
-        eval(wo, wi, unsafe { ptr.slice(width * rows.start, width * rows.len()) });
+        eval(wo, wi, out);
         true
     })?;
     finish(out, width, batched)
+}
+
+/// `out` (3 floats per row) as `Rgb`s.
+fn rgb_rows(out: &mut [f32]) -> &mut [Rgb] {
+    // SAFETY: `Rgb` is `#[repr(transparent)]` over `[f32; 3]` (alignment 4) and `out` holds 3 floats per row.
+    unsafe { std::slice::from_raw_parts_mut(out.as_mut_ptr().cast::<Rgb>(), out.len() / 3) }
 }
 
 /// A reflection model. Build one with `gonio.load_bsdf`; evaluate it with `f`, `pdf`, `sample`, `albedo`.
@@ -203,11 +218,15 @@ impl PyBsdf {
     #[pyo3(signature = (wo, wi, *, normalize = false))]
     fn f<'py>(&self, py: Python<'py>, wo: &Bound<'py, PyAny>, wi: &Bound<'py, PyAny>, normalize: bool) -> PyResult<Bound<'py, PyAny>> {
         let bsdf = &self.bsdf;
-        over_pairs(py, wo, wi, normalize, 3, |wo, wi, out: &mut [f32]| {
-            // SAFETY: `Rgb` is `#[repr(transparent)]` over `[f32; 3]` and `out` holds 3 floats per pair.
-            let out = unsafe { std::slice::from_raw_parts_mut(out.as_mut_ptr().cast::<Rgb>(), wo.len()) };
-            bsdf.f_batch(wo, wi, out);
-        })
+        over_pairs(
+            py,
+            wo,
+            wi,
+            normalize,
+            3,
+            |wo, wi, out| bsdf.f_batch(wo, wi, rgb_rows(out)),
+            |wo, wi, out, band| bsdf.f_batch_checked(wo, wi, rgb_rows(out), band),
+        )
     }
 
     /// The solid-angle density with which `sample` produces `wi` from `wo` (smooth lobes only), float32 of
@@ -215,7 +234,15 @@ impl PyBsdf {
     #[pyo3(signature = (wo, wi, *, normalize = false))]
     fn pdf<'py>(&self, py: Python<'py>, wo: &Bound<'py, PyAny>, wi: &Bound<'py, PyAny>, normalize: bool) -> PyResult<Bound<'py, PyAny>> {
         let bsdf = &self.bsdf;
-        over_pairs(py, wo, wi, normalize, 1, |wo, wi, out: &mut [f32]| bsdf.pdf_batch(wo, wi, out))
+        over_pairs(
+            py,
+            wo,
+            wi,
+            normalize,
+            1,
+            |wo, wi, out| bsdf.pdf_batch(wo, wi, out),
+            |wo, wi, out, band| bsdf.pdf_batch_checked(wo, wi, out, band),
+        )
     }
 
     /// Sample `wi` given `wo` (shape (3,) or (N, 3)), `uc` (lobe choice; a number or shape (N,)) and `u`
@@ -232,23 +259,15 @@ impl PyBsdf {
     ) -> PyResult<PySample> {
         let (ao, auc, au) = (Arg::read(wo, "wo", 3)?, Arg::read(uc, "uc", 1)?, Arg::read(u, "u", 2)?);
         let (n, batched) = broadcast(&[&ao, &auc, &au])?;
-        let (wi_out, wi_ptr) = output::<f32>(py, 3 * n);
-        let (f_out, f_ptr) = output::<f32>(py, 3 * n);
-        let (pdf_out, pdf_ptr) = output::<f32>(py, n);
-        let (weight_out, weight_ptr) = output::<f32>(py, 3 * n);
-        let (flags_out, flags_ptr) = output::<u32>(py, n);
-        let (eta_out, eta_ptr) = output::<f32>(py, n);
-        let (valid_out, valid_ptr) = output::<bool>(py, n);
+        let (wi_out, wi_ptr) = output::<f32>(py, 3 * n)?;
+        let (f_out, f_ptr) = output::<f32>(py, 3 * n)?;
+        let (pdf_out, pdf_ptr) = output::<f32>(py, n)?;
+        let (weight_out, weight_ptr) = output::<f32>(py, 3 * n)?;
+        let (flags_out, flags_ptr) = output::<u32>(py, n)?;
+        let (eta_out, eta_ptr) = output::<f32>(py, n)?;
+        let (valid_out, valid_ptr) = output::<bool>(py, n)?;
         let (co, cuc, cu, bsdf) = (ao.column(), auc.column(), au.column(), &self.bsdf);
         over_rows(py, n, &[&ao], &[&auc, &au], normalize, |rows| {
-            let (mut wo_buf, mut uc_buf, mut u_buf) = (Vec::new(), Vec::new(), Vec::new());
-            let (Some(wo), Some(uc), Some(u)) = (
-                co.directions(rows.clone(), normalize, &mut wo_buf),
-                cuc.unit_numbers(rows.clone(), &mut uc_buf),
-                cu.unit_pairs(rows.clone(), &mut u_buf),
-            ) else {
-                return false;
-            };
             let (start, len) = (rows.start, rows.len());
             // SAFETY: rows `rows` of every output are this task's own and within the arrays; `Vec3` is
             // `#[repr(C)]` of three `f32` and `Rgb` `#[repr(transparent)]` over `[f32; 3]`, so 3·len floats
@@ -264,6 +283,25 @@ impl PyBsdf {
                     eta: eta_ptr.slice(start, len),
                     valid: valid_ptr.slice(start, len),
                 }
+            };
+            let (mut wo_buf, mut uc_buf, mut u_buf) = (Vec::new(), Vec::new(), Vec::new());
+            let exact = |wo_buf: &mut Vec<Vec3>, uc_buf: &mut Vec<f32>, u_buf: &mut Vec<Vec2>| {
+                co.directions(rows.clone(), normalize, wo_buf).is_some()
+                    && cuc.unit_numbers(rows.clone(), uc_buf).is_some()
+                    && cu.unit_pairs(rows.clone(), u_buf).is_some()
+            };
+            if let (false, Some(wo), Some(uc), Some(u)) =
+                (normalize, co.vec3_in_place(rows.clone()), cuc.f32_in_place(rows.clone()), cu.vec2_in_place(rows.clone()))
+            {
+                // Checked in the batch's pass; exactly, row by row, only where that leaves doubt.
+                return bsdf.sample_batch_checked(wo, uc, u, &mut columns, batch::UNIT_BAND) || exact(&mut wo_buf, &mut uc_buf, &mut u_buf);
+            }
+            let (Some(wo), Some(uc), Some(u)) = (
+                co.directions(rows.clone(), normalize, &mut wo_buf),
+                cuc.unit_numbers(rows.clone(), &mut uc_buf),
+                cu.unit_pairs(rows.clone(), &mut u_buf),
+            ) else {
+                return false;
             };
             bsdf.sample_batch(wo, uc, u, &mut columns);
             true
@@ -407,6 +445,18 @@ fn from_xml(py: Python<'_>, text: &str, source: &str) -> PyResult<PyBsdf> {
     Ok(PyBsdf { bsdf, spec: text.to_owned() })
 }
 
+/// Free the memory kept for reuse by large result arrays (see `batch::pool`); the number of bytes freed.
+#[pyfunction]
+fn _release_buffers() -> usize {
+    batch::pool::release()
+}
+
+/// The number of bytes kept for reuse by large result arrays and not in use.
+#[pyfunction]
+fn _cached_buffer_bytes() -> usize {
+    batch::pool::cached()
+}
+
 /// The plugin names gonio understands.
 #[pyfunction]
 fn plugins(py: Python<'_>) -> PyResult<Bound<'_, PyTuple>> {
@@ -429,6 +479,9 @@ fn _gonio(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(from_xml, m)?)?;
     m.add_function(wrap_pyfunction!(plugins, m)?)?;
     m.add_function(wrap_pyfunction!(examples, m)?)?;
+    m.add_function(wrap_pyfunction!(_release_buffers, m)?)?;
+    m.add_function(wrap_pyfunction!(_cached_buffer_bytes, m)?)?;
+    m.add_class::<batch::pool::Block>()?;
     verify::register(m)?;
     scene::register(m)?;
     image::register(m)?;

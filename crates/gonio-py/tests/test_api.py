@@ -320,3 +320,123 @@ def test_torrance_sparrow_without_shadowing_gains_energy_at_grazing_angles():
 def test_torrance_sparrow_bad_parameters(spec, where):
     with pytest.raises(gonio.SpecError, match=where):
         gonio.load_bsdf(spec)
+
+
+def float32_rows(n):
+    return unit(n).astype(np.float32)
+
+
+@pytest.mark.parametrize(
+    "row, ok",
+    [
+        # Inside the 1e-3 tolerance, at the edge of the f32 quick check and beyond it (the exact f64 check
+        # decides those), outside, and rows whose squares overflow, underflow or are NaN.
+        ([0, 0, 1.0009], True),
+        ([0, 0, 0.9991], True),
+        ([0, 0, 1.000999], True),
+        ([0, 0, 0.999001], True),
+        ([0, 0, 1.0011], False),
+        ([0, 0, 0.9989], False),
+        ([3e19, 0, 0], False),
+        ([1e-30, 1e-30, 1e-30], False),
+        ([0, np.nan, 1], False),
+        ([0, 0, np.inf], False),
+        ([0, 0, -1], True),
+    ],
+)
+def test_float32_rows_checked_in_every_chunk(row, ok):
+    """Float32 rows are checked by a vectorised f32 test with an exact fallback: same verdicts as the f64
+    check, for a row anywhere in a call of many parallel chunks."""
+    b = gonio.load_bsdf(DIFFUSE)
+    n = 50_003
+    wo, wi = float32_rows(n), float32_rows(n)
+    for at in (0, 4096, n - 1):
+        bad = wi.copy()
+        bad[at] = row
+        if ok:
+            b.f(wo, bad)
+            b.sample(bad, 0.5, [0.5, 0.5])
+        else:
+            with pytest.raises(ValueError, match=rf"wi\[{at}\]"):
+                b.f(wo, bad)
+            with pytest.raises(ValueError, match=rf"wo\[{at}\]"):
+                b.sample(bad, 0.5, [0.5, 0.5])
+        # The float64 path gives the same verdict.
+        if ok:
+            b.f(wo, bad.astype(np.float64))
+        else:
+            with pytest.raises(ValueError, match=rf"wi\[{at}\]"):
+                b.f(wo, bad.astype(np.float64))
+
+
+def test_float32_sample_numbers_checked_in_every_chunk():
+    b = gonio.load_bsdf(DIFFUSE)
+    n = 50_003
+    wo = float32_rows(n)
+    uc, u = RNG.random(n, dtype=np.float32), RNG.random((n, 2), dtype=np.float32)
+    for at in (0, 9000, n - 1):
+        for bad_value in (-1e-7, 1.0000001, np.nan):
+            bad_uc = uc.copy()
+            bad_uc[at] = bad_value
+            with pytest.raises(ValueError, match=rf"uc\[{at}\].*outside"):
+                b.sample(wo, bad_uc, u)
+            bad_u = u.copy()
+            bad_u[at, 1] = bad_value
+            with pytest.raises(ValueError, match=rf"u\[{at}\].*outside"):
+                b.sample(wo, uc, bad_u)
+    # 0 and 1 are inside.
+    uc[:2], u[:2] = (0.0, 1.0), ((0.0, 1.0), (1.0, 0.0))
+    b.sample(wo, uc, u)
+
+
+@pytest.mark.parametrize(
+    "spec",
+    [
+        DIFFUSE,
+        {"type": "roughconductor", "distribution": "ggx", "alpha": 0.3, "material": "Au"},
+        {"type": "roughplastic", "distribution": "ggx", "alpha": 0.3},
+    ],
+)
+def test_large_results_reuse_memory_and_stay_correct(spec):
+    """Large results live in memory kept for reuse (see `batch::pool`): a freed result's memory serves
+    the next call, which overwrites every element; the arrays behave as numpy's own."""
+    b = gonio.load_bsdf(spec)
+    n = 100_001
+    wo, wi = float32_rows(n), float32_rows(n)
+    uc, u = RNG.random(n, dtype=np.float32), RNG.random((n, 2), dtype=np.float32)
+    # The reference, row by row for a sample of rows (single calls do not use the pool).
+    rows = [0, 1, 7, 8, 4095, 4096, n // 2, n - 2, n - 1]
+    f = b.f(wo, wi)
+    expected_f = np.array([b.f(wo[k], wi[k]) for k in rows])
+    s = b.sample(wo, uc, u)
+    expected_s = {k: b.sample(wo[k], uc[k], u[k]) for k in rows}
+    addresses = {a.__array_interface__["data"][0] for a in (f, s.wi, s.f, s.weight)}
+    assert f.flags.c_contiguous and f.flags.writeable and f.flags.aligned and f.dtype == np.float32
+    del f, s
+    # Other inputs, so that stale numbers in reused memory would show.
+    wo2, wi2 = float32_rows(n), float32_rows(n)
+    wo2[::3, 2] *= -1
+    f2 = b.f(wo2, wi2)
+    assert f2.__array_interface__["data"][0] in addresses, "no freed result's memory was reused"
+    s2 = b.sample(wo2, uc[::-1].copy(), u)
+    for name in ("wi", "f", "pdf", "weight", "flags", "eta", "valid"):
+        assert getattr(s2, name).shape[0] == n
+    np.testing.assert_array_equal(f2[rows], np.array([b.f(wo2[k], wi2[k]) for k in rows]))
+    for k in rows:
+        one = b.sample(wo2[k], uc[::-1][k], u[k])
+        for name in ("wi", "f", "pdf", "weight", "flags", "eta", "valid"):
+            np.testing.assert_array_equal(getattr(s2, name)[k], getattr(one, name))
+    # Fresh calls on the first inputs still give the first results.
+    np.testing.assert_array_equal(b.f(wo, wi)[rows], expected_f)
+    s3 = b.sample(wo, uc, u)
+    for k in rows:
+        np.testing.assert_array_equal(s3.weight[k], expected_s[k].weight)
+        assert s3.valid[k] == expected_s[k].valid
+    # Results can be written to, kept beyond the call, and outlive their model.
+    f2[0] = 7.0
+    assert f2[0, 0] == 7.0
+    kept = s2.wi
+    del b, s2
+    assert kept.shape == (n, 3) and np.isfinite(kept).all()
+    gonio._gonio._release_buffers()
+    assert gonio._gonio._cached_buffer_bytes() == 0

@@ -3,24 +3,31 @@
 //!
 //! ```text
 //! cargo build --release -p gonio --example batch_rows
-//! valgrind --tool=callgrind --toggle-collect='*BsdfModel*_batch*' target/release/examples/batch_rows MODEL METHOD [N]
+//! valgrind --tool=callgrind --toggle-collect='*_batch::with_avx2' target/release/examples/batch_rows MODEL METHOD [N]
 //! ```
 //!
 //! MODEL is `diffuse`, `roughconductor` or `roughplastic` (the models of bench/python_bsdf_vs_mitsuba.py),
 //! METHOD `f`, `pdf` or `sample`; N rows (default 100 000) of random directions above the surface, one
 //! thread, one call of `Bsdf::f_batch` (or `pdf_batch`, `sample_batch`). Instructions per row = the
-//! collected total / N.
+//! collected total / N. (Only `Bsdf`'s own AVX2 function may be named in `--toggle-collect`: a pattern that
+//! also matches a function it calls, such as the drivers' `f_rows::with_avx2`, switches collection off
+//! there again.) Valgrind (3.19) does not run AVX-512: under it the drivers take their AVX2 path, which is
+//! what the table counts; on CPUs with AVX-512 the kernels run 16 rows per instruction instead of 8.
 //!
-//! Instructions per row (2026-11, AVX2 build, 10⁵ rows), first with the kernels' loops compiled for the
-//! baseline target (what `simd_batch!` did before it was fixed), then for AVX2 + FMA:
+//! Instructions per row (AVX2 build machine, 10⁵ rows): first with the kernels' loops compiled for the
+//! baseline target (before `simd_batch!` was fixed), then for AVX2 + FMA with `F32x8` (its lanes
+//! vectorised by LLVM's SLP pass), then (2026-11) on `Avx8`, whose every operation is its AVX instruction,
+//! with rows moved in and out by shuffles and roughplastic's table lookups by gathers (`math::avx2`):
 //!
-//! | model (GGX α = 0.3)   | f        | pdf     | sample    |
-//! |-----------------------|----------|---------|-----------|
-//! | diffuse               | 7 → 8    | 6 → 5   | 119 → 72  |
-//! | roughconductor (Au)   | 189 → 54 | 45 → 26 | 425 → 158 |
-//! | roughplastic          | 226 → 198| 92 → 57 | 562 → 245 |
+//! | model (GGX α = 0.3)   | f              | pdf           | sample          |
+//! |-----------------------|----------------|---------------|-----------------|
+//! | diffuse               | 7 → 8 → 4.8    | 6 → 5 → 3.5   | 119 → 72 → 18.9 |
+//! | roughconductor (Au)   | 189 → 54 → 38.3 | 45 → 26 → 13.3 | 425 → 158 → 78.5 |
+//! | roughplastic          | 226 → 198 → 37.5 | 92 → 57 → 24.4 | 562 → 245 → 97.3 |
 //!
-//! roughplastic's `f` spends most of its instructions in the per-lane lookup of the transmittance table.
+//! roughplastic's `f` spent most of its 198 instructions in the per-lane lookup of the transmittance table.
+//! What remains is arithmetic; the glossy models' is bound by divisions and square roots (roughconductor's
+//! `f`: 34 per register of rows, 3 + 3 per RGB channel in the conductor Fresnel term).
 
 use gonio::bsdf::{Bsdf, BsdfModel, SampleColumns};
 use gonio::math::{Vec2, Vec3};

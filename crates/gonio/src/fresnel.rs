@@ -139,20 +139,20 @@ pub fn fresnel_diffuse_reflectance(eta: f32) -> f64 {
 /// (a + ib)² = η² − k² − s² + 2iηk: a² − b² = t and ab = ηk with t = η² − k² − s², so with
 /// m = a² + b² = √(t² + 4η²k²): a² = (m + t)/2 and b² = (m − t)/2 (Born & Wolf, *Principles of Optics*,
 /// §14.2, eqs. 14.2(21)–(22), the u², v² of an absorbing medium). Whichever of the two would cancel
-/// (m ≈ |t|) is taken as 2η²k²/(m ∓ t) instead, the same value rearranged, so both keep full f32
-/// precision (silver, t ≈ −23, has a² ≈ 0.024: the direct form lost ~10 bits).
+/// (m ≈ |t|) is taken from ab = ηk instead: the smaller of a, b is |ηk| divided by the larger, the same
+/// value rearranged, so both keep full f32 precision (silver, t ≈ −23, has a² ≈ 0.024: the direct form
+/// lost ~10 bits). Two square roots and a division for the pair (2026-12: the kernels of the conductor
+/// models are bound by divisions and square roots; it took three and a division).
 #[inline(always)]
 fn conductor_cos_t<R: Real>(eta_k2: f32, eta_k: f32, sin2_i: R) -> (R, R) {
     let t = R::splat(eta_k2) - sin2_i;
-    let two_eta_k2 = 2.0 * eta_k * eta_k;
-    let m = (t * t + 2.0 * two_eta_k2).sqrt();
-    let big = m + t.abs();
-    // big/2 is the larger of a², b²; the smaller is (m² − t²)/(2 big) = 2η²k²/big (0 when big = 0).
-    let larger = big * 0.5;
-    let smaller = R::select(big.gt(R::splat(0.0)), R::splat(two_eta_k2) / big, R::splat(0.0));
-    let positive = t.ge(R::splat(0.0));
-    let (a2, b2) = (R::select(positive, larger, smaller), R::select(positive, smaller, larger));
-    (a2.sqrt(), b2.sqrt())
+    let m = (t * t + 4.0 * eta_k * eta_k).sqrt();
+    // (m + |t|)/2 is the larger of a², b²; the smaller root is |ηk| / the larger (0 when both are 0).
+    let larger = ((m + t.abs()) * 0.5).sqrt();
+    let zero = R::splat(0.0);
+    let smaller = R::select(larger.gt(zero), R::splat(eta_k.abs()) / larger, zero);
+    let positive = t.ge(zero);
+    (R::select(positive, larger, smaller), R::select(positive, smaller, larger))
 }
 
 /// Unpolarised Fresnel reflectance of a conductor with complex relative index η + i k, for light arriving
@@ -185,10 +185,15 @@ pub fn fresnel_conductor_lanes<R: Real>(cos_theta_i: R, eta: f32, k: f32) -> R {
     let sin2_i = (R::splat(1.0) - c) * (c + 1.0);
     let (e, f) = ((eta - k) * (eta + k), 2.0 * eta * k);
     let (a, b) = conductor_cos_t(e, eta * k, sin2_i);
-    let rs = sum_of_squares(c - a, b) / sum_of_squares(c + a, b);
+    let (ns, ds) = (sum_of_squares(c - a, b), sum_of_squares(c + a, b));
     let (ec, fc) = (c * e, c * f);
-    let rp = sum_of_squares(ec - a, fc - b) / sum_of_squares(ec + a, fc + b);
-    (rs + rp) * 0.5
+    // Rₚ's terms grow as |η̃|⁴ and Rₛ's as |η̃|²: Rₚ's are scaled by σ ≈ 1/|η̃|⁴ so that the product of the
+    // denominators stays far from overflow (finite for |η̃|² up to ~10¹⁸).
+    let sigma = 1.0 / (1.0 + e * e + f * f);
+    let (np, dp) = (sum_of_squares(ec - a, fc - b) * sigma, sum_of_squares(ec + a, fc + b) * sigma);
+    // Rₛ + Rₚ over one denominator (one division instead of two, 2026-12); the numerator is a sum of
+    // non-negative terms.
+    (ns * dp + np * ds) / (ds * dp) * 0.5
 }
 
 /// x² + y².

@@ -414,7 +414,8 @@ impl Ggx {
     #[inline(always)]
     #[must_use]
     pub fn d<R: Real>(&self, wm: V3<R>) -> R {
-        let (x, y) = (wm.x / self.alpha_x, wm.y / self.alpha_y);
+        // Times 1/α (computed once per batch, outside the loop): no divisions per row but the one below.
+        let (x, y) = (wm.x * (1.0 / self.alpha_x), wm.y * (1.0 / self.alpha_y));
         let t = x * x + y * y + wm.z * wm.z;
         let d = R::splat(1.0) / (t * (PI * self.alpha_x * self.alpha_y) * t);
         R::select(wm.z.le(R::splat(0.0)), R::splat(0.0), d)
@@ -438,8 +439,17 @@ impl Ggx {
     #[inline(always)]
     #[must_use]
     pub fn g1<R: Real>(&self, w: V3<R>, wm: V3<R>) -> R {
-        let g = R::splat(1.0) / (self.lambda_upper(w.x, w.y, w.z.abs()) + 1.0);
-        R::select((w.dot(wm) * w.z).le(R::splat(0.0)), R::splat(0.0), g)
+        // 1 / (1 + Λ) with Λ = t / (2 (1 + √(1 + t))), t = s²/z² (see `lambda_upper`), multiplied through by
+        // 2 (1 + √(1 + t)) z² = 2 z (z + q), q = √(z² + s²): G1 = 2z(z + q) / (2z(z + q) + s²). One division
+        // and one square root instead of three and one (2026-12: the GGX kernels are bound by them); no
+        // difference of nearly equal terms. 0 on the horizon (z = 0), 1 at the pole (s² = 0).
+        let z = w.z.abs();
+        let (ax, ay) = (w.x * self.alpha_x, w.y * self.alpha_y);
+        let s2 = ax * ax + ay * ay;
+        let zq2 = z * (z + (z * z + s2).sqrt()) * 2.0;
+        let zero = R::splat(0.0);
+        let g = R::select(s2.eq(zero), R::splat(1.0), zq2 / (zq2 + s2));
+        R::select((w.dot(wm) * w.z).le(zero), zero, g)
     }
 
     /// Separable Smith G = G1(ωo, ωm) G1(ωi, ωm) for reflection (Heitz 2014 eq. 98).
@@ -460,7 +470,9 @@ impl Ggx {
         let vh = V3::new(wo.x * self.alpha_x, wo.y * self.alpha_y, wo.z).normalize();
         // Orthonormal basis around vh (T1 is horizontal; degenerate at normal incidence).
         let len2 = vh.x * vh.x + vh.y * vh.y;
-        let t1 = V3::select(len2.gt(zero), V3::new(-vh.y, vh.x, zero).div(len2.sqrt()), V3::splat(crate::math::Vec3::X));
+        // (Its z, 0 / √len2, is 0 wherever len2 > 0 selects it: not divided.)
+        let len = len2.sqrt();
+        let t1 = V3::select(len2.gt(zero), V3::new(-vh.y / len, vh.x / len, zero), V3::splat(crate::math::Vec3::X));
         let t2 = vh.cross(t1);
         // A uniform point on the unit disk, squeezed onto the visible half: p2 blends towards the
         // half-disk's straight edge by s = (1 + cos θv)/2.
@@ -491,8 +503,12 @@ impl Ggx {
     #[inline(always)]
     #[must_use]
     pub fn pdf_reflected_visible<R: Real>(&self, wo: V3<R>, wm: V3<R>) -> R {
-        let pdf = self.pdf_visible(wo, wm) * (R::splat(1.0) / (wo.dot(wm).abs() * 4.0));
-        R::select(pdf.is_finite(), pdf, R::splat(0.0))
+        // G1 max(0, ωo·ωm) D / cos θo / (4 |ωo·ωm|) with ωo·ωm cancelled: G1 D / (4 cos θo) where ωo·ωm > 0
+        // (one division instead of two, 2026-12).
+        let zero = R::splat(0.0);
+        let pdf = self.g1(wo, wm) * self.d(wm) / (wo.z * 4.0);
+        let pdf = R::select(wo.z.le(zero) | wo.dot(wm).le(zero), zero, pdf);
+        R::select(pdf.is_finite(), pdf, zero)
     }
 }
 

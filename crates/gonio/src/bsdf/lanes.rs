@@ -1,18 +1,19 @@
-//! SIMD kernels: a model's `f`, `pdf` and `sample` written once over [`Real`] lanes, run eight rows at a
-//! time by the batch methods and one row at a time by the single calls — so a batch equals the single calls
-//! bit for bit by construction (test `bsdf::tests::batches_equal_single_calls`).
+//! SIMD kernels: a model's `f`, `pdf` and `sample` written once over [`Real`] lanes, run a register of
+//! rows at a time by the batch methods and one row at a time by the single calls — so a batch equals the
+//! single calls bit for bit by construction (test `bsdf::tests::batches_equal_single_calls`).
 //!
 //! A model (or one configuration of it, e.g. GGX with visible-normal sampling) that has a kernel implements
 //! [`LaneModel`]; its `BsdfModel` methods call [`f_one`], [`pdf_one`], [`sample_one`] for that
-//! configuration, and its batch methods [`f_rows`], [`pdf_rows`], [`sample_rows`] (through the
-//! `lane_batch_methods!` macro). The drivers load eight rows into structure-of-arrays lanes
-//! ([`V3<F32x8>`](V3)), run the kernel and store the lanes back; the last rows (fewer than eight) run on
-//! single `f32`s. Compiled inside `simd_batch!`'s AVX2 + FMA function, each lane operation is one 256-bit
-//! instruction. Measured with callgrind (instructions per row, 10⁵ rows, one thread, 2026-11; `cargo run
-//! --release --example batch_rows`): see the table in that example's doc.
+//! configuration, and its batch methods the drivers [`f_rows`], [`pdf_rows`], [`sample_rows`] and their
+//! `_checked` forms (through the `lane_batch_methods!` macro). A driver loads the rows into
+//! structure-of-arrays lanes ([`V3`] of the widest lane type the CPU runs: `Twice<Twice<Avx16>>` with AVX-512, `Avx8`
+//! with AVX2, else [`F32x8`]), runs the kernel and stores the lanes back; the last rows (fewer than a
+//! register) run on single `f32`s. The `_checked` forms also test the rows against a [`RowCheck`] on the
+//! lanes already loaded, so that checking a batch's inputs costs no pass of its own. Measured with callgrind
+//! (instructions per row): see the table in the `batch_rows` example's doc.
 
 use super::{BsdfFlags, BsdfSample, SampleColumns};
-use crate::math::lanes::{channels, F32x8, Real, V3};
+use crate::math::lanes::{channels, F32x8, Real, Rows, V3};
 use crate::math::{Vec2, Vec3};
 use crate::spectrum::Rgb;
 
@@ -95,82 +96,252 @@ pub fn sample_one<K: LaneModel>(k: &K, wo: Vec3, uc: f32, u: Vec2) -> Option<Bsd
     })
 }
 
-/// `out[k] = f(wo[k], wi[k])` for `k` below the shortest length, eight rows at a time.
-#[inline(always)]
-pub fn f_rows<K: LaneModel>(k: &K, wo: &[Vec3], wi: &[Vec3], out: &mut [Rgb]) {
-    let n = wo.len().min(wi.len()).min(out.len());
-    let full = n - n % 8;
-    for ((o, i), r) in wo[..full].chunks_exact(8).zip(wi[..full].chunks_exact(8)).zip(out[..full].chunks_exact_mut(8)) {
-        let f = k.f_lanes(V3::load(o), V3::load(i));
-        for (l, r) in r.iter_mut().enumerate() {
-            *r = Rgb([f[0].0[l], f[1].0[l], f[2].0[l]]);
-        }
+/// A check of a batch's rows made in the batch's own pass over them (the `_checked` batch methods of
+/// [`BsdfModel`](super::BsdfModel)): every direction's squared length x² + y² + z², computed in `f32`, within
+/// [`lo`, `hi`]; for `sample` also every number of `uc` and `u` within [0, 1]. NaN fails every test.
+/// A caller that must reject rows by another measure (gonio's Python bindings: |w| within 10⁻³ of 1,
+/// in f64) sets the band a little inside it, so that a batch that passes needs no closer look, and looks
+/// row by row at a batch that fails.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RowCheck {
+    pub lo: f32,
+    pub hi: f32,
+}
+
+impl RowCheck {
+    /// Where the direction `w` passes.
+    #[inline(always)]
+    #[must_use]
+    pub fn direction<R: Real>(self, w: V3<R>) -> R::Mask {
+        let l2 = w.dot(w);
+        l2.ge(R::splat(self.lo)) & l2.le(R::splat(self.hi))
     }
-    for j in full..n {
-        out[j] = f_one(k, wo[j], wi[j]);
+
+    /// Where `v` is within [0, 1].
+    #[inline(always)]
+    #[must_use]
+    pub fn unit<R: Real>(v: R) -> R::Mask {
+        v.ge(R::splat(0.0)) & v.le(R::splat(1.0))
+    }
+
+    /// Whether every direction of `w` passes.
+    #[must_use]
+    pub fn directions(self, w: &[Vec3]) -> bool {
+        w.iter().fold(true, |ok, &w| ok & self.direction(V3::from(w)))
+    }
+
+    /// Whether every number of `v` is within [0, 1].
+    #[must_use]
+    pub fn unit_numbers(v: &[f32]) -> bool {
+        v.iter().fold(true, |ok, &v| ok & Self::unit(v))
+    }
+
+    /// Whether both numbers of every pair of `v` are within [0, 1].
+    #[must_use]
+    pub fn unit_pairs(v: &[Vec2]) -> bool {
+        v.iter().fold(true, |ok, &v| ok & Self::unit(v.x) & Self::unit(v.y))
     }
 }
 
-/// `out[k] = pdf(wo[k], wi[k])` for `k` below the shortest length, eight rows at a time.
+/// No lane set.
+#[inline(always)]
+fn none<R: Real>() -> R::Mask {
+    R::splat(1.0).lt(R::splat(0.0))
+}
+
+/// Rows of three numbers (`Vec3`, `Rgb`) as `[f32; 3]`s, to be overwritten.
+#[inline(always)]
+fn triples<T: Triple>(rows: &mut [T]) -> &mut [[f32; 3]] {
+    // SAFETY: `Triple` types are three `f32`s laid out as `[f32; 3]` (size 12, alignment 4).
+    unsafe { std::slice::from_raw_parts_mut(rows.as_mut_ptr().cast::<[f32; 3]>(), rows.len()) }
+}
+
+/// # Safety
+/// Implementors are laid out exactly as `[f32; 3]`.
+unsafe trait Triple {}
+// SAFETY: `glam::Vec3` is `#[repr(C)]` of x, y, z; `Rgb` is `#[repr(transparent)]` over `[f32; 3]`.
+unsafe impl Triple for Vec3 {}
+unsafe impl Triple for Rgb {}
+const _: () = assert!(std::mem::size_of::<Vec3>() == 12 && std::mem::align_of::<Vec3>() == 4);
+const _: () = assert!(std::mem::size_of::<Rgb>() == 12 && std::mem::align_of::<Rgb>() == 4);
+
+/// Defines `$name`, which runs `$generic` on the widest lanes the CPU has: 64 (four `Avx16` registers
+/// whose operations alternate, `Twice<Twice<Avx16>>`: see `math::twice` for why, AVX-512F), 8 (`Avx8`,
+/// AVX2 + FMA), each inside a
+/// function compiled for those features (so that every lane operation is inlined as its instruction,
+/// whoever calls the driver), else [`F32x8`]. `CHECK` selects whether the rows are tested against the
+/// [`RowCheck`] (the result: whether all passed; true when not checked).
+macro_rules! driver {
+    ($name:ident => $generic:ident($($arg:ident: $ty:ty),*)) => {
+        #[inline(always)]
+        fn $name<K: LaneModel, const CHECK: bool>(k: &K, $($arg: $ty),*) -> bool {
+            #[cfg(all(target_arch = "x86_64", gonio_avx512))]
+            {
+                #[target_feature(enable = "avx512f,avx2,fma")]
+                unsafe fn with_avx512<K: LaneModel, const CHECK: bool>(k: &K, $($arg: $ty),*) -> bool {
+                    $generic::<crate::math::twice::Twice<crate::math::twice::Twice<crate::math::avx512::Avx16>>, K, CHECK>(k, $($arg),*)
+                }
+                if crate::math::avx512::detected() {
+                    // SAFETY: the CPU has the features `with_avx512` is compiled for (checked just above);
+                    // `Avx16` values exist only inside it (see `math::avx512`).
+                    return unsafe { with_avx512::<K, CHECK>(k, $($arg),*) };
+                }
+            }
+            #[cfg(target_arch = "x86_64")]
+            {
+                #[target_feature(enable = "avx2,fma")]
+                unsafe fn with_avx2<K: LaneModel, const CHECK: bool>(k: &K, $($arg: $ty),*) -> bool {
+                    $generic::<crate::math::avx2::Avx8, K, CHECK>(k, $($arg),*)
+                }
+                if crate::math::avx2::detected() {
+                    // SAFETY: as above, for AVX2 + FMA and `Avx8`.
+                    return unsafe { with_avx2::<K, CHECK>(k, $($arg),*) };
+                }
+            }
+            $generic::<F32x8, K, CHECK>(k, $($arg),*)
+        }
+    };
+}
+
+/// An unused check (the unchecked drivers).
+const UNCHECKED: RowCheck = RowCheck { lo: 0.0, hi: 0.0 };
+
+/// `out[k] = f(wo[k], wi[k])` for `k` below the shortest length, a register of rows at a time.
+#[inline(always)]
+pub fn f_rows<K: LaneModel>(k: &K, wo: &[Vec3], wi: &[Vec3], out: &mut [Rgb]) {
+    f_rows_on::<K, false>(k, wo, wi, out, UNCHECKED);
+}
+
+/// [`f_rows`], and whether every direction passes `check`.
+#[inline(always)]
+pub fn f_rows_checked<K: LaneModel>(k: &K, wo: &[Vec3], wi: &[Vec3], out: &mut [Rgb], check: RowCheck) -> bool {
+    f_rows_on::<K, true>(k, wo, wi, out, check)
+}
+
+driver!(f_rows_on => f_rows_in(wo: &[Vec3], wi: &[Vec3], out: &mut [Rgb], check: RowCheck));
+
+#[inline(always)]
+fn f_rows_in<R: Rows, K: LaneModel, const CHECK: bool>(k: &K, wo: &[Vec3], wi: &[Vec3], out: &mut [Rgb], check: RowCheck) -> bool {
+    let n = wo.len().min(wi.len()).min(out.len());
+    let full = n - n % R::LANES;
+    let mut bad = none::<R>();
+    for ((o, i), r) in
+        wo[..full].chunks_exact(R::LANES).zip(wi[..full].chunks_exact(R::LANES)).zip(triples(&mut out[..full]).chunks_exact_mut(R::LANES))
+    {
+        let (o, i) = (R::load3(o), R::load3(i));
+        if CHECK {
+            bad = bad | !(check.direction(o) & check.direction(i));
+        }
+        let [r0, r1, r2] = k.f_lanes(o, i);
+        R::store3(r0, r1, r2, r);
+    }
+    let mut ok = !R::any(bad);
+    for j in full..n {
+        if CHECK {
+            ok &= check.direction(V3::from(wo[j])) & check.direction(V3::from(wi[j]));
+        }
+        out[j] = f_one(k, wo[j], wi[j]);
+    }
+    ok
+}
+
+/// `out[k] = pdf(wo[k], wi[k])` for `k` below the shortest length, a register of rows at a time.
 #[inline(always)]
 pub fn pdf_rows<K: LaneModel>(k: &K, wo: &[Vec3], wi: &[Vec3], out: &mut [f32]) {
+    pdf_rows_on::<K, false>(k, wo, wi, out, UNCHECKED);
+}
+
+/// [`pdf_rows`], and whether every direction passes `check`.
+#[inline(always)]
+pub fn pdf_rows_checked<K: LaneModel>(k: &K, wo: &[Vec3], wi: &[Vec3], out: &mut [f32], check: RowCheck) -> bool {
+    pdf_rows_on::<K, true>(k, wo, wi, out, check)
+}
+
+driver!(pdf_rows_on => pdf_rows_in(wo: &[Vec3], wi: &[Vec3], out: &mut [f32], check: RowCheck));
+
+#[inline(always)]
+fn pdf_rows_in<R: Rows, K: LaneModel, const CHECK: bool>(k: &K, wo: &[Vec3], wi: &[Vec3], out: &mut [f32], check: RowCheck) -> bool {
     let n = wo.len().min(wi.len()).min(out.len());
-    let full = n - n % 8;
-    for ((o, i), r) in wo[..full].chunks_exact(8).zip(wi[..full].chunks_exact(8)).zip(out[..full].chunks_exact_mut(8)) {
-        r.copy_from_slice(&k.pdf_lanes(V3::load(o), V3::load(i)).0);
+    let full = n - n % R::LANES;
+    let mut bad = none::<R>();
+    for ((o, i), r) in wo[..full].chunks_exact(R::LANES).zip(wi[..full].chunks_exact(R::LANES)).zip(out[..full].chunks_exact_mut(R::LANES))
+    {
+        let (o, i) = (R::load3(o), R::load3(i));
+        if CHECK {
+            bad = bad | !(check.direction(o) & check.direction(i));
+        }
+        k.pdf_lanes(o, i).store(r);
     }
+    let mut ok = !R::any(bad);
     for j in full..n {
+        if CHECK {
+            ok &= check.direction(V3::from(wo[j])) & check.direction(V3::from(wi[j]));
+        }
         out[j] = pdf_one(k, wo[j], wi[j]);
     }
+    ok
 }
 
 /// Row `k` of `out` = sample(wo[k], uc[k], u[k]) (zeros and `valid = false` where `None`), for `k` below
-/// the shortest length, eight rows at a time.
+/// the shortest length, a register of rows at a time.
 #[inline(always)]
 pub fn sample_rows<K: LaneModel>(k: &K, wo: &[Vec3], uc: &[f32], u: &[Vec2], out: &mut SampleColumns<'_>) {
-    let n = [
-        wo.len(),
-        uc.len(),
-        u.len(),
-        out.wi.len(),
-        out.f.len(),
-        out.pdf.len(),
-        out.weight.len(),
-        out.flags.len(),
-        out.eta.len(),
-        out.valid.len(),
-    ]
-    .into_iter()
-    .min()
-    .unwrap_or(0);
-    let full = n - n % 8;
-    for start in (0..full).step_by(8) {
-        let rows = start..start + 8;
-        let (ux, uy) = F32x8::load2(&u[rows.clone()]);
-        let s = k.sample_lanes(V3::load(&wo[rows.clone()]), F32x8::load(&uc[rows.clone()]), ux, uy);
-        // Invalid lanes are zero in every field.
-        let zero = F32x8::splat(0.0);
-        let (wx, wy, wz) =
-            (F32x8::select(s.valid, s.wi.x, zero), F32x8::select(s.valid, s.wi.y, zero), F32x8::select(s.valid, s.wi.z, zero));
-        let f = channels!(|c| F32x8::select(s.valid, s.f[c], zero));
-        let weight = channels!(|c| F32x8::select(s.valid, s.weight[c], zero));
-        let (pdf, flags, eta) =
-            (F32x8::select(s.valid, s.pdf, zero), F32x8::select(s.valid, s.flags, zero), F32x8::select(s.valid, s.eta, zero));
-        for l in 0..8 {
-            let j = start + l;
-            out.wi[j] = Vec3::new(wx.0[l], wy.0[l], wz.0[l]);
-            out.f[j] = Rgb([f[0].0[l], f[1].0[l], f[2].0[l]]);
-            out.weight[j] = Rgb([weight[0].0[l], weight[1].0[l], weight[2].0[l]]);
-            out.pdf[j] = pdf.0[l];
-            out.flags[j] = flags.0[l] as u32;
-            out.eta[j] = eta.0[l];
-            out.valid[j] = s.valid.get(l);
+    sample_rows_on::<K, false>(k, wo, uc, u, out, UNCHECKED);
+}
+
+/// [`sample_rows`], and whether every row passes `check` (`wo` a direction, `uc` and `u` in [0, 1]).
+#[inline(always)]
+pub fn sample_rows_checked<K: LaneModel>(k: &K, wo: &[Vec3], uc: &[f32], u: &[Vec2], out: &mut SampleColumns<'_>, check: RowCheck) -> bool {
+    sample_rows_on::<K, true>(k, wo, uc, u, out, check)
+}
+
+driver!(sample_rows_on => sample_rows_in(wo: &[Vec3], uc: &[f32], u: &[Vec2], out: &mut SampleColumns<'_>, check: RowCheck));
+
+#[inline(always)]
+fn sample_rows_in<R: Rows, K: LaneModel, const CHECK: bool>(
+    k: &K,
+    wo: &[Vec3],
+    uc: &[f32],
+    u: &[Vec2],
+    out: &mut SampleColumns<'_>,
+    check: RowCheck,
+) -> bool {
+    let n = out.rows(wo, uc, u);
+    let full = n - n % R::LANES;
+    // Zipped chunks of a register each: no bounds checks in the loop.
+    let inputs = wo[..full].chunks_exact(R::LANES).zip(uc[..full].chunks_exact(R::LANES)).zip(u[..full].chunks_exact(R::LANES));
+    let vectors = triples(&mut out.wi[..full])
+        .chunks_exact_mut(R::LANES)
+        .zip(triples(&mut out.f[..full]).chunks_exact_mut(R::LANES))
+        .zip(triples(&mut out.weight[..full]).chunks_exact_mut(R::LANES));
+    let numbers = out.pdf[..full]
+        .chunks_exact_mut(R::LANES)
+        .zip(out.flags[..full].chunks_exact_mut(R::LANES))
+        .zip(out.eta[..full].chunks_exact_mut(R::LANES))
+        .zip(out.valid[..full].chunks_exact_mut(R::LANES));
+    let mut bad = none::<R>();
+    for (((wo, uc), u), (((wi_out, f_out), weight_out), (((pdf_out, flags_out), eta_out), valid_out))) in inputs.zip(vectors.zip(numbers)) {
+        let (wo, uc, (ux, uy)) = (R::load3(wo), R::load(uc), R::load2(u));
+        if CHECK {
+            bad = bad | !(check.direction(wo) & RowCheck::unit(uc) & RowCheck::unit(ux) & RowCheck::unit(uy));
         }
+        let s = k.sample_lanes(wo, uc, ux, uy);
+        // Invalid lanes are zero in every field.
+        let keep = |v: R| R::select(s.valid, v, R::splat(0.0));
+        R::store3(keep(s.wi.x), keep(s.wi.y), keep(s.wi.z), wi_out);
+        R::store3(keep(s.f[0]), keep(s.f[1]), keep(s.f[2]), f_out);
+        R::store3(keep(s.weight[0]), keep(s.weight[1]), keep(s.weight[2]), weight_out);
+        keep(s.pdf).store(pdf_out);
+        keep(s.flags).store_u32(flags_out);
+        keep(s.eta).store(eta_out);
+        R::store_mask(s.valid, valid_out);
     }
+    let mut ok = !R::any(bad);
     for j in full..n {
-        let s = sample_one(k, wo[j], uc[j], u[j]);
-        out.valid[j] = s.is_some();
-        let s = s.unwrap_or(BsdfSample { wi: Vec3::ZERO, f: Rgb::ZERO, pdf: 0.0, weight: Rgb::ZERO, flags: BsdfFlags::NONE, eta: 0.0 });
-        (out.wi[j], out.f[j], out.pdf[j], out.weight[j], out.flags[j], out.eta[j]) = (s.wi, s.f, s.pdf, s.weight, s.flags.0, s.eta);
+        if CHECK {
+            ok &= check.direction(V3::from(wo[j])) & RowCheck::unit(uc[j]) & RowCheck::unit(u[j].x) & RowCheck::unit(u[j].y);
+        }
+        out.set(j, sample_one(k, wo[j], uc[j], u[j]));
     }
+    ok
 }

@@ -63,11 +63,42 @@ macro_rules! forward_bsdf_model {
             ) {
                 self.$field.sample_batch(wo, uc, u, out)
             }
+            #[inline(always)]
+            fn f_batch_checked(
+                &self,
+                wo: &[$crate::math::Vec3],
+                wi: &[$crate::math::Vec3],
+                out: &mut [$crate::spectrum::Rgb],
+                check: $crate::bsdf::RowCheck,
+            ) -> bool {
+                self.$field.f_batch_checked(wo, wi, out, check)
+            }
+            #[inline(always)]
+            fn pdf_batch_checked(
+                &self,
+                wo: &[$crate::math::Vec3],
+                wi: &[$crate::math::Vec3],
+                out: &mut [f32],
+                check: $crate::bsdf::RowCheck,
+            ) -> bool {
+                self.$field.pdf_batch_checked(wo, wi, out, check)
+            }
+            #[inline(always)]
+            fn sample_batch_checked(
+                &self,
+                wo: &[$crate::math::Vec3],
+                uc: &[f32],
+                u: &[$crate::math::Vec2],
+                out: &mut $crate::bsdf::SampleColumns<'_>,
+                check: $crate::bsdf::RowCheck,
+            ) -> bool {
+                self.$field.sample_batch_checked(wo, uc, u, out, check)
+            }
         }
     };
 }
 
-/// The three batch methods of a model with a SIMD kernel ([`lanes::LaneModel`]) for some configurations:
+/// The batch methods (plain and `_checked`) of a model with a SIMD kernel ([`lanes::LaneModel`]) for some configurations:
 /// `lane_batch_methods!(kernel);` inside its `impl BsdfModel`, where `self.kernel()` returns `Some(k)` for a
 /// configuration `k` runs (`Option<impl LaneModel>`) and `None` for the others, which take the per-pair loops
 /// ([`f_each`] and friends).
@@ -92,6 +123,55 @@ macro_rules! lane_batch_methods {
             match self.$kernel() {
                 Some(k) => $crate::bsdf::lanes::sample_rows(&k, wo, uc, u, out),
                 None => $crate::bsdf::sample_each(self, wo, uc, u, out),
+            }
+        }
+        #[inline(always)]
+        fn f_batch_checked(
+            &self,
+            wo: &[$crate::math::Vec3],
+            wi: &[$crate::math::Vec3],
+            out: &mut [$crate::spectrum::Rgb],
+            check: $crate::bsdf::RowCheck,
+        ) -> bool {
+            match self.$kernel() {
+                Some(k) => $crate::bsdf::lanes::f_rows_checked(&k, wo, wi, out, check),
+                None => {
+                    $crate::bsdf::f_each(self, wo, wi, out);
+                    check.directions(wo) & check.directions(wi)
+                }
+            }
+        }
+        #[inline(always)]
+        fn pdf_batch_checked(
+            &self,
+            wo: &[$crate::math::Vec3],
+            wi: &[$crate::math::Vec3],
+            out: &mut [f32],
+            check: $crate::bsdf::RowCheck,
+        ) -> bool {
+            match self.$kernel() {
+                Some(k) => $crate::bsdf::lanes::pdf_rows_checked(&k, wo, wi, out, check),
+                None => {
+                    $crate::bsdf::pdf_each(self, wo, wi, out);
+                    check.directions(wo) & check.directions(wi)
+                }
+            }
+        }
+        #[inline(always)]
+        fn sample_batch_checked(
+            &self,
+            wo: &[$crate::math::Vec3],
+            uc: &[f32],
+            u: &[$crate::math::Vec2],
+            out: &mut $crate::bsdf::SampleColumns<'_>,
+            check: $crate::bsdf::RowCheck,
+        ) -> bool {
+            match self.$kernel() {
+                Some(k) => $crate::bsdf::lanes::sample_rows_checked(&k, wo, uc, u, out, check),
+                None => {
+                    $crate::bsdf::sample_each(self, wo, uc, u, out);
+                    check.directions(wo) & $crate::bsdf::RowCheck::unit_numbers(uc) & $crate::bsdf::RowCheck::unit_pairs(u)
+                }
             }
         }
     };
@@ -132,6 +212,7 @@ pub use blinn_phong::BlinnPhong;
 pub use conductor::Conductor;
 pub use dielectric::Dielectric;
 pub use diffuse::Diffuse;
+pub use lanes::RowCheck;
 pub use layered::Layered;
 pub use mask::Mask;
 pub use measured::Measured;
@@ -300,6 +381,31 @@ pub trait BsdfModel {
     fn sample_batch(&self, wo: &[Vec3], uc: &[f32], u: &[Vec2], out: &mut SampleColumns<'_>) {
         sample_each(self, wo, uc, u, out);
     }
+
+    /// [`f_batch`](Self::f_batch), and whether every row passes `check` ([`RowCheck`]). Models with SIMD
+    /// kernels test the rows on the lanes they load anyway, so that a batch's inputs are read once; the
+    /// rows are computed either way.
+    #[inline(always)]
+    fn f_batch_checked(&self, wo: &[Vec3], wi: &[Vec3], out: &mut [Rgb], check: RowCheck) -> bool {
+        self.f_batch(wo, wi, out);
+        check.directions(wo) & check.directions(wi)
+    }
+
+    /// [`pdf_batch`](Self::pdf_batch), and whether every row passes `check` (see
+    /// [`f_batch_checked`](Self::f_batch_checked)).
+    #[inline(always)]
+    fn pdf_batch_checked(&self, wo: &[Vec3], wi: &[Vec3], out: &mut [f32], check: RowCheck) -> bool {
+        self.pdf_batch(wo, wi, out);
+        check.directions(wo) & check.directions(wi)
+    }
+
+    /// [`sample_batch`](Self::sample_batch), and whether every row passes `check`: `wo` its direction
+    /// test, `uc` and `u` within [0, 1] (see [`f_batch_checked`](Self::f_batch_checked)).
+    #[inline(always)]
+    fn sample_batch_checked(&self, wo: &[Vec3], uc: &[f32], u: &[Vec2], out: &mut SampleColumns<'_>, check: RowCheck) -> bool {
+        self.sample_batch(wo, uc, u, out);
+        check.directions(wo) & RowCheck::unit_numbers(uc) & RowCheck::unit_pairs(u)
+    }
 }
 
 /// The loop of [`BsdfModel::f_batch`]: `out[k] = m.f(wo[k], wi[k])`. Models that override `f_batch` call it
@@ -334,30 +440,42 @@ pub struct SampleColumns<'a> {
     pub valid: &'a mut [bool],
 }
 
+impl SampleColumns<'_> {
+    /// The number of rows a batch of `sample` over `wo`, `uc`, `u` into these columns computes: the
+    /// shortest length of all ten slices.
+    #[must_use]
+    pub fn rows(&self, wo: &[Vec3], uc: &[f32], u: &[Vec2]) -> usize {
+        [
+            wo.len(),
+            uc.len(),
+            u.len(),
+            self.wi.len(),
+            self.f.len(),
+            self.pdf.len(),
+            self.weight.len(),
+            self.flags.len(),
+            self.eta.len(),
+            self.valid.len(),
+        ]
+        .into_iter()
+        .min()
+        .unwrap_or(0)
+    }
+
+    /// Row `k` = `s`, or zeros and `valid = false` for `None`.
+    #[inline(always)]
+    pub fn set(&mut self, k: usize, s: Option<BsdfSample>) {
+        self.valid[k] = s.is_some();
+        let s = s.unwrap_or(BsdfSample { wi: Vec3::ZERO, f: Rgb::ZERO, pdf: 0.0, weight: Rgb::ZERO, flags: BsdfFlags::NONE, eta: 0.0 });
+        (self.wi[k], self.f[k], self.pdf[k], self.weight[k], self.flags[k], self.eta[k]) = (s.wi, s.f, s.pdf, s.weight, s.flags.0, s.eta);
+    }
+}
+
 /// The loop of [`BsdfModel::sample_batch`] (see [`f_each`]), for `k` below the shortest length.
 #[inline(always)]
 pub fn sample_each<M: BsdfModel + ?Sized>(m: &M, wo: &[Vec3], uc: &[f32], u: &[Vec2], out: &mut SampleColumns<'_>) {
-    let n = [
-        wo.len(),
-        uc.len(),
-        u.len(),
-        out.wi.len(),
-        out.f.len(),
-        out.pdf.len(),
-        out.weight.len(),
-        out.flags.len(),
-        out.eta.len(),
-        out.valid.len(),
-    ]
-    .into_iter()
-    .min()
-    .unwrap_or(0);
-    let none = BsdfSample { wi: Vec3::ZERO, f: Rgb::ZERO, pdf: 0.0, weight: Rgb::ZERO, flags: BsdfFlags::NONE, eta: 0.0 };
-    for k in 0..n {
-        let s = m.sample(wo[k], uc[k], u[k]);
-        out.valid[k] = s.is_some();
-        let s = s.unwrap_or(none);
-        (out.wi[k], out.f[k], out.pdf[k], out.weight[k], out.flags[k], out.eta[k]) = (s.wi, s.f, s.pdf, s.weight, s.flags.0, s.eta);
+    for k in 0..out.rows(wo, uc, u) {
+        out.set(k, m.sample(wo[k], uc[k], u[k]));
     }
 }
 
@@ -380,11 +498,11 @@ pub trait Examples {
 /// in hardware and in libm, so the results are the same bit for bit on every path (test
 /// `batches_equal_single_calls`).
 macro_rules! simd_batch {
-    ($self:ident, $m:ident => $call:expr; $($arg:ident: $ty:ty),*) => {{
+    ($self:ident, $m:ident => $call:expr; $($arg:ident: $ty:ty),* => $ret:ty) => {{
         #[cfg(target_arch = "x86_64")]
         {
             #[target_feature(enable = "avx2,fma")]
-            unsafe fn with_avx2(b: &Bsdf, $($arg: $ty),*) {
+            unsafe fn with_avx2(b: &Bsdf, $($arg: $ty),*) -> $ret {
                 dispatch!(b, $m => $call)
             }
             if std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma") {
@@ -423,13 +541,23 @@ macro_rules! bsdf_models {
             #[inline]
             fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 { dispatch!(self, m => m.pdf(wo, wi)) }
             fn f_batch(&self, wo: &[Vec3], wi: &[Vec3], out: &mut [Rgb]) {
-                simd_batch!(self, m => m.f_batch(wo, wi, out); wo: &[Vec3], wi: &[Vec3], out: &mut [Rgb])
+                simd_batch!(self, m => m.f_batch(wo, wi, out); wo: &[Vec3], wi: &[Vec3], out: &mut [Rgb] => ())
             }
             fn pdf_batch(&self, wo: &[Vec3], wi: &[Vec3], out: &mut [f32]) {
-                simd_batch!(self, m => m.pdf_batch(wo, wi, out); wo: &[Vec3], wi: &[Vec3], out: &mut [f32])
+                simd_batch!(self, m => m.pdf_batch(wo, wi, out); wo: &[Vec3], wi: &[Vec3], out: &mut [f32] => ())
             }
             fn sample_batch(&self, wo: &[Vec3], uc: &[f32], u: &[Vec2], out: &mut SampleColumns<'_>) {
-                simd_batch!(self, m => m.sample_batch(wo, uc, u, out); wo: &[Vec3], uc: &[f32], u: &[Vec2], out: &mut SampleColumns<'_>)
+                simd_batch!(self, m => m.sample_batch(wo, uc, u, out); wo: &[Vec3], uc: &[f32], u: &[Vec2], out: &mut SampleColumns<'_> => ())
+            }
+            fn f_batch_checked(&self, wo: &[Vec3], wi: &[Vec3], out: &mut [Rgb], check: RowCheck) -> bool {
+                simd_batch!(self, m => m.f_batch_checked(wo, wi, out, check); wo: &[Vec3], wi: &[Vec3], out: &mut [Rgb], check: RowCheck => bool)
+            }
+            fn pdf_batch_checked(&self, wo: &[Vec3], wi: &[Vec3], out: &mut [f32], check: RowCheck) -> bool {
+                simd_batch!(self, m => m.pdf_batch_checked(wo, wi, out, check); wo: &[Vec3], wi: &[Vec3], out: &mut [f32], check: RowCheck => bool)
+            }
+            fn sample_batch_checked(&self, wo: &[Vec3], uc: &[f32], u: &[Vec2], out: &mut SampleColumns<'_>, check: RowCheck) -> bool {
+                simd_batch!(self, m => m.sample_batch_checked(wo, uc, u, out, check);
+                    wo: &[Vec3], uc: &[f32], u: &[Vec2], out: &mut SampleColumns<'_>, check: RowCheck => bool)
             }
         }
 
@@ -519,8 +647,107 @@ mod tests {
     /// The batch methods (one `match` per batch, AVX2-compiled loops, the eight-lane kernels of diffuse and
     /// GGX roughconductor and roughplastic in `lanes`) give every example model's per-pair results bit for
     /// bit, including directions below the horizon and on it, and the rows after the last full eight.
+    /// The `_checked` batch methods compute what the plain ones do, bit for bit, and report a row that fails
+    /// the check wherever it is (in a full register of rows or among the last rows), for models with SIMD
+    /// kernels and without.
+    #[test]
+    fn checked_batches_compute_the_same_and_find_bad_rows() {
+        for level in [2, 1, 0] {
+            crate::math::simd_level::with(level, checked_batches_at_this_level);
+        }
+    }
+
+    fn checked_batches_at_this_level() {
+        let n = 257;
+        let mut rng = Pcg32::new(3, 0);
+        let mut dir = || Vec3::new(rng.next_f32() - 0.5, rng.next_f32() - 0.5, rng.next_f32() + 0.1).normalize();
+        let (wo, wi): (Vec<Vec3>, Vec<Vec3>) = (0..n).map(|_| (dir(), dir())).unzip();
+        let mut rng = Pcg32::new(4, 0);
+        let uc: Vec<f32> = (0..n).map(|_| rng.next_f32()).collect();
+        let u: Vec<Vec2> = (0..n).map(|_| Vec2::new(rng.next_f32(), rng.next_f32())).collect();
+        let check = RowCheck { lo: 0.998, hi: 1.002 };
+        for spec in [
+            r#"{"type": "diffuse", "reflectance": [0.2, 0.5, 0.8]}"#,
+            r#"{"type": "roughconductor", "distribution": "ggx", "alpha": 0.3, "material": "Au"}"#,
+            r#"{"type": "roughconductor", "distribution": "beckmann", "alpha": 0.3}"#,
+            r#"{"type": "roughplastic", "distribution": "ggx", "alpha": 0.3}"#,
+            r#"{"type": "plastic"}"#,
+        ] {
+            let b = Bsdf::from_json(spec).unwrap();
+            let run = |wo: &[Vec3], wi: &[Vec3], uc: &[f32], u: &[Vec2]| {
+                let (mut f, mut pdf, mut f_checked, mut pdf_checked) = (vec![Rgb::ZERO; n], vec![0.0; n], vec![Rgb::ONE; n], vec![1.0; n]);
+                b.f_batch(wo, wi, &mut f);
+                b.pdf_batch(wo, wi, &mut pdf);
+                let ok = (b.f_batch_checked(wo, wi, &mut f_checked, check), b.pdf_batch_checked(wo, wi, &mut pdf_checked, check));
+                assert!(f.iter().zip(&f_checked).all(|(a, c)| a.0.map(f32::to_bits) == c.0.map(f32::to_bits)), "{spec}: f");
+                assert!(pdf.iter().zip(&pdf_checked).all(|(a, c)| a.to_bits() == c.to_bits()), "{spec}: pdf");
+                let sample = |checked: bool| {
+                    let (mut wi_s, mut f_s, mut pdf_s, mut weight_s) =
+                        (vec![Vec3::ONE; n], vec![Rgb::ONE; n], vec![1.0; n], vec![Rgb::ONE; n]);
+                    let (mut flags_s, mut eta_s, mut valid_s) = (vec![7; n], vec![1.0; n], vec![false; n]);
+                    let mut columns = SampleColumns {
+                        wi: &mut wi_s,
+                        f: &mut f_s,
+                        pdf: &mut pdf_s,
+                        weight: &mut weight_s,
+                        flags: &mut flags_s,
+                        eta: &mut eta_s,
+                        valid: &mut valid_s,
+                    };
+                    let ok = if checked {
+                        b.sample_batch_checked(wo, uc, u, &mut columns, check)
+                    } else {
+                        b.sample_batch(wo, uc, u, &mut columns);
+                        true
+                    };
+                    let bits: Vec<u32> = wi_s
+                        .iter()
+                        .flat_map(|v| v.to_array())
+                        .chain(weight_s.iter().flat_map(|c| c.0))
+                        .chain(pdf_s)
+                        .map(f32::to_bits)
+                        .collect();
+                    (ok, bits, flags_s, valid_s)
+                };
+                let (plain, checked) = (sample(false), sample(true));
+                assert_eq!((&plain.1, &plain.2, &plain.3), (&checked.1, &checked.2, &checked.3), "{spec}: sample");
+                (ok.0, ok.1, checked.0)
+            };
+            assert_eq!(run(&wo, &wi, &uc, &u), (true, true, true), "{spec}: unit rows");
+            for at in [0, 5, 16, 255, 256] {
+                for bad in [1.01, f32::NAN, 0.9] {
+                    let mut w = wi.clone();
+                    w[at] *= bad;
+                    assert_eq!(run(&wo, &w, &uc, &u), (false, false, true), "{spec}: wi[{at}] × {bad}");
+                    let mut w = wo.clone();
+                    w[at] *= bad;
+                    assert_eq!(run(&w, &wi, &uc, &u), (false, false, false), "{spec}: wo[{at}] × {bad}");
+                }
+                for bad in [-1e-7, 1.000_001, f32::NAN] {
+                    let mut v = uc.clone();
+                    v[at] = bad;
+                    assert!(!run(&wo, &wi, &v, &u).2, "{spec}: uc[{at}] = {bad}");
+                    let mut v = u.clone();
+                    v[at].y = bad;
+                    assert!(!run(&wo, &wi, &uc, &v).2, "{spec}: u[{at}].y = {bad}");
+                }
+            }
+            // The band's edges are inside.
+            let mut w = wi.clone();
+            (w[3], w[200]) = (Vec3::new(0.0, 0.0, 0.998f32.sqrt() * 1.000_001), Vec3::new(0.0, 0.0, 1.002f32.sqrt() * 0.999_999));
+            assert_eq!(run(&wo, &w, &uc, &u), (true, true, true), "{spec}: band edges");
+        }
+    }
+
     #[test]
     fn batches_equal_single_calls() {
+        // Each lane type the CPU has: AVX-512, AVX2, portable.
+        for level in [2, 1, 0] {
+            crate::math::simd_level::with(level, batches_equal_single_calls_at_this_level);
+        }
+    }
+
+    fn batches_equal_single_calls_at_this_level() {
         let mut rng = Pcg32::new(7, 0);
         let n = 257;
         let dir = |rng: &mut Pcg32| {
@@ -537,11 +764,13 @@ mod tests {
         let uc: Vec<f32> = (0..n).map(|_| rng.next_f32()).collect();
         let u: Vec<Vec2> = (0..n).map(|_| Vec2::new(rng.next_f32(), rng.next_f32())).collect();
         let bits = |c: Rgb| c.0.map(f32::to_bits);
-        // Every example but the models whose construction integrates tables (seconds each), and two rough
-        // plastics (GGX, which has its own batch loops, and Beckmann, which does not).
+        // Every example but the models whose construction integrates tables (seconds each), and three rough
+        // plastics (GGX, which has its own batch loops, once with a coating less dense than the outside, whose
+        // tables have graded nodes, and Beckmann, which has no batch loops).
         let cheap = Bsdf::examples().into_iter().filter(|s| !["roughplastic", "layered", "measured", "merl"].iter().any(|p| s.contains(p)));
         let plastics = [
             r#"{"type": "roughplastic", "distribution": "ggx", "alpha": 0.3, "diffuse_reflectance": [0.9, 0.4, 0.1], "nonlinear": true}"#,
+            r#"{"type": "roughplastic", "distribution": "ggx", "alpha": 0.2, "int_ior": 1.0, "ext_ior": 1.5}"#,
             r#"{"type": "roughplastic", "alpha": 0.3}"#,
         ];
         for spec in cheap.chain(plastics) {

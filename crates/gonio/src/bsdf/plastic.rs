@@ -79,7 +79,7 @@ pub(crate) const POLYPROPYLENE: f32 = 1.49;
 #[must_use]
 #[inline(always)]
 pub(crate) fn coated_diffuse<R: Real>(rho: Rgb, t_o: R, t_i: R, eta: f32, internal_reflectance: f32, nonlinear: bool) -> [R; 3] {
-    let scale = t_o * t_i * FRAC_1_PI / (eta * eta);
+    let scale = t_o * t_i * (FRAC_1_PI / (eta * eta));
     channels!(|c| {
         let r = rho.0[c];
         let denom = 1.0 - if nonlinear { r * internal_reflectance } else { internal_reflectance };

@@ -187,10 +187,7 @@ impl CoatingTables {
         if let Some(graded) = &self.graded {
             return graded.lookup(mu.clamp(0.0, 1.0));
         }
-        let x = mu.clamp(0.0, 1.0) * (TABLE_SIZE - 1) as f32;
-        let k = (x as usize).min(TABLE_SIZE - 2);
-        let t = x - k as f32;
-        (1.0 - t) * self.transmittance[k] + t * self.transmittance[k + 1]
+        mu.lerp_table(&self.transmittance)
     }
 
     /// The tables for (kind, α, η): integrated at α itself and cached per process, or, while a
@@ -515,6 +512,8 @@ pub struct GgxPlastic<'a> {
     /// The steering weight of the glossy lobe ([`specular_sampling_weight`]).
     weight: f32,
     tables: &'a CoatingTables,
+    /// The even table of T when the lookups use it (no graded nodes), chosen once per kernel.
+    even: Option<&'a [f32; TABLE_SIZE]>,
 }
 
 impl RoughPlastic {
@@ -531,15 +530,20 @@ impl RoughPlastic {
             nonlinear: self.nonlinear,
             weight: specular_sampling_weight(self.diffuse_reflectance, c.specular_reflectance),
             tables: &self.tables,
+            even: self.tables.graded.is_none().then_some(&self.tables.transmittance),
         })
     }
 }
 
 impl GgxPlastic<'_> {
-    /// T(μ) per lane (a table lookup).
+    /// T(μ) per lane ([`CoatingTables::transmittance`]): the even table by [`Real::lerp_table`] (gathers in
+    /// the AVX lanes), graded nodes (η < 1) by a search per lane.
     #[inline(always)]
     fn transmittance<R: Real>(&self, mu: R) -> R {
-        mu.map(|m| self.tables.transmittance(m))
+        match self.even {
+            Some(table) => mu.lerp_table(table),
+            None => mu.map(|m| self.tables.transmittance(m)),
+        }
     }
 
     /// [`RoughPlastic::specular_probability`].
@@ -549,13 +553,16 @@ impl GgxPlastic<'_> {
     }
 
     /// The microfacet normal of a reflected pair with `wo` above ([`RoughDielectric`]'s half vector,
-    /// turned to +z), and the lanes where it is defined.
+    /// turned to +z), and the lanes where it is defined. Times the reciprocal length, where
+    /// `RoughDielectric` divides (one division instead of three, 2026-12): within a rounding of it, and
+    /// a plastic has no transmission lobe, whose 1 − F near the critical angle would magnify that rounding
+    /// (`RoughDielectric` keeps the division, which the Mitsuba comparison's floor was measured with).
     #[inline(always)]
     fn half_vector<R: Real>(wo: V3<R>, wi: V3<R>) -> (V3<R>, R::Mask) {
         let zero = R::splat(0.0);
         let h = wo.add(wi);
         let len = h.length();
-        let wm = h.div(len);
+        let wm = h.scale(R::splat(1.0) / len);
         let wm = V3::select(wm.z.lt(zero), wm.neg(), wm);
         let defined = !(wo.z.le(zero) | wi.z.eq(zero)) & wi.z.gt(zero) & len.gt(zero) & len.is_finite();
         (wm, defined)

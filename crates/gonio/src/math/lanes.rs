@@ -1,23 +1,21 @@
-//! Numbers in lanes: one formula written once, run on a single `f32` or on eight at a time.
+//! Numbers in lanes: one formula written once, run on a single `f32` or on many at a time.
 //!
 //! | item        | what it is                                                                          |
 //! |-------------|-------------------------------------------------------------------------------------|
-//! | [`Real`]    | the arithmetic a formula needs: + − × ÷, √, fused multiply–add, min/max, comparisons into a mask, `select` |
+//! | [`Real`]    | the arithmetic a formula needs: + − × ÷, √, fused multiply–add, min/max, comparisons into a mask, `select`, a table lookup |
 //! | `f32`       | one lane; its mask is `bool` and `select` a branch — the renderer's single calls      |
-//! | [`F32x8`]   | eight lanes (one AVX register); each operation is a loop over the lanes that the compiler turns into one vector instruction |
+//! | [`F32x8`]   | eight lanes as plain Rust: each operation a loop over the lanes, for CPUs without AVX2 (and other architectures) |
+//! | `avx2::Avx8`, `avx512::Avx16` | eight or sixteen lanes in one AVX / AVX-512 register, each operation its instruction; what the batch drivers run on where the CPU has them (crate-private: see `math::avx2`) |
+//! | `twice::Twice<R>` | two registers of `R` as one, their operations alternating (two dependency chains in flight): the AVX-512 drivers run `Twice<Twice<Avx16>>` |
 //! | [`V3`]      | a direction of lanes (structure of arrays: x, y and z each one `Real`)               |
+//! | `Rows`      | moving a register of rows between slices and lanes (the batch drivers' side)          |
 //!
-//! A formula generic over [`Real`] computes, in every lane of an [`F32x8`], exactly the IEEE operations it
-//! computes on an `f32`, in the same order (every operation is correctly rounded, and Rust never fuses a
-//! multiply and an add on its own), so the eight-lane result equals eight single calls bit for bit. Branches
-//! become masks: both sides are computed and [`Real::select`] keeps one per lane; a lane's discarded side may
-//! be NaN or infinite, which is harmless. [`Real::any`] lets a formula skip work no lane needs (on an `f32`
-//! it is the early return of scalar code).
-//!
-//! The loops over eight lanes are plain Rust: compiled inside gonio's AVX2 + FMA batch functions (see
-//! `bsdf::simd_batch`), LLVM's SLP vectoriser maps each to one 256-bit instruction (checked with callgrind
-//! instruction counts per row, see `bsdf::lanes`); on other CPUs they run as SSE pairs or scalar loops with
-//! the same results.
+//! A formula generic over [`Real`] computes, in every lane, exactly the IEEE operations it computes on an
+//! `f32`, in the same order (every operation is correctly rounded, and Rust never fuses a multiply and an
+//! add on its own), so the lanes' result equals the single calls bit for bit. Branches become masks: both
+//! sides are computed and [`Real::select`] keeps one per lane; a lane's discarded side may be NaN or
+//! infinite, which is harmless. [`Real::any`] lets a formula skip work no lane needs (on an `f32` it is the
+//! early return of scalar code). Every lane type passes the same checks (`check_lane_type` in the tests).
 
 use crate::math::{Vec2, Vec3};
 use std::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
@@ -43,16 +41,23 @@ pub trait Real:
     fn splat(v: f32) -> Self;
     fn sqrt(self) -> Self;
     fn abs(self) -> Self;
-    /// `f32::min`: the other operand where one is NaN.
+    /// self < o ? self : o, and `self` where `o` is NaN: `f32::min` (the other operand where one is NaN),
+    /// with ties of ±0 settled as x86's `minss(self, o)` does (`o`), which is what `f32::min(x, c)` with a
+    /// constant `c` — the only form the kernels use — compiles to. Written out so that every lane type
+    /// gives the same bits whatever the compiler knows about `o`.
     fn min(self, o: Self) -> Self;
+    /// As [`Self::min`], with self > o.
     fn max(self, o: Self) -> Self;
     fn clamp(self, lo: f32, hi: f32) -> Self;
     /// `f32::mul_add`: self · a + b with one rounding.
     fn mul_add(self, a: Self, b: Self) -> Self;
     /// `f32::round`: to the nearest integer, halves away from zero.
     fn round(self) -> Self;
-    /// `f(lane)` in every lane: for a table lookup or other scalar code (not vectorised, same results).
+    /// `f(lane)` in every lane: for scalar code (not vectorised, same results).
     fn map(self, f: impl Fn(f32) -> f32) -> Self;
+    /// The piecewise-linear function through `table[k]` at k/(N − 1), on [0, 1] (arguments are clamped to
+    /// it; NaN gives NaN): with x·(N − 1) = k + t, (1 − t)·`table[k]` + t·`table[k + 1]`.
+    fn lerp_table<const N: usize>(self, table: &[f32; N]) -> Self;
     fn lt(self, o: Self) -> Self::Mask;
     fn le(self, o: Self) -> Self::Mask;
     fn gt(self, o: Self) -> Self::Mask;
@@ -85,11 +90,19 @@ impl Real for f32 {
     }
     #[inline(always)]
     fn min(self, o: Self) -> Self {
-        f32::min(self, o)
+        if self < o || o.is_nan() {
+            self
+        } else {
+            o
+        }
     }
     #[inline(always)]
     fn max(self, o: Self) -> Self {
-        f32::max(self, o)
+        if self > o || o.is_nan() {
+            self
+        } else {
+            o
+        }
     }
     #[inline(always)]
     fn clamp(self, lo: f32, hi: f32) -> Self {
@@ -106,6 +119,13 @@ impl Real for f32 {
     #[inline(always)]
     fn map(self, f: impl Fn(f32) -> f32) -> Self {
         f(self)
+    }
+    #[inline(always)]
+    fn lerp_table<const N: usize>(self, table: &[f32; N]) -> Self {
+        let x = self.clamp(0.0, 1.0) * (N - 1) as f32;
+        let k = (x as usize).min(N - 2);
+        let t = x - k as f32;
+        (1.0 - t) * table[k] + t * table[k + 1]
     }
     #[inline(always)]
     fn lt(self, o: Self) -> bool {
@@ -256,11 +276,11 @@ impl Real for F32x8 {
     }
     #[inline(always)]
     fn min(self, o: Self) -> Self {
-        lanes!(F32x8, |i| self.0[i].min(o.0[i]))
+        lanes!(F32x8, |i| Real::min(self.0[i], o.0[i]))
     }
     #[inline(always)]
     fn max(self, o: Self) -> Self {
-        lanes!(F32x8, |i| self.0[i].max(o.0[i]))
+        lanes!(F32x8, |i| Real::max(self.0[i], o.0[i]))
     }
     #[inline(always)]
     fn clamp(self, lo: f32, hi: f32) -> Self {
@@ -277,6 +297,10 @@ impl Real for F32x8 {
     #[inline(always)]
     fn map(self, f: impl Fn(f32) -> f32) -> Self {
         lanes!(F32x8, |i| f(self.0[i]))
+    }
+    #[inline(always)]
+    fn lerp_table<const N: usize>(self, table: &[f32; N]) -> Self {
+        self.map(|x| x.lerp_table(table))
     }
     #[inline(always)]
     fn lt(self, o: Self) -> M32x8 {
@@ -446,6 +470,63 @@ impl From<V3<f32>> for Vec3 {
     }
 }
 
+/// Lanes that the batch drivers (`bsdf::lanes`) fill from slices of rows and empty into them, each time
+/// exactly [`Real::LANES`] rows (the slices' lengths are checked). Implemented by [`F32x8`] (element by
+/// element) and on x86-64 by `avx2::Avx8` and `avx512::Avx16` (shuffles); all move the same numbers.
+pub(crate) trait Rows: Real {
+    fn load(v: &[f32]) -> Self;
+    fn store(self, out: &mut [f32]);
+    /// The x, y and z of the rows.
+    fn load3(v: &[Vec3]) -> V3<Self>;
+    /// The x and y of the rows.
+    fn load2(v: &[Vec2]) -> (Self, Self);
+    /// Lanes x, y and z as rows of three numbers.
+    fn store3(x: Self, y: Self, z: Self, out: &mut [[f32; 3]]);
+    /// `v as u32` per lane, for whole numbers in [0, 2³¹) (flag bits).
+    fn store_u32(self, out: &mut [u32]);
+    fn store_mask(m: Self::Mask, out: &mut [bool]);
+}
+
+impl Rows for F32x8 {
+    #[inline(always)]
+    fn load(v: &[f32]) -> Self {
+        F32x8::load(v)
+    }
+    #[inline(always)]
+    fn store(self, out: &mut [f32]) {
+        out.copy_from_slice(&self.0);
+    }
+    #[inline(always)]
+    fn load3(v: &[Vec3]) -> V3<Self> {
+        V3::load(v)
+    }
+    #[inline(always)]
+    fn load2(v: &[Vec2]) -> (Self, Self) {
+        F32x8::load2(v)
+    }
+    #[inline(always)]
+    fn store3(x: Self, y: Self, z: Self, out: &mut [[f32; 3]]) {
+        let out: &mut [[f32; 3]; 8] = out.try_into().expect("eight rows");
+        for (l, r) in out.iter_mut().enumerate() {
+            *r = [x.0[l], y.0[l], z.0[l]];
+        }
+    }
+    #[inline(always)]
+    fn store_u32(self, out: &mut [u32]) {
+        let out: &mut [u32; 8] = out.try_into().expect("eight numbers");
+        for (l, o) in out.iter_mut().enumerate() {
+            *o = self.0[l] as u32;
+        }
+    }
+    #[inline(always)]
+    fn store_mask(m: M32x8, out: &mut [bool]) {
+        let out: &mut [bool; 8] = out.try_into().expect("eight flags");
+        for (l, o) in out.iter_mut().enumerate() {
+            *o = m.get(l);
+        }
+    }
+}
+
 impl V3<F32x8> {
     /// Eight `Vec3`s (exactly eight) as lanes.
     #[inline(always)]
@@ -481,28 +562,140 @@ impl F32x8 {
     }
 }
 
+/// The checks every lane type passes (`F32x8` here, `Avx8` and `Avx16` in their modules): each operation
+/// is the `f32` operation per lane, bit for bit — NaN, ±0, infinities and subnormals included, `round` at
+/// and between halves, `lerp_table` across and beyond its range — and rows move exactly.
+#[cfg(test)]
+pub(crate) fn check_lane_type<R: Rows>() {
+    let n = R::LANES;
+    let get = |v: R| {
+        let mut o = vec![0.0; n];
+        v.store(&mut o);
+        o
+    };
+    const VALUES: [f32; 16] =
+        [0.5, -1.5, 0.0, -0.0, f32::INFINITY, f32::NAN, 3.0e-39, 2.5, 2.0, -1.5, -0.0, 0.0, 1.0, 0.5, -7.0, f32::NEG_INFINITY];
+    for shift in 0..16 {
+        let a: Vec<f32> = (0..n).map(|i| VALUES[(i + shift) % 16]).collect();
+        let b: Vec<f32> = (0..n).map(|i| VALUES[(7 * i + shift + 3) % 16]).collect();
+        let (x, y) = (R::load(&a), R::load(&b));
+        let same = |v: R, f: &dyn Fn(f32, f32) -> f32, what: &str| {
+            let v = get(v);
+            for i in 0..n {
+                assert_eq!(v[i].to_bits(), f(a[i], b[i]).to_bits(), "{what}({}, {})", a[i], b[i]);
+            }
+        };
+        same(x + y, &|p, q| p + q, "+");
+        same(x - y, &|p, q| p - q, "-");
+        same(x * y, &|p, q| p * q, "*");
+        same(x / y, &|p, q| p / q, "/");
+        same(x + 0.25, &|p, _| p + 0.25, "+ f32");
+        same(x - 3.0, &|p, _| p - 3.0, "- f32");
+        same(x * 1.5, &|p, _| p * 1.5, "* f32");
+        same(x / 3.0, &|p, _| p / 3.0, "/ f32");
+        same(-x, &|p, _| -p, "neg");
+        same(x.abs(), &|p, _| p.abs(), "abs");
+        same(x.sqrt(), &|p, _| p.sqrt(), "sqrt");
+        same(x.min(y), &Real::min, "min");
+        same(x.max(y), &Real::max, "max");
+        same(x.clamp(0.0, 1.0), &|p, _| p.clamp(0.0, 1.0), "clamp");
+        same(x.mul_add(y, x), &|p, q| p.mul_add(q, p), "mul_add");
+        same(x.round(), &|p, _| p.round(), "round");
+        same(x.map(|v| v * 2.0 + 1.0), &|p, _| p * 2.0 + 1.0, "map");
+        same(R::select(x.lt(y), x, y), &|p, q| if p < q { p } else { q }, "select");
+        let mask = |m: R::Mask, f: &dyn Fn(f32, f32) -> bool, what: &str| {
+            let mut o = vec![false; n];
+            R::store_mask(m, &mut o);
+            for i in 0..n {
+                assert_eq!(o[i], f(a[i], b[i]), "{what}({}, {})", a[i], b[i]);
+            }
+        };
+        mask(x.lt(y), &|p, q| p < q, "<");
+        mask(x.le(y), &|p, q| p <= q, "<=");
+        mask(x.gt(y), &|p, q| p > q, ">");
+        mask(x.ge(y), &|p, q| p >= q, ">=");
+        mask(x.eq(y), &|p, q| p == q, "==");
+        mask(x.ne(y), &|p, q| p != q, "!=");
+        mask(x.is_finite(), &|p, _| p.is_finite(), "is_finite");
+        mask(x.is_nan(), &|p, _| p.is_nan(), "is_nan");
+        mask(!x.lt(y) & x.is_finite() | y.is_nan(), &|p, q| !(p < q) && p.is_finite() || q.is_nan(), "mask logic");
+        assert_eq!(R::any(x.is_nan() | y.is_nan()), a.iter().chain(&b).any(|v| v.is_nan()));
+        assert!(!R::any(x.is_nan() & x.is_finite()));
+    }
+    // `round` at and between halves, near 2²³ and beyond.
+    let mut xs: Vec<f32> = (-4000..=4000).map(|i| i as f32 / 8.0).collect();
+    xs.extend([0.499_999_97, -0.499_999_97, 8_388_607.5, -8_388_607.5, 16_777_217.0, 1e30, -1e-40, 1e-40]);
+    // `lerp_table` across and beyond [0, 1], at its nodes.
+    let table: [f32; 64] = std::array::from_fn(|k| ((k as f32) * 0.37).sin() + 1.5);
+    let mut ts: Vec<f32> = (0..=6400).map(|i| i as f32 / 6400.0).collect();
+    ts.extend((0..64).map(|k| k as f32 / 63.0));
+    ts.extend([-1.0, -0.0, 1.0, 1.0 + f32::EPSILON, 2.0, f32::NAN, f32::INFINITY, f32::NEG_INFINITY, 1e-30, 0.999_999_9]);
+    // And a table of another size (the AVX-512 lanes look a table of 64 up by permutes, others by gathers).
+    let short: [f32; 33] = std::array::from_fn(|k| ((k as f32) * 0.61).cos() + 2.5);
+    let mut ts_short = ts.clone();
+    let round = (&|v: R| v.round()) as &dyn Fn(R) -> R;
+    let lookup = (&|v: R| v.lerp_table(&table)) as &dyn Fn(R) -> R;
+    let lookup_short = (&|v: R| v.lerp_table(&short)) as &dyn Fn(R) -> R;
+    for (xs, lanes, one) in [
+        (&mut xs, round, (&|v: f32| v.round()) as &dyn Fn(f32) -> f32),
+        (&mut ts, lookup, &|v: f32| v.lerp_table(&table)),
+        (&mut ts_short, lookup_short, &|v: f32| v.lerp_table(&short)),
+    ] {
+        while xs.len() % n != 0 {
+            xs.push(0.5);
+        }
+        for c in xs.chunks_exact(n) {
+            let got = get(lanes(R::load(c)));
+            for (l, &x) in c.iter().enumerate() {
+                assert_eq!(got[l].to_bits(), one(x).to_bits(), "lane {l}: {x}");
+            }
+        }
+    }
+    // Rows in and out.
+    let v: Vec<Vec3> = (0..n).map(|i| Vec3::new(i as f32, -(i as f32) - 0.5, 100.0 + i as f32)).collect();
+    let l = R::load3(&v);
+    let (x, y, z) = (get(l.x), get(l.y), get(l.z));
+    for i in 0..n {
+        assert_eq!(Vec3::new(x[i], y[i], z[i]), v[i]);
+    }
+    let mut back = vec![[0.0; 3]; n];
+    R::store3(l.x, l.y, l.z, &mut back);
+    assert!(back.iter().zip(&v).all(|(b, w)| *b == w.to_array()));
+    let w: Vec<Vec2> = (0..n).map(|i| Vec2::new(i as f32 + 0.25, -(i as f32))).collect();
+    let (x, y) = R::load2(&w);
+    let (x, y) = (get(x), get(y));
+    assert!((0..n).all(|i| Vec2::new(x[i], y[i]) == w[i]));
+    let flags: Vec<f32> = (0..n).map(|i| [0.0, 1.0, 5.0, 9.0, 16.0, 31.0, 3.0][i % 7]).collect();
+    let mut out = vec![7; n];
+    R::load(&flags).store_u32(&mut out);
+    assert!(out.iter().zip(&flags).all(|(&o, &f)| o == f as u32));
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    /// Every operation of `F32x8` is the `f32` operation per lane, bit for bit, NaN and infinities included.
     #[test]
-    fn lanes_are_scalar_operations() {
-        let a = [0.5f32, -1.5, 0.0, -0.0, f32::INFINITY, f32::NAN, 3.0e-39, 2.5];
-        let b = [2.0f32, -1.5, -0.0, 1.0, 1.0, 0.5, -7.0, f32::NEG_INFINITY];
-        let (x, y) = (F32x8(a), F32x8(b));
-        let same = |l: F32x8, f: &dyn Fn(f32, f32) -> f32| (0..8).all(|i| l.0[i].to_bits() == f(a[i], b[i]).to_bits());
-        assert!(same(x + y, &|p, q| p + q) && same(x - y, &|p, q| p - q) && same(x * y, &|p, q| p * q));
-        assert!(same(x / y, &|p, q| p / q) && same(x.min(y), &f32::min) && same(x.max(y), &f32::max));
-        assert!(
-            same(x.sqrt(), &|p, _| p.sqrt()) && same(x.round(), &|p, _| p.round()) && same(x.clamp(0.0, 1.0), &|p, _| p.clamp(0.0, 1.0))
-        );
-        assert!(same(x.mul_add(y, x), &|p, q| p.mul_add(q, p)) && same(-x, &|p, _| -p) && same(x.abs(), &|p, _| p.abs()));
-        let mask = |m: M32x8, f: &dyn Fn(f32, f32) -> bool| (0..8).all(|i| m.get(i) == f(a[i], b[i]));
-        assert!(mask(x.lt(y), &|p, q| p < q) && mask(x.le(y), &|p, q| p <= q) && mask(x.gt(y), &|p, q| p > q));
-        assert!(mask(x.ge(y), &|p, q| p >= q) && mask(x.eq(y), &|p, q| p == q) && mask(x.ne(y), &|p, q| p != q));
-        assert!(mask(x.is_finite(), &|p, _| p.is_finite()) && mask(x.is_nan(), &|p, _| p.is_nan()));
-        assert!(same(F32x8::select(x.lt(y), x, y), &|p, q| if p < q { p } else { q }));
-        assert!(F32x8::any(x.lt(y)) && !F32x8::any(x.is_nan() & x.is_finite()));
+    fn f32x8_is_a_lane_type() {
+        check_lane_type::<F32x8>();
+    }
+
+    /// `Real::min` and `max` on `f32` are what `f32::min(x, c)` and `max` with a constant `c` (the form the
+    /// kernels use) give, ties of ±0 and NaN included.
+    #[test]
+    fn min_and_max_are_std_with_constants() {
+        use std::hint::black_box;
+        for x in [-0.0f32, 0.0, 1.0, -1.0, 0.5, f32::NAN, f32::INFINITY, f32::NEG_INFINITY, 1e-40] {
+            let x = black_box(x);
+            for (real, std) in [
+                (Real::max(x, 0.0), x.max(0.0)),
+                (Real::min(x, 0.0), x.min(0.0)),
+                (Real::min(x, 1.0), x.min(1.0)),
+                (Real::max(x, -0.0), x.max(-0.0)),
+                (Real::min(x, -0.0), x.min(-0.0)),
+            ] {
+                assert_eq!(real.to_bits(), std.to_bits(), "{x}");
+            }
+        }
     }
 }
