@@ -2,6 +2,7 @@
 
 pub mod frame;
 pub mod lanes;
+pub mod simd;
 pub mod spherical;
 pub mod transform;
 pub mod trig;
