@@ -1,15 +1,14 @@
 //! The render loop: passes of a few samples per pixel over 16×16 tiles on rayon's threads.
 //!
 //! Deterministic for a seed whatever the number of threads: sample `k` of pixel `i` draws from its own PCG32
-//! stream, `Pcg32::new(mix(seed, k), i)`, and every pixel sums its samples in order. Cancellation (the
+//! stream ([`integrator::start`]), and every pixel sums its samples in order. Cancellation (the
 //! `cancel` flag, e.g. set by Ctrl-C) is checked between tiles; the pass in flight is dropped, so the image
 //! holds exactly `spp_done` samples in every pixel.
 
 use crate::film::Film;
-use crate::integrator;
-use crate::sampling::Pcg32;
+use crate::integrator::{self, CameraSample};
 use crate::scene::Scene;
-use glam::Vec2;
+use crate::spectrum::Rgb;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::Instant;
@@ -30,14 +29,6 @@ pub struct RenderOutput {
     pub nonfinite: u64,
     pub cancelled: bool,
     pub seconds: f64,
-}
-
-/// Mix a seed and a sample index into a PCG32 seed (the SplitMix64 finaliser, Steele et al. 2014).
-fn mix(seed: u64, sample: u64) -> u64 {
-    let mut z = seed.wrapping_add(sample.wrapping_mul(0x9e37_79b9_7f4a_7c15));
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^ (z >> 31)
 }
 
 /// Render `spp` samples per pixel with `seed`. `progress(samples_done)` is called after every tile
@@ -64,18 +55,16 @@ pub fn render(scene: &Scene, spp: u32, seed: u64, cancel: &AtomicBool, progress:
                 let (tw, th) = (TILE.min(w - x0), TILE.min(h - y0));
                 let mut tile = Film::new(tw, th);
                 let mut bad = 0;
-                for y in y0..y0 + th {
-                    for x in x0..x0 + tw {
-                        let pixel = u64::from(y) * u64::from(w) + u64::from(x);
-                        let local = ((y - y0) * tw + (x - x0)) as usize;
-                        for k in first..first + n {
-                            let mut rng = Pcg32::new(mix(seed, u64::from(k)), pixel);
-                            let s = Vec2::new((x as f32 + rng.next_f32()) / w as f32, (y as f32 + rng.next_f32()) / h as f32);
-                            let ray = scene.camera.ray(s);
-                            if !tile.add(local, integrator::radiance(scene, &ray, &mut rng)) {
-                                bad += 1;
-                            }
-                        }
+                // The tile's camera samples, pixel by pixel and sample by sample within a pixel; the integrator
+                // may trace them in any order (several at once), and the film sums them in this one.
+                let samples: Vec<CameraSample> = (y0..y0 + th)
+                    .flat_map(|y| (x0..x0 + tw).flat_map(move |x| (first..first + n).map(move |k| CameraSample { x, y, k })))
+                    .collect();
+                let mut radiance = vec![Rgb::ZERO; samples.len()];
+                integrator::radiance(scene, seed, &samples, &mut radiance);
+                for (s, &l) in samples.iter().zip(&radiance) {
+                    if !tile.add(((s.y - y0) * tw + (s.x - x0)) as usize, l) {
+                        bad += 1;
                     }
                 }
                 nonfinite.fetch_add(bad, Ordering::Relaxed);

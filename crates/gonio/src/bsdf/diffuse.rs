@@ -84,25 +84,43 @@ impl Diffuse {
 impl LaneModel for Diffuse {
     #[inline(always)]
     fn f_lanes<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> [R; 3] {
-        let zero = R::splat(0.0);
-        let below = wo.z.le(zero) | wi.z.le(zero);
-        channels!(|c| R::select(below, zero, R::splat(self.reflectance.0[c] * FRAC_1_PI)))
+        diffuse_f(channels!(|c| R::splat(self.reflectance.0[c])), wo, wi)
     }
 
     #[inline(always)]
     fn pdf_lanes<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> R {
-        R::select(wo.z.le(R::splat(0.0)), R::splat(0.0), cosine_hemisphere_density(wi.z))
+        diffuse_pdf(wo, wi)
     }
 
     #[inline(always)]
     fn sample_lanes<R: Real>(&self, wo: V3<R>, _uc: R, ux: R, uy: R) -> LaneSample<R> {
-        let wi = cosine_hemisphere(ux, uy);
-        let pdf = cosine_hemisphere_density(wi.z);
-        // pdf is finite; a sample wherever it is positive (not on the horizon).
-        let valid = !wo.z.le(R::splat(0.0)) & pdf.gt(R::splat(0.0));
-        let f = channels!(|c| R::splat(self.reflectance.0[c] * FRAC_1_PI));
-        // f·cos/pdf = (ρ/π)·cos/(cos/π) = ρ: set exactly rather than through a division.
-        let weight = channels!(|c| R::splat(self.reflectance.0[c]));
-        LaneSample { wi, f, pdf, weight, flags: flag_lanes(BsdfFlags::DIFFUSE_REFLECTION), eta: R::splat(1.0), valid }
+        diffuse_sample(channels!(|c| R::splat(self.reflectance.0[c])), wo, ux, uy)
     }
+}
+
+/// The Lambertian `f` with a reflectance per lane (the kernel of [`Diffuse`], and of the renderer's packets,
+/// whose lanes hit different diffuse surfaces).
+#[inline(always)]
+pub fn diffuse_f<R: Real>(reflectance: [R; 3], wo: V3<R>, wi: V3<R>) -> [R; 3] {
+    let zero = R::splat(0.0);
+    let below = wo.z.le(zero) | wi.z.le(zero);
+    channels!(|c| R::select(below, zero, reflectance[c] * FRAC_1_PI))
+}
+
+/// The Lambertian `pdf` (it does not depend on the reflectance).
+#[inline(always)]
+pub fn diffuse_pdf<R: Real>(wo: V3<R>, wi: V3<R>) -> R {
+    R::select(wo.z.le(R::splat(0.0)), R::splat(0.0), cosine_hemisphere_density(wi.z))
+}
+
+/// The Lambertian `sample` with a reflectance per lane.
+#[inline(always)]
+pub fn diffuse_sample<R: Real>(reflectance: [R; 3], wo: V3<R>, ux: R, uy: R) -> LaneSample<R> {
+    let wi = cosine_hemisphere(ux, uy);
+    let pdf = cosine_hemisphere_density(wi.z);
+    // pdf is finite; a sample wherever it is positive (not on the horizon).
+    let valid = !wo.z.le(R::splat(0.0)) & pdf.gt(R::splat(0.0));
+    let f = channels!(|c| reflectance[c] * FRAC_1_PI);
+    // f·cos/pdf = (ρ/π)·cos/(cos/π) = ρ: set exactly rather than through a division.
+    LaneSample { wi, f, pdf, weight: reflectance, flags: flag_lanes(BsdfFlags::DIFFUSE_REFLECTION), eta: R::splat(1.0), valid }
 }

@@ -61,7 +61,7 @@ mod tests {
         for d in [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z] {
             let r = Ray::new(d * 3.0, -d, 10.0);
             let (tri, h) = (0..12).filter_map(|t| c.intersect(t, &r).map(|h| (t, h))).min_by(|a, b| a.1.t.total_cmp(&b.1.t)).unwrap();
-            assert!((c.interaction(tri, &r, &h).n - d).length() < 1e-6, "{d}");
+            assert!((c.interaction(tri, &r, &h, true).n - d).length() < 1e-6, "{d}");
         }
     }
 
@@ -70,6 +70,6 @@ mod tests {
         let r = rectangle(&Transform::scale(Vec3::new(-1.0, 1.0, 1.0)).unwrap(), false, "t").unwrap();
         let ray = Ray::new(Vec3::new(0.1, 0.1, 1.0), -Vec3::Z, 10.0);
         let (tri, h) = (0..2).find_map(|t| r.intersect(t, &ray).map(|h| (t, h))).unwrap();
-        assert!((r.interaction(tri, &ray, &h).n - Vec3::Z).length() < 1e-6);
+        assert!((r.interaction(tri, &ray, &h, true).n - Vec3::Z).length() < 1e-6);
     }
 }

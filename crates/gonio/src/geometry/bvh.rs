@@ -1,44 +1,52 @@
-//! A 4-wide bounding volume hierarchy over primitive bounds.
+//! An 8-wide bounding volume hierarchy over primitive bounds.
 //!
 //! Built in two steps:
 //! 1. a binary tree with the binned surface area heuristic (Wald 2007, "On fast Construction of SAH-based
 //!    Bounding Volume Hierarchies", §3: 16 bins over the centroid extent; all three axes for small sets), whose leaf cost counts
-//!    primitives in packets of [`LANES`] because leaves are intersected four at a time;
-//! 2. collapsed into nodes of four children (Dammertz et al. 2008, "Shallow Bounding Volume Hierarchies
+//!    primitives in packets of [`LANES`] because leaves are intersected eight at a time;
+//! 2. collapsed into nodes of eight children (Dammertz et al. 2008, "Shallow Bounding Volume Hierarchies
 //!    for Fast SIMD Ray Tracing of Incoherent Rays"; Wald et al. 2008, "Getting Rid of Packets"): each
-//!    node pulls up the grandchildren of its largest child until it has four.
+//!    node pulls up the grandchildren of its largest child until it has eight.
 //!
-//! A node stores its children's boxes as structure-of-arrays `Vec4`s so that one ray is tested against
-//! all four boxes at once (SSE through glam on x86-64), choosing the near and far slab planes by the
-//! sign of the ray direction once per ray (Williams et al. 2005, "An Efficient and Robust Ray–Box
-//! Intersection Algorithm").
+//! A node stores its children's boxes as structure-of-arrays `[f32; 8]` rows so that one ray is tested
+//! against all eight boxes at once (one AVX register per row where the build targets AVX, two SSE
+//! registers otherwise), choosing the near and far slab planes by the sign of the ray direction once per
+//! ray (Williams et al. 2005, "An Efficient and Robust Ray–Box Intersection Algorithm").
 //!
 //! Leaves start at a multiple of [`LANES`] in the primitive order ([`Bvh::order`] holds [`EMPTY_SLOT`]
-//! in the padding), so that callers can keep primitive data in leaf order as packets of four.
+//! in the padding), so that callers can keep primitive data in leaf order as packets of eight.
 //!
 //! Traversal is geometry-agnostic: the caller passes a closure that intersects the primitives of one
 //! leaf (a range of slots) with the ray, as obvhs does. Children are visited nearest first (by box entry
 //! distance); farther ones are culled when a closer hit has been found by the time they are popped.
 //!
+//! The path tracer traces its rays eight at a time ([`Bvh::closest_rays`], [`Bvh::any_rays`]): each child
+//! box is tested against the packet's rays in lanes, and the packet descends with the lanes that enter it;
+//! a subtree that at most `ALONE_BELOW` rays reach is finished by each ray alone (Benthin et al. 2012).
+//! The leaves are the caller's ([`PacketLeaves`]), for rays in lanes or one by one.
+//!
 //! # Against a crate (2026-11)
-//! `bench/bvh_compare` (a standalone crate, run by hand) sets this BVH against obvhs 0.4 (compressed 8-wide
-//! BVH, PLOC build) on the same triangles and rays, single-threaded: on the Cornell box and on spheres of
-//! 10³…10⁶ triangles this one answered closest-hit queries (interaction included) 1.25–2.2× and occlusion
-//! queries 1.2–2.2× faster, and built 10⁵–10⁶ triangles in about 0.8× obvhs' time, with the same hits. So
-//! gonio keeps its own: its leaves test four triangles at once and store them inline in leaf order.
+//! `bench/bvh_compare` (a standalone crate, run by hand) set the 4-wide predecessor of this BVH against
+//! obvhs 0.4 (compressed 8-wide BVH, PLOC build) on the same triangles and rays, single-threaded: on the
+//! Cornell box and on spheres of 10³…10⁶ triangles it answered closest-hit queries (interaction included)
+//! 1.25–2.2× and occlusion queries 1.2–2.2× faster, and built 10⁵–10⁶ triangles in about 0.8× obvhs'
+//! time, with the same hits. So gonio keeps its own: its leaves test eight primitives at once and store
+//! them inline in leaf order.
 
+use super::ray::RayLanes;
 use super::{Bounds3, Ray};
-use glam::{Vec3, Vec4};
+use crate::math::simd::{Float8, Mask8};
+use glam::Vec3;
 use std::mem::MaybeUninit;
 
 /// Primitives per packet, and the number of children of a node.
-pub const LANES: usize = 4;
+pub const LANES: usize = 8;
 /// The primitive index of padding slots in [`Bvh::order`].
 pub const EMPTY_SLOT: u32 = u32::MAX;
 /// Number of SAH bins.
 const BINS: usize = 16;
-/// Leaves hold at most this many primitives (two packets).
-const MAX_LEAF: usize = 8;
+/// Leaves hold at most this many primitives (one packet).
+const MAX_LEAF: usize = LANES;
 /// Relative cost of a (binary) traversal step against one packet test. 2026-11: 1 measured fastest
 /// among 0.25, 0.5, 1, 2 on the Cornell box (within the noise of this shared machine on a 10⁵-triangle
 /// sphere).
@@ -48,9 +56,9 @@ const ALL_AXES_BELOW: usize = 4096;
 /// Above this depth the binary build splits at the median, which bounds the tree depth by
 /// `MAX_SAH_DEPTH + log2(n)` and so the traversal stack.
 const MAX_SAH_DEPTH: usize = 48;
-/// Traversal stack entries: a node pushes at most three, and the tree is at most
+/// Traversal stack entries: a node pushes at most seven, and the tree is at most
 /// `MAX_SAH_DEPTH + 32` deep.
-const STACK: usize = 3 * (MAX_SAH_DEPTH + 32) + 4;
+const STACK: usize = 7 * (MAX_SAH_DEPTH + 32) + 8;
 
 /// Child reference of an empty lane.
 const EMPTY_CHILD: u32 = u32::MAX;
@@ -59,13 +67,14 @@ const EMPTY_CHILD: u32 = u32::MAX;
 const LEAF_BIT: u32 = 1 << 31;
 const PACKET_BITS: u32 = 28;
 
-/// Four children: boxes as `bounds[0]` = (min x, min y, min z), `bounds[1]` = (max x, max y, max z),
-/// each a `Vec4` over the children. Empty lanes have the inverted box (min +∞, max −∞), which the
-/// sign-selected slab test never hits. 112 bytes.
+/// Eight children: `bounds[side][axis][lane]` is the box of child `lane`, side 0 its minimum and 1 its
+/// maximum. Empty lanes have the inverted box (min +∞, max −∞), which the sign-selected slab test never
+/// hits. 224 bytes, aligned to 32 so that each row is one aligned 256-bit load.
 #[derive(Clone, Copy, Debug)]
-struct Node4 {
-    bounds: [[Vec4; 3]; 2],
-    child: [u32; 4],
+#[repr(C, align(32))]
+struct Node8 {
+    bounds: [[[f32; LANES]; 3]; 2],
+    child: [u32; LANES],
 }
 
 /// A binary node during construction.
@@ -78,10 +87,10 @@ struct BinNode {
     count: u32,
 }
 
-/// The hierarchy: 4-wide nodes, and the permutation of primitive indices its leaves refer to.
+/// The hierarchy: 8-wide nodes, and the permutation of primitive indices its leaves refer to.
 #[derive(Clone, Debug, Default)]
 pub struct Bvh {
-    nodes: Vec<Node4>,
+    nodes: Vec<Node8>,
     order: Vec<u32>,
 }
 
@@ -91,11 +100,11 @@ struct BuildPrim {
     index: u32,
 }
 
-/// The ray as the 4-wide box test wants it: splatted origin and inverse direction, and for each axis
-/// which of `bounds[0]` / `bounds[1]` holds the near plane.
+/// The ray as the box test wants it: origin and inverse direction, splatted, and for each axis which of
+/// `bounds[0]` / `bounds[1]` holds the near plane.
 struct RayPre {
-    o: [Vec4; 3],
-    inv_d: [Vec4; 3],
+    o: [Float8; 3],
+    inv_d: [Float8; 3],
     near: [usize; 3],
 }
 
@@ -105,26 +114,43 @@ impl RayPre {
         let inv_d = ray.d.recip();
         let near = |v: f32| usize::from(v.is_sign_negative());
         RayPre {
-            o: [Vec4::splat(ray.o.x), Vec4::splat(ray.o.y), Vec4::splat(ray.o.z)],
-            inv_d: [Vec4::splat(inv_d.x), Vec4::splat(inv_d.y), Vec4::splat(inv_d.z)],
+            o: [Float8::splat(ray.o.x), Float8::splat(ray.o.y), Float8::splat(ray.o.z)],
+            inv_d: [Float8::splat(inv_d.x), Float8::splat(inv_d.y), Float8::splat(inv_d.z)],
             near: [near(inv_d.x), near(inv_d.y), near(inv_d.z)],
         }
     }
 }
 
-impl Node4 {
-    const EMPTY: Node4 = Node4 { bounds: [[Vec4::INFINITY; 3], [Vec4::NEG_INFINITY; 3]], child: [EMPTY_CHILD; 4] };
+impl Node8 {
+    const EMPTY: Node8 = Node8 { bounds: [[[f32::INFINITY; LANES]; 3], [[f32::NEG_INFINITY; LANES]; 3]], child: [EMPTY_CHILD; LANES] };
 
-    /// Which children the ray enters within (0, tmax) (bit i for child i), and their entry distances.
-    /// A NaN slab (0 · ∞ for a ray in a slab's plane) is ignored, which only widens the interval: the
-    /// slab's value is the first operand of `max`/`min`, and SSE's max/min return the second operand
-    /// when either is NaN.
+    /// Which children the ray enters within (0, tmax) (bit i for child i), and their entry
+    /// distances. A NaN slab (0 · ∞ for a ray in a slab's plane) is ignored, which only widens the
+    /// interval: the slab's value is the first operand of `max_or_second` / `min_or_second`, which return
+    /// the second where either is NaN.
     #[inline(always)]
-    fn hit(&self, r: &RayPre, tmax: f32) -> (u32, Vec4) {
-        let slab = |axis: usize, side: usize| (self.bounds[side][axis] - r.o[axis]) * r.inv_d[axis];
-        let tnear = slab(0, r.near[0]).max(slab(1, r.near[1]).max(slab(2, r.near[2]).max(Vec4::ZERO)));
-        let tfar = slab(0, 1 - r.near[0]).min(slab(1, 1 - r.near[1]).min(slab(2, 1 - r.near[2]).min(Vec4::splat(tmax))));
-        (tnear.cmple(tfar).bitmask(), tnear)
+    fn hit(&self, r: &RayPre, tmax: Float8) -> (u32, Float8) {
+        let near = |axis: usize| r.near[axis];
+        let slab = |axis: usize, side: usize| Float8::load(&self.bounds[side][axis]).sub(r.o[axis]).mul(r.inv_d[axis]);
+        let tnear = slab(0, near(0)).max_or_second(slab(1, near(1)).max_or_second(slab(2, near(2)).max_or_second(Float8::splat(0.0))));
+        let tfar = slab(0, 1 - near(0)).min_or_second(slab(1, 1 - near(1)).min_or_second(slab(2, 1 - near(2)).min_or_second(tmax)));
+        (tnear.le(tfar).bitmask(), tnear)
+    }
+}
+
+impl Node8 {
+    /// Child `c`'s box against eight rays: the lanes entering it within (0, tmax) and their entry distances,
+    /// by the operations of [`Node8::hit`] in each lane.
+    #[inline(always)]
+    fn hit_rays(&self, c: usize, r: &PacketPre, tmax: Float8) -> (Mask8, Float8) {
+        let slab = |axis: usize, near: bool| {
+            let (lo, hi) = (Float8::splat(self.bounds[0][axis][c]), Float8::splat(self.bounds[1][axis][c]));
+            let plane = if near { Float8::select(r.neg[axis], hi, lo) } else { Float8::select(r.neg[axis], lo, hi) };
+            plane.sub(r.o[axis]).mul(r.inv_d[axis])
+        };
+        let tnear = slab(0, true).max_or_second(slab(1, true).max_or_second(slab(2, true).max_or_second(Float8::splat(0.0))));
+        let tfar = slab(0, false).min_or_second(slab(1, false).min_or_second(slab(2, false).min_or_second(tmax)));
+        (tnear.le(tfar), tnear)
     }
 }
 
@@ -151,11 +177,11 @@ impl Bvh {
         while builder.order.len() % LANES != 0 {
             builder.order.push(EMPTY_SLOT);
         }
-        let mut bvh = Bvh { nodes: Vec::with_capacity(builder.nodes.len() / 2 + 1), order: builder.order };
+        let mut bvh = Bvh { nodes: Vec::with_capacity(builder.nodes.len() / 4 + 1), order: builder.order };
         let bin = &builder.nodes;
         if bin[0].count > 0 {
             // A single leaf: a root with one child.
-            let mut root = Node4::EMPTY;
+            let mut root = Node8::EMPTY;
             Self::set_lane(&mut root, 0, bin[0].bounds, Self::leaf_ref(&bin[0]));
             bvh.nodes.push(root);
         } else {
@@ -171,7 +197,7 @@ impl Bvh {
         LEAF_BIT | ((packets - 1) << PACKET_BITS) | first_packet
     }
 
-    fn set_lane(node: &mut Node4, lane: usize, b: Bounds3, child: u32) {
+    fn set_lane(node: &mut Node8, lane: usize, b: Bounds3, child: u32) {
         for axis in 0..3 {
             node.bounds[0][axis][lane] = b.min[axis];
             node.bounds[1][axis][lane] = b.max[axis];
@@ -179,11 +205,11 @@ impl Bvh {
         node.child[lane] = child;
     }
 
-    /// Turn the interior binary node `i` (and its subtree) into 4-wide nodes; returns the node index.
+    /// Turn the interior binary node `i` (and its subtree) into 8-wide nodes; returns the node index.
     fn collapse(&mut self, bin: &[BinNode], i: usize) -> u32 {
         let children_of = |i: usize| [i + 1, bin[i].offset as usize];
         let mut kids: Vec<usize> = children_of(i).to_vec();
-        // Open the interior child of largest surface area until there are four children.
+        // Open the interior child of largest surface area until there are eight children.
         while kids.len() < LANES {
             let Some(k) = (0..kids.len())
                 .filter(|&k| bin[kids[k]].count == 0)
@@ -195,7 +221,7 @@ impl Bvh {
             kids.extend(children_of(opened));
         }
         let me = self.nodes.len();
-        self.nodes.push(Node4::EMPTY);
+        self.nodes.push(Node8::EMPTY);
         for (lane, &k) in kids.iter().enumerate() {
             let child = if bin[k].count > 0 { Self::leaf_ref(&bin[k]) } else { self.collapse(bin, k) };
             let mut node = self.nodes[me];
@@ -220,7 +246,31 @@ impl Bvh {
         &self.order
     }
 
-    /// Number of 4-wide nodes (for statistics).
+    /// The tree as text (debugging): per node, its children as `L<first packet>x<packets>` or `N<node>`.
+    #[must_use]
+    pub fn describe(&self) -> String {
+        let mut out = String::new();
+        for (i, n) in self.nodes.iter().enumerate() {
+            out += &format!("node {i}:");
+            for lane in 0..LANES {
+                let c = n.child[lane];
+                if c == EMPTY_CHILD {
+                    continue;
+                }
+                if c & LEAF_BIT != 0 {
+                    let (first, count) = leaf_range(c);
+                    let filled = (first..first + count).filter(|&s| self.order[s as usize] != EMPTY_SLOT).count();
+                    out += &format!(" L{}({filled})", first / LANES as u32);
+                } else {
+                    out += &format!(" N{c}");
+                }
+            }
+            out += "\n";
+        }
+        out
+    }
+
+    /// Number of 8-wide nodes (for statistics).
     #[must_use]
     pub fn node_count(&self) -> usize {
         self.nodes.len()
@@ -230,107 +280,356 @@ impl Bvh {
     /// slots may be padding) and returns the distance of its closest hit below `tmax` with whatever the
     /// caller wants back. Returns that for the closest hit overall.
     #[inline]
-    pub fn closest<H>(&self, ray: &Ray, mut leaf: impl FnMut(u32, u32, f32) -> Option<(f32, H)>) -> Option<H> {
-        let mut best = None;
+    pub fn closest<H>(&self, ray: &Ray, leaf: impl FnMut(u32, u32, f32) -> Option<(f32, H)>) -> Option<H> {
         if self.nodes.is_empty() {
-            return best;
+            return None;
         }
-        let pre = RayPre::new(ray);
-        let mut tmax = ray.tmax;
-        let mut stack = [MaybeUninit::<(u32, f32)>::uninit(); STACK];
+        closest_from(self, 0, ray, leaf)
+    }
+
+    /// Whether any primitive is hit: `leaf(first_slot, slot_count)` tests the primitives of one leaf
+    /// against the ray's full extent.
+    #[inline]
+    pub fn any(&self, ray: &Ray, leaf: impl FnMut(u32, u32) -> bool) -> bool {
+        if self.nodes.is_empty() {
+            return false;
+        }
+        any_from(self, 0, ray, leaf)
+    }
+
+    /// The closest hits of eight rays (the lanes of `rays` whose bit is set in `lanes`), traversed together
+    /// (see [`PacketLeaves`] and the module doc): each lane's hit as its distance and slot ([`EMPTY_SLOT`]
+    /// where nothing is hit below its `tmax`).
+    #[inline]
+    pub fn closest_rays<L: PacketLeaves>(&self, rays: &RayLanes<Float8>, lanes: u32, leaves: &L) -> Hits8 {
+        let mut hits = Hits8 { t: rays.tmax, slot: [EMPTY_SLOT; PACKET] };
+        if self.nodes.is_empty() || lanes == 0 {
+            return hits;
+        }
+        let pre = PacketPre::new(rays);
+        let each = each_ray(rays);
+        // (node, lanes, the smallest entry distance among them).
+        let mut stack = [MaybeUninit::<(u32, u32, f32)>::uninit(); STACK];
         let mut sp = 0usize;
-        let mut cur = 0u32;
+        let (mut cur, mut active) = (0u32, lanes);
         'visit: loop {
-            if cur & LEAF_BIT != 0 {
-                let (first, count) = leaf_range(cur);
-                if let Some((t, h)) = leaf(first, count, tmax) {
-                    tmax = t;
-                    best = Some(h);
+            if active.count_ones() <= ALONE_BELOW {
+                // Few rays left here: each finishes the subtree alone.
+                let mut t = hits.t.to_array();
+                for lane in bits(active) {
+                    let ray = &each[lane];
+                    if let Some((tl, slot)) =
+                        closest_from_t(self, cur, ray, t[lane], |first, count, tmax| leaves.closest_ray(ray, first, count, tmax))
+                    {
+                        t[lane] = tl;
+                        hits.slot[lane] = slot;
+                    }
                 }
+                hits.t = Float8::load(&t);
+            } else if cur & LEAF_BIT != 0 {
+                let (first, count) = leaf_range(cur);
+                leaves.closest_rays(rays, &each, first, count, active, &mut hits);
             } else {
                 let node = &self.nodes[cur as usize];
-                let (mask, tnear) = node.hit(&pre, tmax);
-                if mask != 0 {
-                    let tnear = tnear.to_array();
-                    if mask & (mask - 1) == 0 {
-                        cur = node.child[mask.trailing_zeros() as usize];
-                        continue 'visit;
+                // The children the rays enter, nearest (by the smallest entry distance of their rays) first.
+                let mut kids = [(0u32, 0u32, 0.0f32); LANES];
+                let mut n = 0;
+                for c in 0..LANES {
+                    let child = node.child[c];
+                    if child == EMPTY_CHILD {
+                        break;
                     }
-                    // Sort the hit children by entry distance (at most four: insertion sort).
-                    let mut hits = [(0u32, 0.0f32); LANES];
-                    let mut n = 0;
-                    let mut m = mask;
-                    while m != 0 {
-                        let lane = m.trailing_zeros() as usize;
-                        m &= m - 1;
-                        let entry = (node.child[lane], tnear[lane]);
-                        let mut j = n;
-                        while j > 0 && hits[j - 1].1 > entry.1 {
-                            hits[j] = hits[j - 1];
-                            j -= 1;
-                        }
-                        hits[j] = entry;
-                        n += 1;
+                    let (hit, tnear) = node.hit_rays(c, &pre, hits.t);
+                    let m = hit.bitmask() & active;
+                    if m == 0 {
+                        continue;
                     }
-                    // Push the farther ones, farthest first; go on with the nearest.
-                    for &h in hits[1..n].iter().rev() {
-                        stack[sp].write(h);
+                    let dist = Float8::select(Mask8::from_bitmask(m), tnear, Float8::splat(f32::INFINITY)).min_lane();
+                    let mut j = n;
+                    while j > 0 && kids[j - 1].2 > dist {
+                        kids[j] = kids[j - 1];
+                        j -= 1;
+                    }
+                    kids[j] = (child, m, dist);
+                    n += 1;
+                }
+                if n > 0 {
+                    for &k in kids[1..n].iter().rev() {
+                        stack[sp].write(k);
                         sp += 1;
                     }
-                    cur = hits[0].0;
+                    (cur, active) = (kids[0].0, kids[0].1);
                     continue 'visit;
                 }
             }
-            // Pop the next child that can still hold a hit closer than tmax.
+            // Pop the next subtree, with the lanes that can still find a closer hit in it.
             loop {
                 if sp == 0 {
-                    return best;
+                    return hits;
                 }
                 sp -= 1;
                 // SAFETY: entries below `sp` were written by the pushes above.
-                let (r, tnear) = unsafe { stack[sp].assume_init() };
-                if tnear <= tmax {
-                    cur = r;
+                let (node, m, dist) = unsafe { stack[sp].assume_init() };
+                let m = m & hits.t.ge(Float8::splat(dist)).bitmask();
+                if m != 0 {
+                    (cur, active) = (node, m);
                     continue 'visit;
                 }
             }
         }
     }
 
-    /// Whether any primitive is hit: `leaf(first_slot, slot_count)` tests the primitives of one leaf
-    /// against the ray's full extent.
+    /// Which of eight rays (the lanes of `rays` set in `lanes`) are blocked before their `tmax`, traversed
+    /// together; a bit mask.
     #[inline]
-    pub fn any(&self, ray: &Ray, mut leaf: impl FnMut(u32, u32) -> bool) -> bool {
-        if self.nodes.is_empty() {
-            return false;
+    pub fn any_rays<L: PacketLeaves>(&self, rays: &RayLanes<Float8>, lanes: u32, leaves: &L) -> u32 {
+        let mut blocked = 0u32;
+        if self.nodes.is_empty() || lanes == 0 {
+            return blocked;
         }
-        let pre = RayPre::new(ray);
-        let mut stack = [MaybeUninit::<u32>::uninit(); STACK];
+        let pre = PacketPre::new(rays);
+        let each = each_ray(rays);
+        let mut stack = [MaybeUninit::<(u32, u32)>::uninit(); STACK];
         let mut sp = 0usize;
-        let mut cur = 0u32;
+        let (mut cur, mut active) = (0u32, lanes);
         loop {
-            if cur & LEAF_BIT != 0 {
+            if active.count_ones() <= ALONE_BELOW {
+                for lane in bits(active) {
+                    let ray = &each[lane];
+                    if any_from(self, cur, ray, |first, count| leaves.any_ray(ray, first, count)) {
+                        blocked |= 1 << lane;
+                    }
+                }
+            } else if cur & LEAF_BIT != 0 {
                 let (first, count) = leaf_range(cur);
-                if leaf(first, count) {
-                    return true;
+                blocked |= leaves.any_rays(rays, &each, first, count, active);
+                if blocked == lanes {
+                    return blocked;
                 }
             } else {
                 let node = &self.nodes[cur as usize];
-                let (mut mask, _) = node.hit(&pre, ray.tmax);
-                while mask != 0 {
-                    let lane = mask.trailing_zeros() as usize;
-                    mask &= mask - 1;
-                    stack[sp].write(node.child[lane]);
-                    sp += 1;
+                for c in 0..LANES {
+                    let child = node.child[c];
+                    if child == EMPTY_CHILD {
+                        break;
+                    }
+                    let m = node.hit_rays(c, &pre, rays.tmax).0.bitmask() & active;
+                    if m != 0 {
+                        stack[sp].write((child, m));
+                        sp += 1;
+                    }
                 }
             }
+            loop {
+                if sp == 0 {
+                    return blocked;
+                }
+                sp -= 1;
+                // SAFETY: entries below `sp` were written by the pushes above.
+                let (node, m) = unsafe { stack[sp].assume_init() };
+                let m = m & !blocked;
+                if m != 0 {
+                    (cur, active) = (node, m);
+                    break;
+                }
+            }
+        }
+    }
+}
+
+/// Rays per packet.
+pub const PACKET: usize = 8;
+
+/// Below this many rays a packet's subtree is traversed by each ray alone (Benthin et al. 2012, "Combining
+/// Single and Packet-Ray Tracing for Arbitrary Ray Distributions on the Intel MIC Architecture"): the packet
+/// tests cost the same for one ray as for eight.
+const ALONE_BELOW: u32 = 2;
+
+/// The closest hits of a packet: per lane the distance and the slot hit ([`EMPTY_SLOT`] for none).
+#[derive(Clone, Copy, Debug)]
+pub struct Hits8 {
+    pub t: Float8,
+    pub slot: [u32; PACKET],
+}
+
+/// The primitives' side of packet traversal: the tests of one leaf (slots `first..first + count`, some of
+/// them padding) for several rays at once, and for one ray (when few rays remain in a subtree). The
+/// packet's rays come both as lanes and one by one (`each`, with the packet's `tmax`).
+pub trait PacketLeaves {
+    /// Update `hits` (distance and slot per lane) with the closer hits of the rays in `lanes`.
+    fn closest_rays(&self, rays: &RayLanes<Float8>, each: &[Ray; PACKET], first: u32, count: u32, lanes: u32, hits: &mut Hits8);
+    /// The closest hit of one ray below `tmax`: its distance and slot.
+    fn closest_ray(&self, ray: &Ray, first: u32, count: u32, tmax: f32) -> Option<(f32, u32)>;
+    /// The rays in `lanes` that something in the leaf blocks before their `tmax` (a bit mask).
+    fn any_rays(&self, rays: &RayLanes<Float8>, each: &[Ray; PACKET], first: u32, count: u32, lanes: u32) -> u32;
+    /// Whether something in the leaf blocks one ray.
+    fn any_ray(&self, ray: &Ray, first: u32, count: u32) -> bool;
+}
+
+/// The set lanes of a bit mask, lowest first.
+#[inline(always)]
+pub fn bits(mut m: u32) -> impl Iterator<Item = usize> {
+    std::iter::from_fn(move || {
+        (m != 0).then(|| {
+            let lane = m.trailing_zeros() as usize;
+            m &= m - 1;
+            lane
+        })
+    })
+}
+
+/// The rays of a packet one by one.
+#[inline(always)]
+#[must_use]
+pub fn each_ray(r: &RayLanes<Float8>) -> [Ray; PACKET] {
+    let (ox, oy, oz) = (r.o.x.to_array(), r.o.y.to_array(), r.o.z.to_array());
+    let (dx, dy, dz) = (r.d.x.to_array(), r.d.y.to_array(), r.d.z.to_array());
+    let tmax = r.tmax.to_array();
+    std::array::from_fn(|i| Ray::new(Vec3::new(ox[i], oy[i], oz[i]), Vec3::new(dx[i], dy[i], dz[i]), tmax[i]))
+}
+
+/// Eight rays as the packet box test wants them: origins, inverse directions, and per axis the lanes
+/// whose near slab plane is the box's maximum.
+struct PacketPre {
+    o: [Float8; 3],
+    inv_d: [Float8; 3],
+    neg: [Mask8; 3],
+}
+
+impl PacketPre {
+    #[inline(always)]
+    fn new(r: &RayLanes<Float8>) -> Self {
+        let one = Float8::splat(1.0);
+        let inv_d = [one / r.d.x, one / r.d.y, one / r.d.z];
+        // Sign bit set (as `is_sign_negative` of the single-ray test): −0 counts as negative.
+        let neg = |v: Float8| Float8::splat(1.0).xor_sign(v).lt(Float8::splat(0.0));
+        PacketPre { o: [r.o.x, r.o.y, r.o.z], inv_d, neg: [neg(inv_d[0]), neg(inv_d[1]), neg(inv_d[2])] }
+    }
+}
+
+/// [`Bvh::closest`]. Children are visited nearest first; the others wait on a stack with their entry
+/// distance and are dropped when popped behind the closest hit found by then. (2026-11: a copy of the
+/// traversal per ray octant, with the near planes known at compile time, took fewer instructions but more
+/// time: eight copies of the leaf tests crowd the instruction cache.)
+#[inline(always)]
+fn closest_from<H>(bvh: &Bvh, start: u32, ray: &Ray, leaf: impl FnMut(u32, u32, f32) -> Option<(f32, H)>) -> Option<H> {
+    closest_from_t(bvh, start, ray, ray.tmax, leaf).map(|(_, h)| h)
+}
+
+/// [`closest_from`] below `tmax` rather than the ray's own, returning the distance of the hit too.
+#[inline(always)]
+fn closest_from_t<H>(
+    bvh: &Bvh,
+    start: u32,
+    ray: &Ray,
+    tmax: f32,
+    mut leaf: impl FnMut(u32, u32, f32) -> Option<(f32, H)>,
+) -> Option<(f32, H)> {
+    let mut best = None;
+    let pre = RayPre::new(ray);
+    let mut tmax = tmax;
+    let mut stack = [MaybeUninit::<(u32, f32)>::uninit(); STACK];
+    let mut sp = 0usize;
+    let mut cur = start;
+    'visit: loop {
+        if cur & LEAF_BIT != 0 {
+            let (first, count) = leaf_range(cur);
+            if let Some((t, h)) = leaf(first, count, tmax) {
+                tmax = t;
+                best = Some((t, h));
+            }
+        } else {
+            let node = &bvh.nodes[cur as usize];
+            let (mask, tnear) = node.hit(&pre, Float8::splat(tmax));
+            if mask != 0 {
+                let first = mask.trailing_zeros() as usize;
+                let rest = mask & (mask - 1);
+                if rest == 0 {
+                    cur = node.child[first];
+                    continue 'visit;
+                }
+                let tnear = tnear.to_array();
+                let second = rest.trailing_zeros() as usize;
+                if rest & (rest - 1) == 0 {
+                    // Two children (the common case after one): the nearer now, the other on the stack.
+                    let (a, b) = ((node.child[first], tnear[first]), (node.child[second], tnear[second]));
+                    let (near, far) = if b.1 < a.1 { (b, a) } else { (a, b) };
+                    stack[sp].write(far);
+                    sp += 1;
+                    cur = near.0;
+                    continue 'visit;
+                }
+                // Sort the hit children by entry distance (at most eight: insertion sort, stable).
+                let mut hits = [(0u32, 0.0f32); LANES];
+                let mut n = 0;
+                let mut m = mask;
+                while m != 0 {
+                    let lane = m.trailing_zeros() as usize;
+                    m &= m - 1;
+                    let entry = (node.child[lane], tnear[lane]);
+                    let mut j = n;
+                    while j > 0 && hits[j - 1].1 > entry.1 {
+                        hits[j] = hits[j - 1];
+                        j -= 1;
+                    }
+                    hits[j] = entry;
+                    n += 1;
+                }
+                // Push the farther ones, farthest first; go on with the nearest.
+                for &h in hits[1..n].iter().rev() {
+                    stack[sp].write(h);
+                    sp += 1;
+                }
+                cur = hits[0].0;
+                continue 'visit;
+            }
+        }
+        // Pop the next child that can still hold a hit closer than tmax.
+        loop {
             if sp == 0 {
-                return false;
+                return best;
             }
             sp -= 1;
             // SAFETY: entries below `sp` were written by the pushes above.
-            cur = unsafe { stack[sp].assume_init() };
+            let (r, tnear) = unsafe { stack[sp].assume_init() };
+            if tnear <= tmax {
+                cur = r;
+                continue 'visit;
+            }
         }
+    }
+}
+
+/// [`Bvh::any`].
+#[inline(always)]
+fn any_from(bvh: &Bvh, start: u32, ray: &Ray, mut leaf: impl FnMut(u32, u32) -> bool) -> bool {
+    let pre = RayPre::new(ray);
+    let tmax = Float8::splat(ray.tmax);
+    let mut stack = [MaybeUninit::<u32>::uninit(); STACK];
+    let mut sp = 0usize;
+    let mut cur = start;
+    loop {
+        if cur & LEAF_BIT != 0 {
+            let (first, count) = leaf_range(cur);
+            if leaf(first, count) {
+                return true;
+            }
+        } else {
+            let node = &bvh.nodes[cur as usize];
+            let (mut mask, _) = node.hit(&pre, tmax);
+            while mask != 0 {
+                let lane = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                stack[sp].write(node.child[lane]);
+                sp += 1;
+            }
+        }
+        if sp == 0 {
+            return false;
+        }
+        sp -= 1;
+        // SAFETY: entries below `sp` were written by the pushes above.
+        cur = unsafe { stack[sp].assume_init() };
     }
 }
 
@@ -340,7 +639,7 @@ struct Builder {
     order: Vec<u32>,
 }
 
-/// SAH cost of `n` primitives: they are tested in packets of four.
+/// SAH cost of `n` primitives: they are tested in packets of eight.
 #[inline]
 fn packets(n: usize) -> f32 {
     n.div_ceil(LANES) as f32

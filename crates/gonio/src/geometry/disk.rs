@@ -62,23 +62,20 @@ impl Disk {
 
     /// The interaction for a hit whose `uv` holds the object-space (x, y).
     #[must_use]
-    pub fn interaction(&self, ray: &Ray, hit: &PrimHit) -> SurfaceInteraction {
+    pub fn interaction(&self, ray: &Ray, hit: &PrimHit, uv: bool) -> SurfaceInteraction {
         let (x, y) = (hit.uv.x, hit.uv.y);
-        let mut phi = y.atan2(x);
-        if phi < 0.0 {
-            phi += 2.0 * PI;
-        }
         let p = self.to_world.point(Vec3::new(x, y, 0.0));
         let _ = ray;
-        SurfaceInteraction {
-            t: hit.t,
-            p,
-            n: self.normal,
-            shading: Frame::from_normal(self.normal),
-            uv: Vec2::new((x * x + y * y).sqrt(), phi / (2.0 * PI)),
-            shape: 0,
-            prim: 0,
-        }
+        let uv = if uv {
+            let mut phi = y.atan2(x);
+            if phi < 0.0 {
+                phi += 2.0 * PI;
+            }
+            Vec2::new((x * x + y * y).sqrt(), phi / (2.0 * PI))
+        } else {
+            Vec2::ZERO
+        };
+        SurfaceInteraction { t: hit.t, p, n: self.normal, shading: Frame::from_normal(self.normal), uv, shape: 0, prim: 0 }
     }
 
     /// A point uniformly distributed over the disk (an affine map keeps uniform densities uniform).
@@ -102,6 +99,6 @@ mod tests {
         let h = d.intersect(&r).unwrap();
         assert!((h.t - 1.0).abs() < 1e-6);
         assert!(d.intersect(&Ray::new(Vec3::new(2.1, 0.0, 1.0), -Vec3::Z, 10.0)).is_none());
-        assert!((d.interaction(&r, &h).n - Vec3::Z).length() < 1e-6);
+        assert!((d.interaction(&r, &h, true).n - Vec3::Z).length() < 1e-6);
     }
 }

@@ -13,6 +13,7 @@ pub struct SurfaceInteraction {
     pub n: Vec3,
     /// Shading frame; `shading.n` is the interpolated normal for meshes with vertex normals.
     pub shading: Frame,
+    /// Texture coordinates, where the scene asked for them (its material is textured); else zero.
     pub uv: Vec2,
     /// Index of the shape in the scene.
     pub shape: u32,

@@ -8,6 +8,7 @@
 //! 1–1000, and far below any feature of interest. pbrt-v4's error bounds (§6.8) are tighter; this scaled
 //! offset is simpler and, like Mitsuba's ray epsilon, relative to the scene's scale.
 
+use crate::math::lanes::{Real, V3};
 use glam::Vec3;
 
 /// Relative offset of spawned ray origins (see the module docs).
@@ -40,9 +41,16 @@ impl Ray {
 #[inline]
 #[must_use]
 pub fn offset_origin(p: Vec3, n: Vec3, w: Vec3) -> Vec3 {
-    let scale = RAY_OFFSET * (1.0 + p.abs().max_element());
-    let side = if n.dot(w) >= 0.0 { 1.0 } else { -1.0 };
-    p + n * (scale * side)
+    offset_origin_lanes::<f32>(p.into(), n.into(), w.into()).into()
+}
+
+/// [`offset_origin`] in lanes (the same operations, in the order glam's `Vec3` does them).
+#[inline(always)]
+#[must_use]
+pub fn offset_origin_lanes<R: Real>(p: V3<R>, n: V3<R>, w: V3<R>) -> V3<R> {
+    let scale = (p.x.abs().max(p.y.abs().max(p.z.abs())) + 1.0) * RAY_OFFSET;
+    let side = R::select(n.dot(w).ge(R::splat(0.0)), R::splat(1.0), R::splat(-1.0));
+    p.add(n.scale(scale * side))
 }
 
 /// A ray leaving `p` (on a surface with geometric normal `n`) in unit direction `d`.
@@ -57,12 +65,30 @@ pub fn spawn_ray(p: Vec3, n: Vec3, d: Vec3) -> Ray {
 #[inline]
 #[must_use]
 pub fn spawn_ray_to(p: Vec3, n: Vec3, target: Vec3, n_target: Vec3) -> Ray {
-    let o = offset_origin(p, n, target - p);
-    let q = if n_target == Vec3::ZERO { target } else { offset_origin(target, n_target, p - target) };
-    let delta = q - o;
+    let r = spawn_ray_to_lanes::<f32>(p.into(), n.into(), target.into(), n_target.into());
+    Ray::new(r.o.into(), r.d.into(), r.tmax)
+}
+
+/// Rays in lanes.
+#[derive(Clone, Copy, Debug)]
+pub struct RayLanes<R> {
+    pub o: V3<R>,
+    pub d: V3<R>,
+    pub tmax: R,
+}
+
+/// [`spawn_ray_to`] in lanes.
+#[inline(always)]
+#[must_use]
+pub fn spawn_ray_to_lanes<R: Real>(p: V3<R>, n: V3<R>, target: V3<R>, n_target: V3<R>) -> RayLanes<R> {
+    let o = offset_origin_lanes(p, n, target.sub(p));
+    let zero = R::splat(0.0);
+    let point = n_target.x.eq(zero) & n_target.y.eq(zero) & n_target.z.eq(zero);
+    let q = V3::select(point, target, offset_origin_lanes(target, n_target, p.sub(target)));
+    let delta = q.sub(o);
     let dist = delta.length();
     // 2026-11: stop 1e-5 relative before the target so the light's own surface never occludes it.
-    Ray::new(o, delta / dist, dist * (1.0 - 1e-5))
+    RayLanes { o, d: delta.div(dist), tmax: dist * (1.0 - 1e-5) }
 }
 
 #[cfg(test)]

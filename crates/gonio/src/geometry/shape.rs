@@ -6,7 +6,20 @@ use super::interaction::{PositionSample, SurfaceInteraction};
 use super::mesh::Mesh;
 use super::sphere::Sphere;
 use super::{Bounds3, Ray};
+use crate::math::lanes::{Real, V3};
 use glam::Vec2;
+
+/// The solid-angle density at `p` of a point `q` (geometric normal `ng`) sampled with area density
+/// `pdf_area`: p_ω = p_A d² / |cos θ| (pbrt-v4 eq. 4.9), in lanes; valid where `q` is not seen edge-on
+/// (nor at `p`).
+#[inline(always)]
+pub fn solid_angle_density<R: Real>(p: V3<R>, q: V3<R>, ng: V3<R>, pdf_area: R) -> (R, R::Mask) {
+    let d = q.sub(p);
+    let dist2 = d.dot(d);
+    let cos = ng.dot(d).abs() / dist2.sqrt();
+    let zero = R::splat(0.0);
+    (pdf_area * dist2 / cos, cos.gt(zero) & dist2.gt(zero))
+}
 
 /// A ray's hit on one primitive, before the full interaction is computed: the ray parameter and
 /// shape-specific coordinates (barycentrics for triangles, object-space (x, y) for disks).
@@ -52,13 +65,14 @@ impl Shape {
         }
     }
 
-    /// The full interaction of a hit found by [`Shape::intersect`]; `shape` and `prim` are filled in.
+    /// The full interaction of a hit found by [`Shape::intersect`]; `shape` and `prim` are filled in. Texture
+    /// coordinates only with `uv` (else zero): spheres and disks need an arc tangent for them.
     #[must_use]
-    pub fn interaction(&self, shape: u32, prim: u32, ray: &Ray, hit: &PrimHit) -> SurfaceInteraction {
+    pub fn interaction(&self, shape: u32, prim: u32, ray: &Ray, hit: &PrimHit, uv: bool) -> SurfaceInteraction {
         let mut si = match self {
-            Shape::Mesh(m) => m.interaction(prim, ray, hit),
-            Shape::Sphere(s) => s.interaction(ray, hit.t),
-            Shape::Disk(d) => d.interaction(ray, hit),
+            Shape::Mesh(m) => m.interaction(prim, ray, hit, uv),
+            Shape::Sphere(s) => s.interaction(ray, hit.t, uv),
+            Shape::Disk(d) => d.interaction(ray, hit, uv),
         };
         si.shape = shape;
         si.prim = prim;
@@ -83,10 +97,8 @@ impl Shape {
             return s.sample_from(p, u);
         }
         let ps = self.sample_position(uc, u);
-        let d = ps.p - p;
-        let dist2 = d.length_squared();
-        let cos = ps.ng.dot(d).abs() / dist2.sqrt();
-        (cos > 0.0 && dist2 > 0.0).then(|| (ps, ps.pdf_area * dist2 / cos))
+        let (pdf, valid) = solid_angle_density::<f32>(p.into(), ps.p.into(), ps.ng.into(), ps.pdf_area);
+        valid.then_some((ps, pdf))
     }
 
     /// The solid-angle density with which [`Self::sample_from`] at `p` finds the surface point `q` (geometric

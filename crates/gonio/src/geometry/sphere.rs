@@ -12,6 +12,8 @@
 
 use super::interaction::{PositionSample, SurfaceInteraction};
 use super::{Bounds3, PrimHit, Ray};
+use crate::math::lanes::{Real, V3};
+use crate::math::simd::Float8;
 use crate::math::{Frame, Transform};
 use crate::sampling::warp::sample_uniform_sphere;
 use glam::{Vec2, Vec3};
@@ -56,38 +58,27 @@ impl Sphere {
     #[inline]
     #[must_use]
     pub fn intersect(&self, ray: &Ray) -> Option<PrimHit> {
-        let oc = ray.o - self.center;
-        let a = ray.d.length_squared();
-        let b = 2.0 * ray.d.dot(oc);
-        let c = oc.length_squared() - self.radius * self.radius;
-        let v = oc - ray.d * (b / (2.0 * a));
-        let disc = 4.0 * a * (self.radius * self.radius - v.length_squared());
-        if disc < 0.0 {
-            return None;
-        }
-        let root = disc.sqrt();
-        let q = if b < 0.0 { -0.5 * (b - root) } else { -0.5 * (b + root) };
-        let (mut t0, mut t1) = (q / a, c / q);
-        if t0 > t1 {
-            std::mem::swap(&mut t0, &mut t1);
-        }
-        let t = if t0 > 0.0 { t0 } else { t1 };
-        (t > 0.0 && t < ray.tmax).then_some(PrimHit { t, uv: Vec2::ZERO })
+        let (t, hit) = intersect_sphere::<f32>(ray.o.into(), ray.d.into(), self.center.into(), self.radius, ray.tmax);
+        hit.then_some(PrimHit { t, uv: Vec2::ZERO })
     }
 
     /// The interaction at parameter `t` of `ray`; the point is re-projected onto the surface.
     #[must_use]
-    pub fn interaction(&self, ray: &Ray, t: f32) -> SurfaceInteraction {
+    pub fn interaction(&self, ray: &Ray, t: f32, uv: bool) -> SurfaceInteraction {
         let outward = (ray.at(t) - self.center).normalize();
         let p = self.center + outward * self.radius;
         let n = if self.flip_normals { -outward } else { outward };
-        // Mitsuba's parametrisation: u = φ / 2π, v = θ / π in object space.
-        let local = self.to_object.vector(outward).normalize();
-        let mut phi = local.y.atan2(local.x);
-        if phi < 0.0 {
-            phi += 2.0 * PI;
-        }
-        let uv = Vec2::new(phi / (2.0 * PI), local.z.clamp(-1.0, 1.0).acos() / PI);
+        let uv = if uv {
+            // Mitsuba's parametrisation: u = φ / 2π, v = θ / π in object space.
+            let local = self.to_object.vector(outward).normalize();
+            let mut phi = local.y.atan2(local.x);
+            if phi < 0.0 {
+                phi += 2.0 * PI;
+            }
+            Vec2::new(phi / (2.0 * PI), local.z.clamp(-1.0, 1.0).acos() / PI)
+        } else {
+            Vec2::ZERO
+        };
         SurfaceInteraction { t, p, n, shading: Frame::from_normal(n), uv, shape: 0, prim: 0 }
     }
 
@@ -157,6 +148,75 @@ impl Sphere {
     }
 }
 
+/// The nearer hit in (0, tmax) of the ray o + t d with the sphere (`center`, `radius`), in lanes (of rays,
+/// or of spheres): the distance and whether it is hit.
+#[inline(always)]
+#[must_use]
+pub fn intersect_sphere<R: Real>(o: V3<R>, d: V3<R>, center: V3<R>, radius: R, tmax: R) -> (R, R::Mask) {
+    let oc = o.sub(center);
+    let a = d.dot(d);
+    let b = d.dot(oc) * 2.0;
+    let r2 = radius * radius;
+    let c = oc.dot(oc) - r2;
+    let v = oc.sub(d.scale(b / (a * 2.0)));
+    let disc = a * 4.0 * (r2 - v.dot(v));
+    let zero = R::splat(0.0);
+    let root = disc.sqrt();
+    let q = R::select(b.lt(zero), (b - root) * -0.5, (b + root) * -0.5);
+    let (t0, t1) = (q / a, c / q);
+    let swap = t0.gt(t1);
+    let (t0, t1) = (R::select(swap, t1, t0), R::select(swap, t0, t1));
+    let t = R::select(t0.gt(zero), t0, t1);
+    (t, !disc.lt(zero) & t.gt(zero) & t.lt(tmax))
+}
+
+/// Up to eight spheres in structure-of-arrays form, for [`intersect_sphere`] on eight at once with one ray.
+/// Lanes without a sphere are masked out.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Sphere8 {
+    center: [[f32; 8]; 3],
+    radius: [f32; 8],
+    lanes: u32,
+}
+
+impl Sphere8 {
+    /// Put `sphere` in lane `lane`.
+    pub fn set(&mut self, lane: usize, sphere: &Sphere) {
+        for axis in 0..3 {
+            self.center[axis][lane] = sphere.center[axis];
+        }
+        self.radius[lane] = sphere.radius;
+        self.lanes |= 1 << lane;
+    }
+
+    /// The lanes holding a sphere (bit mask).
+    #[inline(always)]
+    #[must_use]
+    pub fn lanes(&self) -> u32 {
+        self.lanes
+    }
+
+    /// The sphere in lane `lane` tested against eight rays (one per lane of `o`, `d`, `tmax`): the rays that
+    /// hit it and their distances, as [`Sphere::intersect`] computes them.
+    #[inline(always)]
+    #[must_use]
+    pub fn intersect_rays(&self, lane: usize, o: V3<Float8>, d: V3<Float8>, tmax: Float8) -> (crate::math::simd::Mask8, Float8) {
+        let center = V3::new(Float8::splat(self.center[0][lane]), Float8::splat(self.center[1][lane]), Float8::splat(self.center[2][lane]));
+        let (t, hit) = intersect_sphere(o, d, center, Float8::splat(self.radius[lane]), tmax);
+        (hit, t)
+    }
+
+    /// The lanes hit within (0, tmax) (bit mask) and their distances, as [`Sphere::intersect`] computes them.
+    #[inline(always)]
+    #[must_use]
+    pub fn intersect(&self, ray: &Ray, tmax: f32) -> (u32, [f32; 8]) {
+        let row = |r: &[f32; 8]| Float8::load(r);
+        let center = V3::new(row(&self.center[0]), row(&self.center[1]), row(&self.center[2]));
+        let (t, hit) = intersect_sphere(V3::splat(ray.o), V3::splat(ray.d), center, row(&self.radius), Float8::splat(tmax));
+        (hit.bitmask() & self.lanes, t.to_array())
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -170,7 +230,7 @@ mod tests {
         assert!((h.t - 1.0).abs() < 1e-5);
         assert!(s.intersect(&Ray::new(Vec3::ZERO, Vec3::X, f32::INFINITY)).is_none());
         assert!(s.intersect(&Ray::new(Vec3::ZERO, Vec3::Z, 3.0)).is_none());
-        let si = s.interaction(&Ray::new(Vec3::ZERO, Vec3::Z, f32::INFINITY), 4.0);
+        let si = s.interaction(&Ray::new(Vec3::ZERO, Vec3::Z, f32::INFINITY), 4.0, true);
         assert!((si.n + Vec3::Z).length() < 1e-5);
     }
 
@@ -193,5 +253,30 @@ mod tests {
         let s = Sphere::new(Vec3::ZERO, 1.5, t, false).unwrap();
         assert!((s.radius - 3.0).abs() < 1e-6 && (s.center - Vec3::X).length() < 1e-6);
         assert!(Sphere::new(Vec3::ZERO, 1.0, Transform::scale(Vec3::new(1.0, 2.0, 1.0)).unwrap(), false).is_none());
+    }
+
+    /// The eight-sphere test agrees with the scalar one, lane by lane, bit for bit.
+    #[test]
+    fn eight_wide_test_matches_scalar() {
+        let mut rng = crate::sampling::Pcg32::new(8, 1);
+        let mut v = || Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 4.0 - Vec3::splat(2.0);
+        for _ in 0..2000 {
+            let spheres: Vec<Sphere> =
+                (0..7).map(|_| Sphere::new(v(), 0.2 + v().x.abs() * 0.3, Transform::IDENTITY, false).unwrap()).collect();
+            let mut packet = Sphere8::default();
+            for (lane, s) in spheres.iter().enumerate() {
+                packet.set(lane, s);
+            }
+            let ray = Ray::new(v() * 2.0, (v() + Vec3::splat(1e-3)).normalize(), 6.0);
+            let (mask, t) = packet.intersect(&ray, ray.tmax);
+            assert_eq!(mask & 128, 0, "the empty lane is never hit");
+            for (lane, s) in spheres.iter().enumerate() {
+                let scalar = s.intersect(&ray);
+                assert_eq!(scalar.is_some(), mask & (1 << lane) != 0);
+                if let Some(h) = scalar {
+                    assert_eq!(h.t.to_bits(), t[lane].to_bits());
+                }
+            }
+        }
     }
 }

@@ -16,13 +16,45 @@ use crate::scene::{IntegratorKind, Scene};
 use crate::spectrum::Rgb;
 use glam::Vec3;
 
-/// The radiance along a camera ray, by the scene's integrator.
+/// One camera sample: sample number `k` of pixel (`x`, `y`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CameraSample {
+    pub x: u32,
+    pub y: u32,
+    pub k: u32,
+}
+
+/// Mix a seed and a sample index into a PCG32 seed (the SplitMix64 finaliser, Steele et al. 2014).
+fn mix(seed: u64, sample: u64) -> u64 {
+    let mut z = seed.wrapping_add(sample.wrapping_mul(0x9e37_79b9_7f4a_7c15));
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
+}
+
+/// The start of a camera sample's path: its own PCG32 stream, `Pcg32::new(mix(seed, k), pixel index)`, and
+/// the camera ray through a uniformly jittered point of its pixel (the box filter), drawn from that stream.
+#[inline]
 #[must_use]
-pub fn radiance(scene: &Scene, ray: &Ray, rng: &mut Pcg32) -> Rgb {
+pub fn start(scene: &Scene, seed: u64, s: CameraSample) -> (Ray, Pcg32) {
+    let (w, h) = (scene.film.width, scene.film.height);
+    let pixel = u64::from(s.y) * u64::from(w) + u64::from(s.x);
+    let mut rng = Pcg32::new(mix(seed, u64::from(s.k)), pixel);
+    let p = glam::Vec2::new((s.x as f32 + rng.next_f32()) / w as f32, (s.y as f32 + rng.next_f32()) / h as f32);
+    (scene.camera.ray(p), rng)
+}
+
+/// The radiance of each camera sample (`out[i]` for `samples[i]`), by the scene's integrator.
+pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [Rgb]) {
     match scene.integrator {
-        IntegratorKind::Path { max_depth, rr_depth, hide_emitters } => path::radiance(scene, ray, rng, max_depth, rr_depth, hide_emitters),
+        IntegratorKind::Path { max_depth, rr_depth, hide_emitters } => {
+            path::radiance(scene, seed, samples, out, path::Settings { max_depth, rr_depth, hide_emitters });
+        }
         IntegratorKind::Direct { emitter_samples, bsdf_samples, hide_emitters } => {
-            direct::radiance(scene, ray, rng, emitter_samples, bsdf_samples, hide_emitters)
+            for (s, l) in samples.iter().zip(out) {
+                let (ray, mut rng) = start(scene, seed, *s);
+                *l = direct::radiance(scene, &ray, &mut rng, emitter_samples, bsdf_samples, hide_emitters);
+            }
         }
     }
 }

@@ -9,62 +9,501 @@
 //!
 //! Russian roulette as Mitsuba: continue with probability q = min(max(β) · η², 0.95), β the throughput
 //! and η the accumulated relative index of refraction, and divide β by q.
+//!
+//! # Eight paths at a time
+//! Paths are traced in packets of eight, one per lane ([`W`]), bounce by bounce: every phase of a bounce
+//! (trace, emission found, next-event estimation, BSDF sampling, Russian roulette) runs for all the packet's
+//! paths before the next phase, so that the arithmetic of the phases can run in SIMD lanes. A lane whose
+//! path ends takes the next camera sample at the top of the next bounce (path regeneration, Novák et al.
+//! 2010, "GPU Computing: Path Regeneration"), so the lanes stay busy until the samples run out. Each path
+//! draws from its own random stream in the order a path traced alone would, so the packet changes nothing
+//! but the speed.
 
-use super::{emitter_hit, sample_emitter, BsdfSampled};
-use crate::bsdf::{BsdfFlags, BsdfModel};
-use crate::geometry::ray::spawn_ray;
-use crate::geometry::Ray;
-use crate::sampling::Pcg32;
-use crate::scene::Scene;
+use super::{emitter_hit, start, BsdfSampled, CameraSample};
+use crate::bsdf::diffuse::{diffuse_f, diffuse_pdf, diffuse_sample};
+use crate::bsdf::{Bsdf, BsdfFlags, BsdfModel};
+use crate::geometry::mesh::uniform_triangle_point;
+use crate::geometry::ray::{offset_origin_lanes, spawn_ray_to_lanes, RayLanes};
+use crate::geometry::shape::solid_angle_density;
+use crate::geometry::{Ray, Shape, SurfaceInteraction};
+use crate::light::area::towards;
+use crate::light::Light;
+use crate::math::lanes::{Real, V3};
+use crate::math::simd::{Float8, Mask8};
+use crate::math::{Vec2, Vec3};
+use crate::sampling::{Pcg32, Pcg32x8};
+use crate::scene::{Scene, EMPTY_SLOT};
 use crate::spectrum::Rgb;
+use std::borrow::Cow;
 
-/// The radiance along `ray`.
-#[must_use]
-pub fn radiance(scene: &Scene, ray: &Ray, rng: &mut Pcg32, max_depth: i32, rr_depth: i32, hide_emitters: bool) -> Rgb {
-    if max_depth == 0 {
-        return Rgb::ZERO;
+/// Paths per packet.
+pub const W: usize = 8;
+
+/// The parameters of the table above.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Settings {
+    pub max_depth: i32,
+    pub rr_depth: i32,
+    pub hide_emitters: bool,
+}
+
+/// Three numbers per lane (a direction, a point or an RGB value), as rows x, y, z (or r, g, b).
+#[derive(Clone, Copy, Debug, Default)]
+struct Rows3([[f32; W]; 3]);
+
+impl Rows3 {
+    #[inline(always)]
+    fn get(&self, lane: usize) -> Vec3 {
+        Vec3::new(self.0[0][lane], self.0[1][lane], self.0[2][lane])
     }
-    let mut l = Rgb::ZERO;
-    let mut beta = Rgb::ONE;
-    let mut eta = 1.0f32;
-    let mut ray = *ray;
-    let mut prev: Option<BsdfSampled> = None;
-    let mut depth = 0i32;
+
+    #[inline(always)]
+    fn set(&mut self, lane: usize, v: Vec3) {
+        (self.0[0][lane], self.0[1][lane], self.0[2][lane]) = (v.x, v.y, v.z);
+    }
+
+    #[inline(always)]
+    fn rgb(&self, lane: usize) -> Rgb {
+        Rgb([self.0[0][lane], self.0[1][lane], self.0[2][lane]])
+    }
+
+    #[inline(always)]
+    fn set_rgb(&mut self, lane: usize, v: Rgb) {
+        (self.0[0][lane], self.0[1][lane], self.0[2][lane]) = (v.0[0], v.0[1], v.0[2]);
+    }
+}
+
+/// Rays as rows of lanes.
+#[derive(Clone, Copy, Debug, Default)]
+struct RayRows {
+    o: Rows3,
+    d: Rows3,
+    tmax: [f32; W],
+}
+
+impl RayRows {
+    #[inline(always)]
+    fn set(&mut self, lane: usize, r: &Ray) {
+        self.o.set(lane, r.o);
+        self.d.set(lane, r.d);
+        self.tmax[lane] = r.tmax;
+    }
+
+    /// The lanes of `r` where `m` is set.
+    #[inline(always)]
+    fn merge(&mut self, m: Mask8, r: &RayLanes<Float8>) {
+        let (o, d) = (V3::select(m, r.o, load(&self.o)), V3::select(m, r.d, load(&self.d)));
+        store(&mut self.o, o);
+        store(&mut self.d, d);
+        self.tmax = Float8::select(m, r.tmax, Float8::load(&self.tmax)).to_array();
+    }
+}
+
+/// The lanes of the bit mask `bits`, lowest first.
+#[inline(always)]
+fn lanes(mut bits: u32) -> impl Iterator<Item = usize> {
+    std::iter::from_fn(move || {
+        (bits != 0).then(|| {
+            let lane = bits.trailing_zeros() as usize;
+            bits &= bits - 1;
+            lane
+        })
+    })
+}
+
+/// Eight paths in flight.
+struct Packet {
+    /// Lanes holding a path (bit `i` for lane `i`).
+    live: u32,
+    /// The camera sample (index into the caller's slice) of each lane.
+    sample: [usize; W],
+    rng: Pcg32x8,
+    /// Segments traced so far.
+    depth: [i32; W],
+    /// The ray to trace next.
+    o: Rows3,
+    d: Rows3,
+    /// Throughput and radiance gathered.
+    beta: Rows3,
+    l: Rows3,
+    /// Accumulated relative index of refraction.
+    eta: [f32; W],
+    /// How the ray was sampled at the vertex it leaves (for weighting an emitter it finds): the vertex,
+    /// the BSDF sample's density, and whether it came from a delta lobe (bit per lane).
+    from: Rows3,
+    pdf: [f32; W],
+    delta: u32,
+}
+
+impl Packet {
+    fn new() -> Self {
+        Packet {
+            live: 0,
+            sample: [0; W],
+            rng: Pcg32x8::default(),
+            depth: [0; W],
+            o: Rows3::default(),
+            d: Rows3::default(),
+            beta: Rows3::default(),
+            l: Rows3::default(),
+            eta: [1.0; W],
+            from: Rows3::default(),
+            pdf: [0.0; W],
+            delta: 0,
+        }
+    }
+
+    #[inline(always)]
+    fn ray(&self, lane: usize) -> Ray {
+        Ray::new(self.o.get(lane), self.d.get(lane), f32::INFINITY)
+    }
+
+    /// Lane `lane` starts camera sample `index`.
+    fn start(&mut self, lane: usize, index: usize, ray: Ray, rng: Pcg32) {
+        self.live |= 1 << lane;
+        self.sample[lane] = index;
+        self.rng.set(lane, &rng);
+        self.depth[lane] = 0;
+        self.o.set(lane, ray.o);
+        self.d.set(lane, ray.d);
+        self.beta.set_rgb(lane, Rgb::ONE);
+        self.l.set_rgb(lane, Rgb::ZERO);
+        self.eta[lane] = 1.0;
+    }
+
+    /// Lane `lane`'s path ends: its radiance goes to `out`.
+    #[inline(always)]
+    fn finish(&mut self, lane: usize, out: &mut [Rgb]) {
+        out[self.sample[lane]] = self.l.rgb(lane);
+        self.live &= !(1 << lane);
+    }
+}
+
+/// The surfaces the packet's rays found, as lanes (rows), for the phases that run in SIMD.
+#[derive(Default)]
+struct Surfaces {
+    p: Rows3,
+    /// Geometric normal.
+    n: Rows3,
+    /// Shading frame.
+    s: Rows3,
+    t: Rows3,
+    ns: Rows3,
+    /// Diffuse reflectance, for the lanes in `diffuse`.
+    rho: Rows3,
+    /// Lanes whose surface is `diffuse` (textured or not), evaluated in lanes; the others call their model.
+    diffuse: u32,
+}
+
+/// `Rows3` as lanes.
+#[inline(always)]
+fn load(r: &Rows3) -> V3<Float8> {
+    V3::new(Float8::load(&r.0[0]), Float8::load(&r.0[1]), Float8::load(&r.0[2]))
+}
+
+#[inline(always)]
+fn store(r: &mut Rows3, v: V3<Float8>) {
+    r.0 = [v.x.to_array(), v.y.to_array(), v.z.to_array()];
+}
+
+#[inline(always)]
+fn load_rgb(r: &Rows3) -> [Float8; 3] {
+    [Float8::load(&r.0[0]), Float8::load(&r.0[1]), Float8::load(&r.0[2])]
+}
+
+#[inline(always)]
+fn store_rgb(r: &mut Rows3, v: [Float8; 3]) {
+    r.0 = [v[0].to_array(), v[1].to_array(), v[2].to_array()];
+}
+
+/// `v` in the frame (s, t, n), as [`crate::math::Frame::to_local`].
+#[inline(always)]
+fn to_local(s: V3<Float8>, t: V3<Float8>, n: V3<Float8>, v: V3<Float8>) -> V3<Float8> {
+    V3::new(v.dot(s), v.dot(t), v.dot(n))
+}
+
+/// `v` from the frame (s, t, n) to world space, as [`crate::math::Frame::to_world`].
+#[inline(always)]
+fn to_world(s: V3<Float8>, t: V3<Float8>, n: V3<Float8>, v: V3<Float8>) -> V3<Float8> {
+    s.scale(v.x).add(t.scale(v.y)).add(n.scale(v.z))
+}
+
+/// [`power_heuristic`] with one sample of each technique, in lanes.
+#[inline(always)]
+fn power_heuristic_1(f: Float8, g: Float8) -> Float8 {
+    let (zero, one) = (Float8::splat(0.0), Float8::splat(1.0));
+    let w = (f * f) / (f * f + g * g);
+    let w = Float8::select(f.eq(zero) & g.eq(zero), zero, w);
+    Float8::select(f.abs().eq(Float8::splat(f32::INFINITY)), one, w)
+}
+
+/// The radiance of each camera sample (`out[i]` for `samples[i]`), eight paths at a time.
+pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [Rgb], settings: Settings) {
+    let Settings { max_depth, rr_depth, hide_emitters } = settings;
+    if max_depth == 0 {
+        out.fill(Rgb::ZERO);
+        return;
+    }
+    let n_lights = scene.lights.len();
+    let mut p = Packet::new();
+    let mut next = 0;
     loop {
-        let hit = scene.intersect(&ray);
-        if !(depth == 0 && hide_emitters) {
-            l += beta * emitter_hit(scene, &ray, hit.as_ref(), prev.as_ref());
-        }
-        let Some(si) = hit else { break };
-        // A vertex at `depth` can extend the path only if the next one is within max_depth.
-        if max_depth >= 0 && depth + 1 >= max_depth {
-            break;
-        }
-        let material = scene.materials[si.shape as usize].at(si.uv);
-        let bsdf = &*material;
-        let wo = si.shading.to_local(-ray.d);
-        if bsdf.flags().has_smooth() {
-            l += beta * sample_emitter(scene, &si, wo, bsdf, rng, 1.0, 1.0);
-        }
-        let (uc, u) = (rng.next_f32(), rng.next_vec2());
-        let Some(s) = bsdf.sample(wo, uc, u) else { break };
-        beta *= s.weight;
-        eta *= s.eta;
-        let wi = si.shading.to_world(s.wi);
-        prev = Some(BsdfSampled { from: si.p, pdf: s.pdf, delta: s.flags.contains(BsdfFlags::DELTA), n_bsdf: 1.0, n_light: 1.0 });
-        ray = spawn_ray(si.p, si.n, wi);
-        depth += 1;
-        let beta_max = beta.max_component();
-        if !(beta_max > 0.0) {
-            break;
-        }
-        if depth >= rr_depth {
-            let q = (beta_max * eta * eta).min(0.95);
-            if rng.next_f32() >= q {
+        // Lanes without a path take the next camera sample.
+        for lane in lanes(!p.live & ((1 << W) - 1)) {
+            if next == samples.len() {
                 break;
             }
-            beta = beta / q;
+            let (ray, rng) = start(scene, seed, samples[next]);
+            p.start(lane, next, ray, rng);
+            next += 1;
         }
+        if p.live == 0 {
+            return;
+        }
+
+        // Trace.
+        let mut hits: [Option<SurfaceInteraction>; W] = [None; W];
+        let rays = RayLanes { o: load(&p.o), d: load(&p.d), tmax: Float8::splat(f32::INFINITY) };
+        let found = scene.intersect_rays(&rays, p.live);
+        for lane in lanes(p.live) {
+            if found.slot[lane] != EMPTY_SLOT {
+                hits[lane] = scene.interaction_at(found.slot[lane], &p.ray(lane));
+            }
+        }
+
+        // Emission found by the ray; paths that escaped or reached the longest length end.
+        for lane in lanes(p.live) {
+            let depth = p.depth[lane];
+            if !(depth == 0 && hide_emitters) {
+                let prev = (depth > 0).then(|| BsdfSampled {
+                    from: p.from.get(lane),
+                    pdf: p.pdf[lane],
+                    delta: p.delta & (1 << lane) != 0,
+                    n_bsdf: 1.0,
+                    n_light: 1.0,
+                });
+                let le = emitter_hit(scene, &p.ray(lane), hits[lane].as_ref(), prev.as_ref());
+                p.l.set_rgb(lane, p.l.rgb(lane) + p.beta.rgb(lane) * le);
+            }
+            // A vertex at `depth` can extend the path only if the next one is within max_depth.
+            if hits[lane].is_none() || (max_depth >= 0 && depth + 1 >= max_depth) {
+                p.finish(lane, out);
+            }
+        }
+        if p.live == 0 {
+            continue;
+        }
+
+        // The surfaces as lanes; diffuse ones are evaluated in lanes, the others by their model.
+        let mut surf = Surfaces::default();
+        let mut models: [Option<Cow<'_, Bsdf>>; W] = Default::default();
+        for lane in lanes(p.live) {
+            let Some(si) = &hits[lane] else { continue };
+            surf.p.set(lane, si.p);
+            surf.n.set(lane, si.n);
+            surf.s.set(lane, si.shading.s);
+            surf.t.set(lane, si.shading.t);
+            surf.ns.set(lane, si.shading.n);
+            let material = &scene.materials[si.shape as usize];
+            match material.diffuse_reflectance(si.uv) {
+                Some(rho) => {
+                    surf.rho.set_rgb(lane, rho);
+                    surf.diffuse |= 1 << lane;
+                }
+                None => models[lane] = Some(material.at(si.uv)),
+            }
+        }
+        let (fs, ft, fn_) = (load(&surf.s), load(&surf.t), load(&surf.ns));
+        let wo = to_local(fs, ft, fn_, load(&p.d).neg());
+        let wo_rows = {
+            let mut r = Rows3::default();
+            store(&mut r, wo);
+            r
+        };
+        let rho = load_rgb(&surf.rho);
+        let mut beta = load_rgb(&p.beta);
+
+        // Next-event estimation (on lanes whose model has a smooth component): a light chosen uniformly and
+        // sampled, its contribution weighted against BSDF sampling by the power heuristic.
+        let smooth = surf.diffuse
+            | lanes(p.live & !surf.diffuse)
+                .fold(0, |m, lane| m | (u32::from(models[lane].as_ref().is_some_and(|b| b.flags().has_smooth())) << lane));
+        if n_lights > 0 && smooth != 0 {
+            // Per lane, the light and (for a flat mesh's area light, the common case) the triangle; the
+            // point on it in lanes. Other lights sample in full per lane.
+            let (mut wi, mut li, mut light_pdf) = (Rows3::default(), Rows3::default(), [0.0f32; W]);
+            let (mut tri, mut tri_n, mut pdf_area, mut ux, mut uy) =
+                ([Rows3::default(); 3], Rows3::default(), [0.0f32; W], [0.0f32; W], [0.0f32; W]);
+            let (mut sampled, mut on_mesh, mut delta) = (0u32, 0u32, 0u32);
+            let mut shadow = RayRows::default();
+            let u_light = p.rng.next_f32(smooth);
+            let (u_c, u_x, u_y) = (p.rng.next_f32(smooth), p.rng.next_f32(smooth), p.rng.next_f32(smooth));
+            // `(u · n) as usize`, at most n − 1: u · n is in [0, n), so truncation is the cast.
+            let chosen = (u_light * n_lights as f32).trunc().min(Float8::splat((n_lights - 1) as f32)).to_array();
+            let (u_c, u_x, u_y) = (u_c.to_array(), u_x.to_array(), u_y.to_array());
+            for lane in lanes(smooth) {
+                let index = chosen[lane] as usize;
+                let (uc, u) = (u_c[lane], Vec2::new(u_x[lane], u_y[lane]));
+                let light = &scene.lights[index];
+                if let Light::Area(area) = light {
+                    if let Shape::Mesh(mesh) = &scene.shapes[area.shape as usize] {
+                        if let Some((vertices, n, density)) = mesh.sample_flat_triangle(uc) {
+                            if !area.radiance.is_black() {
+                                for (rows, v) in tri.iter_mut().zip(vertices) {
+                                    rows.set(lane, v);
+                                }
+                                tri_n.set(lane, n);
+                                (pdf_area[lane], ux[lane], uy[lane]) = (density, u.x, u.y);
+                                li.set_rgb(lane, area.radiance);
+                                on_mesh |= 1 << lane;
+                            }
+                            continue;
+                        }
+                    }
+                }
+                let Some(ls) = light.sample_li(&scene.shapes, surf.p.get(lane), surf.n.get(lane), uc, u) else { continue };
+                if !(ls.pdf > 0.0) || ls.li.is_black() {
+                    continue;
+                }
+                wi.set(lane, ls.wi);
+                li.set_rgb(lane, ls.li);
+                light_pdf[lane] = ls.pdf;
+                delta |= u32::from(ls.delta) << lane;
+                shadow.set(lane, &ls.shadow);
+                sampled |= 1 << lane;
+            }
+            if on_mesh != 0 {
+                // `AreaLight::sample_li` on a flat mesh, in lanes.
+                let (sp, sn) = (load(&surf.p), load(&surf.n));
+                let q = uniform_triangle_point(load(&tri[0]), load(&tri[1]), load(&tri[2]), Float8::load(&ux), Float8::load(&uy));
+                let ng = load(&tri_n);
+                let (pdf, by_area) = solid_angle_density(sp, q, ng, Float8::load(&pdf_area));
+                let (dir, facing) = towards(sp, q, ng, pdf);
+                let ray = spawn_ray_to_lanes(sp, sn, q, ng);
+                let ok = by_area & facing & Mask8::from_bitmask(on_mesh);
+                let m = ok.bitmask();
+                let (mut w, mut pdfs) = (load(&wi), Float8::load(&light_pdf));
+                w = V3::select(ok, dir, w);
+                pdfs = Float8::select(ok, pdf, pdfs);
+                store(&mut wi, w);
+                light_pdf = pdfs.to_array();
+                shadow.merge(ok, &ray);
+                sampled |= m;
+            }
+            for v in light_pdf.iter_mut() {
+                *v /= n_lights as f32;
+            }
+            let wi_local = to_local(fs, ft, fn_, load(&wi));
+            // f and the BSDF's density: in lanes for diffuse surfaces, by the model for the others.
+            let mut f = diffuse_f(rho, wo, wi_local);
+            let mut bsdf_pdf = diffuse_pdf(wo, wi_local);
+            let others = sampled & !surf.diffuse;
+            if others != 0 {
+                let (mut f_rows, mut pdf_rows) = (Rows3::default(), [0.0f32; W]);
+                store_rgb(&mut f_rows, f);
+                let wi_rows = {
+                    let mut r = Rows3::default();
+                    store(&mut r, wi_local);
+                    r
+                };
+                for lane in lanes(others) {
+                    let (bsdf, wo, wi) = (models[lane].as_deref().expect("a model"), wo_rows.get(lane), wi_rows.get(lane));
+                    f_rows.set_rgb(lane, bsdf.f(wo, wi));
+                    if delta & (1 << lane) == 0 {
+                        pdf_rows[lane] = bsdf.pdf(wo, wi);
+                    }
+                }
+                f = load_rgb(&f_rows);
+                bsdf_pdf = Float8::select(Mask8::from_bitmask(others), Float8::load(&pdf_rows), bsdf_pdf);
+            }
+            // Shadow rays where the sample carries light.
+            let nonzero = (f[0].ne(Float8::splat(0.0)) | f[1].ne(Float8::splat(0.0)) | f[2].ne(Float8::splat(0.0))).bitmask();
+            let tested = sampled & nonzero;
+            let rays = RayLanes { o: load(&shadow.o), d: load(&shadow.d), tmax: Float8::load(&shadow.tmax) };
+            let visible = tested & !scene.occluded_rays(&rays, tested);
+            // L += β · f · Lᵢ · |cos θi| · w / p_light, or β · 0 where the sample carries nothing (as a path
+            // traced alone adds it: a non-finite β spoils the sample either way).
+            let light_pdf = Float8::load(&light_pdf);
+            let w = Float8::select(Mask8::from_bitmask(delta), Float8::splat(1.0), power_heuristic_1(light_pdf, bsdf_pdf));
+            let scale = wi_local.z.abs() * w / light_pdf;
+            let li = load_rgb(&li);
+            let mut l = load_rgb(&p.l);
+            let (visible, smooth) = (Mask8::from_bitmask(visible), Mask8::from_bitmask(smooth));
+            for c in 0..3 {
+                let ne = Float8::select(visible, f[c] * li[c] * scale, Float8::splat(0.0));
+                l[c] = Float8::select(smooth, l[c] + beta[c] * ne, l[c]);
+            }
+            store_rgb(&mut p.l, l);
+        } else if smooth != 0 {
+            // No light: L += β · 0, as a path traced alone does.
+            let (mut l, smooth) = (load_rgb(&p.l), Mask8::from_bitmask(smooth));
+            for c in 0..3 {
+                l[c] = Float8::select(smooth, l[c] + beta[c] * Float8::splat(0.0), l[c]);
+            }
+            store_rgb(&mut p.l, l);
+        }
+
+        // BSDF sampling: in lanes for diffuse surfaces, by the model for the others.
+        let (uc, ux, uy) = (p.rng.next_f32(p.live), p.rng.next_f32(p.live), p.rng.next_f32(p.live));
+        let ds = diffuse_sample(rho, wo, ux, uy);
+        let (uc, ux, uy) = (uc.to_array(), ux.to_array(), uy.to_array());
+        let mut valid = ds.valid.bitmask() & surf.diffuse;
+        let (mut s_wi, mut s_pdf, mut s_eta, mut s_weight) = (ds.wi, ds.pdf, ds.eta, ds.weight);
+        let mut s_delta = 0u32;
+        let others = p.live & !surf.diffuse;
+        if others != 0 {
+            let (mut wi_rows, mut w_rows) = (Rows3::default(), Rows3::default());
+            let (mut pdf_rows, mut eta_rows) = (s_pdf.to_array(), s_eta.to_array());
+            store(&mut wi_rows, s_wi);
+            store_rgb(&mut w_rows, s_weight);
+            for lane in lanes(others) {
+                let bsdf = models[lane].as_deref().expect("a model");
+                let Some(s) = bsdf.sample(wo_rows.get(lane), uc[lane], Vec2::new(ux[lane], uy[lane])) else { continue };
+                wi_rows.set(lane, s.wi);
+                w_rows.set_rgb(lane, s.weight);
+                pdf_rows[lane] = s.pdf;
+                eta_rows[lane] = s.eta;
+                s_delta |= u32::from(s.flags.contains(BsdfFlags::DELTA)) << lane;
+                valid |= 1 << lane;
+            }
+            (s_wi, s_weight, s_pdf, s_eta) = (load(&wi_rows), load_rgb(&w_rows), Float8::load(&pdf_rows), Float8::load(&eta_rows));
+        }
+        for lane in lanes(p.live & !valid) {
+            p.finish(lane, out);
+        }
+        for c in 0..3 {
+            beta[c] = beta[c] * s_weight[c];
+        }
+        let eta = Float8::load(&p.eta) * s_eta;
+        let wi = to_world(fs, ft, fn_, s_wi);
+        let sp = load(&surf.p);
+        store(&mut p.o, offset_origin_lanes(sp, load(&surf.n), wi));
+        store(&mut p.d, wi);
+        store(&mut p.from, sp);
+        p.pdf = s_pdf.to_array();
+        p.eta = eta.to_array();
+        p.delta = s_delta;
+        // Russian roulette.
+        let beta_max = beta[0].max(beta[1]).max(beta[2]);
+        let q = (beta_max * eta * eta).min(Float8::splat(0.95));
+        let dead = (!beta_max.gt(Float8::splat(0.0))).bitmask();
+        let mut roulette = 0u32;
+        for lane in lanes(p.live) {
+            p.depth[lane] += 1;
+            if dead & (1 << lane) != 0 {
+                p.finish(lane, out);
+                continue;
+            }
+            roulette |= u32::from(p.depth[lane] >= rr_depth) << lane;
+        }
+        let survive_scale = roulette & !p.rng.next_f32(roulette).ge(q).bitmask();
+        for lane in lanes(roulette & !survive_scale) {
+            p.finish(lane, out);
+        }
+        let scaled = Mask8::from_bitmask(survive_scale);
+        for b in &mut beta {
+            *b = Float8::select(scaled, *b / q, *b);
+        }
+        store_rgb(&mut p.beta, beta);
     }
-    l
 }

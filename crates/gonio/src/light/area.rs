@@ -11,8 +11,22 @@
 use super::LightSample;
 use crate::geometry::ray::spawn_ray_to;
 use crate::geometry::{Shape, SurfaceInteraction};
+use crate::math::lanes::{Real, V3};
 use crate::spectrum::Rgb;
 use glam::{Vec2, Vec3};
+
+/// For a point `q` on an emitter (shading normal `nq`) sampled from `p` with solid-angle density `pdf`: the
+/// unit direction from `p` towards it, and whether the sample counts — one-sided emission: `q` must face
+/// `p` — with a positive, finite density. In lanes.
+#[inline(always)]
+pub fn towards<R: Real>(p: V3<R>, q: V3<R>, nq: V3<R>, pdf: R) -> (V3<R>, R::Mask) {
+    // `Vec3::normalize_or_zero`.
+    let d = q.sub(p);
+    let rcp = R::splat(1.0) / d.length();
+    let zero = R::splat(0.0);
+    let wi = V3::select(rcp.is_finite() & rcp.gt(zero), d.scale(rcp), V3::new(zero, zero, zero));
+    (wi, !nq.dot(wi.neg()).le(zero) & pdf.gt(zero) & pdf.is_finite())
+}
 
 /// Emission from shape number `shape`.
 #[derive(Clone, Debug, PartialEq)]
@@ -36,12 +50,8 @@ impl AreaLight {
     #[must_use]
     pub fn sample_li(&self, shape: &Shape, p: Vec3, n: Vec3, uc: f32, u: Vec2) -> Option<LightSample> {
         let (ps, pdf) = shape.sample_from(p, uc, u)?;
-        let wi = (ps.p - p).normalize_or_zero();
-        // One-sided emission: the sampled point must face the reference point.
-        if ps.n.dot(-wi) <= 0.0 || !(pdf > 0.0) || !pdf.is_finite() {
-            return None;
-        }
-        Some(LightSample { wi, li: self.radiance, pdf, delta: false, shadow: spawn_ray_to(p, n, ps.p, ps.ng) })
+        let (wi, valid) = towards::<f32>(p.into(), ps.p.into(), ps.n.into(), pdf);
+        valid.then(|| LightSample { wi: wi.into(), li: self.radiance, pdf, delta: false, shadow: spawn_ray_to(p, n, ps.p, ps.ng) })
     }
 
     /// Solid-angle density with which [`Self::sample_li`] from `p` produces the point `hit` on the light.

@@ -186,6 +186,7 @@ impl Distribution1D {
     }
 
     /// Choose a cell with probability proportional to its value, and hand back `u` rescaled for reuse.
+    #[inline]
     #[must_use]
     pub fn sample_discrete(&self, u: f32) -> DiscreteSample {
         debug_assert!((0.0..=1.0).contains(&u), "Distribution1D::sample_discrete: u = {u} outside [0, 1]");
@@ -195,6 +196,14 @@ impl Distribution1D {
         let pmf = c1 - c0;
         let u_remapped = if pmf > 0.0 { (((u - c0) / pmf) as f32).clamp(0.0, ONE_MINUS_EPSILON) } else { 0.0 };
         DiscreteSample { index, pmf: pmf as f32, u_remapped }
+    }
+
+    /// The cell [`Self::sample_discrete`] chooses for `u`, alone.
+    #[inline]
+    #[must_use]
+    pub fn sample_index(&self, u: f32) -> usize {
+        debug_assert!((0.0..=1.0).contains(&u), "Distribution1D::sample_index: u = {u} outside [0, 1]");
+        self.find_cell(f64::from(u))
     }
 
     /// The probability with which [`Self::sample_discrete`] chooses cell `index`.

@@ -7,4 +7,4 @@ pub mod mis;
 pub mod rng;
 pub mod warp;
 
-pub use rng::Pcg32;
+pub use rng::{Pcg32, Pcg32x8};

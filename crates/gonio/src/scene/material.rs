@@ -61,7 +61,7 @@ impl Material {
     fn try_at(&self, uv: Vec2) -> Result<Cow<'_, Bsdf>> {
         Ok(match self {
             Material::Fixed(b) => Cow::Borrowed(b),
-            Material::TexturedDiffuse(t) => Cow::Owned(Bsdf::Diffuse(Diffuse::new(t.eval(uv).map(|v| v.clamp(0.0, 1.0))))),
+            Material::TexturedDiffuse(t) => Cow::Owned(Bsdf::Diffuse(Diffuse::new(Self::texel(t, uv)))),
             Material::Textured { template, textures, cache } => {
                 let values: Vec<TextureValue> = textures.iter().map(|(path, t)| TextureValue::of(path, t, uv)).collect();
                 let key: Vec<u32> = values.iter().flat_map(TextureValue::bits).collect();
@@ -82,6 +82,30 @@ impl Material {
                 Cow::Owned(bsdf)
             }
         })
+    }
+
+    /// Whether the material reads textures (and so needs texture coordinates at hits).
+    #[must_use]
+    pub fn is_textured(&self) -> bool {
+        !matches!(self, Material::Fixed(_))
+    }
+
+    /// A textured `diffuse`'s reflectance at `uv`: the texture's value clamped to [0, 1].
+    #[inline]
+    fn texel(t: &Texture, uv: Vec2) -> crate::spectrum::Rgb {
+        t.eval(uv).map(|v| v.clamp(0.0, 1.0))
+    }
+
+    /// For a `diffuse` material (textured or not), its reflectance at `uv` — what [`Self::at`] would build a
+    /// [`Diffuse`] of, without building it (the renderer's packets evaluate diffuse surfaces in lanes).
+    #[inline]
+    #[must_use]
+    pub fn diffuse_reflectance(&self, uv: Vec2) -> Option<crate::spectrum::Rgb> {
+        match self {
+            Material::Fixed(Bsdf::Diffuse(d)) => Some(d.reflectance),
+            Material::TexturedDiffuse(t) => Some(Self::texel(t, uv)),
+            _ => None,
+        }
     }
 
     /// The BSDF at texture coordinates `uv`. A texture value a model rejects (e.g. a reflectance above 1)
