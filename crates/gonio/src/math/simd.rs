@@ -644,6 +644,10 @@ impl Real for Float8 {
         Float8::from_fn(|i| f(a[i]))
     }
     #[inline(always)]
+    fn lerp_table<const N: usize>(self, table: &[f32; N]) -> Self {
+        self.map(|x| x.lerp_table(table))
+    }
+    #[inline(always)]
     fn lt(self, o: Self) -> Mask8 {
         Float8::lt(self, o)
     }
