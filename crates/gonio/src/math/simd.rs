@@ -614,11 +614,12 @@ impl Real for Float8 {
     /// `f32::min`: `o` where `o < self`, and `o` where `self` is NaN — what `f32::min(self, o)` compiles to.
     #[inline(always)]
     fn min(self, o: Self) -> Self {
-        Float8::select(self.unordered(self), o, o.min_or_second(self))
+        // minps(self, o) is `o` on ties of ±0 and where self is NaN, as `Real::min` specifies.
+        Float8::select(o.unordered(o), self, self.min_or_second(o))
     }
     #[inline(always)]
     fn max(self, o: Self) -> Self {
-        Float8::select(self.unordered(self), o, o.max_or_second(self))
+        Float8::select(o.unordered(o), self, self.max_or_second(o))
     }
     /// `f32::clamp`: NaN stays NaN.
     #[inline(always)]
@@ -690,6 +691,39 @@ impl Real for Float8 {
     }
 }
 
+/// Rows in and out of [`Float8`], so that it passes the checks every lane type passes
+/// ([`check_lane_type`](super::lanes::check_lane_type)); the renderer moves its lanes itself.
+#[cfg(test)]
+impl super::lanes::Rows for Float8 {
+    fn load(v: &[f32]) -> Self {
+        Float8::load(v.try_into().expect("eight numbers"))
+    }
+    fn store(self, out: &mut [f32]) {
+        out.copy_from_slice(&self.to_array());
+    }
+    fn load3(v: &[super::Vec3]) -> super::lanes::V3<Self> {
+        super::lanes::V3::new(Float8::from_fn(|i| v[i].x), Float8::from_fn(|i| v[i].y), Float8::from_fn(|i| v[i].z))
+    }
+    fn load2(v: &[super::Vec2]) -> (Self, Self) {
+        (Float8::from_fn(|i| v[i].x), Float8::from_fn(|i| v[i].y))
+    }
+    fn store3(x: Self, y: Self, z: Self, out: &mut [[f32; 3]]) {
+        for (l, r) in out.iter_mut().enumerate() {
+            *r = [x.lane(l), y.lane(l), z.lane(l)];
+        }
+    }
+    fn store_u32(self, out: &mut [u32]) {
+        for (l, o) in out.iter_mut().enumerate() {
+            *o = self.lane(l) as u32;
+        }
+    }
+    fn store_mask(m: Mask8, out: &mut [bool]) {
+        for (l, o) in out.iter_mut().enumerate() {
+            *o = m.lane(l);
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -703,6 +737,12 @@ mod tests {
 
     fn mask(m: Mask8, f: &dyn Fn(f32, f32) -> bool) -> bool {
         (0..8).all(|i| m.lane(i) == f(A[i], B[i]))
+    }
+
+    /// The checks every lane type passes, `lerp_table` and row moves included.
+    #[test]
+    fn passes_the_lane_type_checks() {
+        crate::math::lanes::check_lane_type::<Float8>();
     }
 
     /// Every operation is the `f32` one per lane, bit for bit, NaN and infinities included.
