@@ -23,18 +23,9 @@ DATA = pathlib.Path(os.environ.get("GONIO_DATA", ROOT.parent / "shared" / "data"
 if not DATA.is_dir():
     DATA = pathlib.Path("/work/shared/data")
 
-# The scene the CLI's tests vary (crates/gonio-cli/tests/common/mod.rs): line numbers in the messages
-# refer to it.
-SCENE = """<scene version="3.0.0">
-    <default name="res" value="4"/>
-    <integrator type="path"><integer name="max_depth" value="3"/></integrator>
-    <sensor type="perspective">
-        <transform name="to_world"><lookat origin="0, 0, 4" target="0, 0, 0" up="0, 1, 0"/></transform>
-        <film type="hdrfilm"><integer name="width" value="$res"/><integer name="height" value="$res"/></film>
-    </sensor>
-    <emitter type="constant"/>
-    <shape type="sphere"/>
-</scene>"""
+# The scene the CLI's tests vary (crates/gonio-cli/tests/data/sphere_sky.xml, the CLI tests' `SCENE`): line
+# numbers in the messages refer to it.
+SCENE = (ROOT / "crates" / "gonio-cli" / "tests" / "data" / "sphere_sky.xml").read_text()
 SPHERE = '<shape type="sphere"/>'
 CONSTANT = '<emitter type="constant"/>'
 

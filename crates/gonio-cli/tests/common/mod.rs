@@ -37,17 +37,9 @@ pub fn assert_one_line_error(args: &[&str], expect: &str) {
     assert_eq!(stderr.trim_end().lines().count(), 1, "{args:?}: {stderr}");
 }
 
-/// A 4×4 render of a sphere under a constant sky (`-D res=N` changes the size).
-pub const SCENE: &str = r#"<scene version="3.0.0">
-    <default name="res" value="4"/>
-    <integrator type="path"><integer name="max_depth" value="3"/></integrator>
-    <sensor type="perspective">
-        <transform name="to_world"><lookat origin="0, 0, 4" target="0, 0, 0" up="0, 1, 0"/></transform>
-        <film type="hdrfilm"><integer name="width" value="$res"/><integer name="height" value="$res"/></film>
-    </sensor>
-    <emitter type="constant"/>
-    <shape type="sphere"/>
-</scene>"#;
+/// A 4×4 render of a sphere under a constant sky (`-D res=N` changes the size); the Python error tests
+/// read the same file.
+pub const SCENE: &str = include_str!("../data/sphere_sky.xml");
 
 /// A fresh directory under the system's temporary directory, removed with everything in it when dropped.
 pub use gonio::scratch::ScratchDir as Scratch;
