@@ -135,39 +135,41 @@ pub fn fresnel_diffuse_reflectance(eta: f32) -> f64 {
 }
 
 /// The parts a = Re(η̃ cos θₜ), b = Im(η̃ cos θₜ) of η̃ cos θₜ = √(η̃² − sin²θᵢ) for a conductor of complex
-/// relative index η̃ = η + i k, given `eta_k2` = η² − k², `eta_k` = ηk and s² = sin²θᵢ. From
-/// (a + ib)² = η² − k² − s² + 2iηk: a² − b² = t and ab = ηk with t = η² − k² − s², so with
-/// m = a² + b² = √(t² + 4η²k²): a² = (m + t)/2 and b² = (m − t)/2 (Born & Wolf, *Principles of Optics*,
-/// §14.2, eqs. 14.2(21)–(22), the u², v² of an absorbing medium). Whichever of the two would cancel
-/// (m ≈ |t|) is taken from ab = ηk instead: the smaller of a, b is |ηk| divided by the larger, the same
-/// value rearranged, so both keep full f32 precision (silver, t ≈ −23, has a² ≈ 0.024: the direct form
-/// lost ~10 bits). Two square roots and a division for the pair (2026-12: the kernels of the conductor
-/// models are bound by divisions and square roots; it took three and a division).
+/// relative index η̃ = η + i k, given `eta_k2` = η² − k², `eta_k` = ηk and s² = sin²θᵢ, as fractions
+/// (a, b) = (x/ℓ, y/ℓ) over one positive denominator ℓ. From (a + ib)² = η² − k² − s² + 2iηk:
+/// a² − b² = t and ab = ηk with t = η² − k² − s², so with m = a² + b² = √(t² + 4η²k²): a² = (m + t)/2 and
+/// b² = (m − t)/2 (Born & Wolf, *Principles of Optics*, §14.2, eqs. 14.2(21)–(22), the u², v² of an
+/// absorbing medium). Whichever of the two would cancel (m ≈ |t|) is taken from ab = ηk instead: with
+/// ℓ² = (m + |t|)/2 the larger of a², b², the larger root is ℓ = ℓ²/ℓ and the smaller |ηk|/ℓ, so
+/// (x, y) = (ℓ², |ηk|) for t ≥ 0 and (|ηk|, ℓ²) for t < 0 — both in full f32 precision (silver, t ≈ −23,
+/// has a² ≈ 0.024: the direct form lost ~10 bits), with two square roots and no division (2026-12: the
+/// conductor kernels are bound by divisions and square roots; the callers' ratios are homogeneous in a
+/// and b, so ℓ cancels). a = b = 0 (η = sin θᵢ, k = 0) comes back as (0, 0, 1).
 #[inline(always)]
-fn conductor_cos_t<R: Real>(eta_k2: f32, eta_k: f32, sin2_i: R) -> (R, R) {
+fn conductor_cos_t<R: Real>(eta_k2: f32, eta_k: f32, sin2_i: R) -> (R, R, R) {
     let t = R::splat(eta_k2) - sin2_i;
     let m = (t * t + 4.0 * eta_k * eta_k).sqrt();
-    // (m + |t|)/2 is the larger of a², b²; the smaller root is |ηk| / the larger (0 when both are 0).
-    let larger = ((m + t.abs()) * 0.5).sqrt();
+    let larger2 = (m + t.abs()) * 0.5;
     let zero = R::splat(0.0);
-    let smaller = R::select(larger.gt(zero), R::splat(eta_k.abs()) / larger, zero);
+    let ell = R::select(larger2.gt(zero), larger2.sqrt(), R::splat(1.0));
+    let smaller = R::splat(eta_k.abs());
     let positive = t.ge(zero);
-    (R::select(positive, larger, smaller), R::select(positive, smaller, larger))
+    (R::select(positive, larger2, smaller), R::select(positive, smaller, larger2), ell)
 }
 
 /// Unpolarised Fresnel reflectance of a conductor with complex relative index η + i k, for light arriving
 /// at `cos_theta_i` ∈ [0, 1] from the outside (pbrt-v4 §9.3.6: Snell's law with a complex index, then the
-/// dielectric amplitude coefficients). Evaluated in real arithmetic: with a + ib = η̃ cos θₜ
+/// dielectric amplitude coefficients). Evaluated in real arithmetic: with a + ib = η̃ cos θₜ = (x + iy)/ℓ
 /// ([`conductor_cos_t`]), c = cos θᵢ and η̃² = e + i f (e = η² − k², f = 2ηk),
 ///
-/// Rₛ = |c − (a + ib)|² / |c + (a + ib)|² = ((c − a)² + b²) / ((c + a)² + b²),
-/// Rₚ = |η̃² c − (a + ib)|² / |η̃² c + (a + ib)|² = ((ec − a)² + (fc − b)²) / ((ec + a)² + (fc + b)²)
+/// Rₛ = |c − (a + ib)|² / |c + (a + ib)|² = ((cℓ − x)² + y²) / ((cℓ + x)² + y²),
+/// Rₚ = |η̃² c − (a + ib)|² / |η̃² c + (a + ib)|² = ((ecℓ − x)² + (fcℓ − y)²) / ((ecℓ + x)² + (fcℓ + y)²)
 ///
-/// (Born & Wolf §14.2 eq. 14.2(24) write the same ratios through a², b²; rₚ here is multiplied through by
-/// η̃, which leaves |rₚ| unchanged). Both quotients are of sums of squares. Against an f64 complex
-/// evaluation the f32 result is within 3.6e-6 relative over η ∈ [0.05, 50], k ∈ {0} ∪ [1e-3, 100],
-/// cos θ ∈ [0, 1] (49 × 50 × 257 grid; worst near η ≈ 1, k ≈ 0 at Brewster's angle, where Rₚ ≈ 0); the
-/// f32 complex-arithmetic version it replaced (2026-11) reached 6.2e-6 on the same grid. Test:
+/// (each ratio multiplied through by ℓ²; Born & Wolf §14.2 eq. 14.2(24) write the same ratios through a²,
+/// b²; rₚ here is multiplied through by η̃, which leaves |rₚ| unchanged). Both quotients are of sums of
+/// squares, and Rₛ + Rₚ is taken over one denominator: one division per channel. Against an f64 complex
+/// evaluation the f32 result is within 1.5e-6 relative over η ∈ [0.05, 50], k ∈ {0} ∪ [1e-3, 100],
+/// cos θ ∈ [0, 1] (25 × 26 × 65 grid; worst near η ≈ 1, k ≈ 0 at Brewster's angle, where Rₚ ≈ 0). Test:
 /// `conductor_sweep_matches_f64`.
 #[inline(always)]
 #[must_use]
@@ -184,15 +186,16 @@ pub fn fresnel_conductor_lanes<R: Real>(cos_theta_i: R, eta: f32, k: f32) -> R {
     // (No `mul_add`: without a target FMA it is a library call per use, which would dominate.)
     let sin2_i = (R::splat(1.0) - c) * (c + 1.0);
     let (e, f) = ((eta - k) * (eta + k), 2.0 * eta * k);
-    let (a, b) = conductor_cos_t(e, eta * k, sin2_i);
-    let (ns, ds) = (sum_of_squares(c - a, b), sum_of_squares(c + a, b));
-    let (ec, fc) = (c * e, c * f);
-    // Rₚ's terms grow as |η̃|⁴ and Rₛ's as |η̃|²: Rₚ's are scaled by σ ≈ 1/|η̃|⁴ so that the product of the
-    // denominators stays far from overflow (finite for |η̃|² up to ~10¹⁸).
-    let sigma = 1.0 / (1.0 + e * e + f * f);
-    let (np, dp) = (sum_of_squares(ec - a, fc - b) * sigma, sum_of_squares(ec + a, fc + b) * sigma);
-    // Rₛ + Rₚ over one denominator (one division instead of two, 2026-12); the numerator is a sum of
-    // non-negative terms.
+    let (x, y, ell) = conductor_cos_t(e, eta * k, sin2_i);
+    let cl = c * ell;
+    // Rₛ's terms grow as |η̃|⁴ (ℓ² ~ |η̃|²) and Rₚ's as |η̃|⁶: scaled by σₛ ≈ 1/|η̃|² and σₚ ≈ 1/|η̃|⁶ (each
+    // ratio is unchanged) so that the product of the denominators stays far from overflow.
+    let abs2 = (e * e + f * f).sqrt();
+    let (sigma_s, sigma_p) = (1.0 / (1.0 + abs2), 1.0 / ((1.0 + abs2) * (1.0 + e * e + f * f)));
+    let (ns, ds) = (sum_of_squares(cl - x, y) * sigma_s, sum_of_squares(cl + x, y) * sigma_s);
+    let (ecl, fcl) = (cl * e, cl * f);
+    let (np, dp) = (sum_of_squares(ecl - x, fcl - y) * sigma_p, sum_of_squares(ecl + x, fcl + y) * sigma_p);
+    // Rₛ + Rₚ over one denominator; the numerator is a sum of non-negative terms.
     (ns * dp + np * ds) / (ds * dp) * 0.5
 }
 

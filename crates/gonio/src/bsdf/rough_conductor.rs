@@ -204,17 +204,18 @@ impl MicrofacetConductor {
 }
 
 impl LaneModel for GgxConductor {
-    /// [`MicrofacetConductor::eval`] for GGX: the same steps, with selects for its early returns.
+    /// [`MicrofacetConductor::eval`] for GGX, with selects for its early returns, from the unnormalised
+    /// half vector h = ωo + ωi ([`Ggx::reflection_term`]): ωo·ωh = ωi·ωh = |h|/2 since ωo·h + ωi·h = h·h,
+    /// so F's cosine is √(h·h)/2 (the average `eval` takes, without its division).
     #[inline(always)]
     fn f_lanes<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> [R; 3] {
         let zero = R::splat(0.0);
-        let wm = wo.add(wi).normalize();
-        let d = self.ggx.d(wm);
-        let g = self.ggx.g_smith(wo, wi, wm);
-        let value = d * g / (wo.z * 4.0 * wi.z);
-        // Below the surface, D = 0, or within f32 underflow of the horizon (see `eval`): 0.
-        let ok = !(wo.z.le(zero) | wi.z.le(zero)) & d.ne(zero) & value.is_finite();
-        let cos_theta_d = (wo.dot(wm) + wi.dot(wm)) * 0.5;
+        let h = wo.add(wi);
+        let l = h.dot(h);
+        let value = self.ggx.reflection_term(wo, wi, h, l);
+        // Below the surface, a direction behind ωh, or within f32 underflow of the horizon (see `eval`): 0.
+        let ok = wo.z.gt(zero) & wi.z.gt(zero) & wo.dot(h).gt(zero) & wi.dot(h).gt(zero) & value.is_finite();
+        let cos_theta_d = l.sqrt() * 0.5;
         let fresnel = match self.eta_k {
             Some((eta, k)) => fresnel_conductor_rgb_lanes(cos_theta_d, eta, k),
             None => [R::splat(1.0); 3],
@@ -223,12 +224,12 @@ impl LaneModel for GgxConductor {
         channels!(|c| R::select(ok, fresnel[c] * s[c] * value, zero))
     }
 
-    /// [`MicrofacetConductor::pdf_lobe`] for GGX visible normals.
+    /// [`MicrofacetConductor::pdf_lobe`] for GGX visible normals ([`Ggx::pdf_reflected_visible_h`]).
     #[inline(always)]
     fn pdf_lanes<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> R {
         let zero = R::splat(0.0);
-        let wm = wo.add(wi).normalize();
-        R::select(wo.z.le(zero) | wi.z.le(zero), zero, self.ggx.pdf_reflected_visible(wo, wm))
+        let h = wo.add(wi);
+        R::select(wo.z.le(zero) | wi.z.le(zero), zero, self.ggx.pdf_reflected_visible_h(wo, h, h.dot(h)))
     }
 
     /// [`MicrofacetConductor::sample_lobe`] for GGX visible normals.

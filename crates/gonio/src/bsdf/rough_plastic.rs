@@ -552,42 +552,24 @@ impl GgxPlastic<'_> {
         specular_probability(R::splat(1.0) - self.transmittance(cos_theta_o), self.weight)
     }
 
-    /// The microfacet normal of a reflected pair with `wo` above ([`RoughDielectric`]'s half vector,
-    /// turned to +z), and the lanes where it is defined. Times the reciprocal length, where
-    /// `RoughDielectric` divides (one division instead of three, 2026-12): within a rounding of it, and
-    /// a plastic has no transmission lobe, whose 1 − F near the critical angle would magnify that rounding
-    /// (`RoughDielectric` keeps the division, which the Mitsuba comparison's floor was measured with).
-    #[inline(always)]
-    fn half_vector<R: Real>(wo: V3<R>, wi: V3<R>) -> (V3<R>, R::Mask) {
-        let zero = R::splat(0.0);
-        let h = wo.add(wi);
-        let len = h.length();
-        let wm = h.scale(R::splat(1.0) / len);
-        let wm = V3::select(wm.z.lt(zero), wm.neg(), wm);
-        let defined = !(wo.z.le(zero) | wi.z.eq(zero)) & wi.z.gt(zero) & len.gt(zero) & len.is_finite();
-        (wm, defined)
-    }
-
-    /// [`RoughDielectric::reflection`] (no compensation): Walter 2007 eq. 20.
+    /// [`RoughDielectric::reflection`] (no compensation): Walter 2007 eq. 20, from the unnormalised half
+    /// vector h = ωo + ωi as in [`GgxConductor`](super::rough_conductor::GgxConductor) (one division and
+    /// three square roots besides F's, 2026-12; F's cosine ωo·ωh = √(h·h)/2).
     #[inline(always)]
     fn reflection<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> [R; 3] {
         let zero = R::splat(0.0);
-        let (wm, defined) = Self::half_vector(wo, wi);
-        let d = self.ggx.d(wm);
-        let g = self.ggx.g_smith(wo, wi, wm);
-        let f = fresnel_dielectric_lanes((wo.dot(wm) + wi.dot(wm)) * 0.5, self.eta);
-        let value = f * d * g / (wo.z * 4.0 * wi.z);
-        let ok = (wo.z * wi.z).gt(zero) & defined & !(d.eq(zero) | g.eq(zero)) & value.is_finite();
+        let h = wo.add(wi);
+        let l = h.dot(h);
+        let value = self.ggx.reflection_term(wo, wi, h, l) * fresnel_dielectric_lanes(l.sqrt() * 0.5, self.eta);
+        let ok = wo.z.gt(zero) & wi.z.gt(zero) & wo.dot(h).gt(zero) & wi.dot(h).gt(zero) & value.is_finite();
         channels!(|c| R::select(ok, value * self.specular_reflectance.0[c], zero))
     }
 
-    /// [`RoughDielectric::reflection_pdf`] for GGX visible normals.
+    /// [`RoughDielectric::reflection_pdf`] for GGX visible normals ([`Ggx::pdf_reflected_visible_h`]).
     #[inline(always)]
     fn reflection_pdf<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> R {
-        let zero = R::splat(0.0);
-        let (wm, defined) = Self::half_vector(wo, wi);
-        let ok = !(wo.z.le(zero) | wi.z.le(zero)) & defined & !wo.dot(wm).le(zero);
-        R::select(ok, self.ggx.pdf_reflected_visible(wo, wm), zero)
+        let h = wo.add(wi);
+        R::select(wi.z.gt(R::splat(0.0)), self.ggx.pdf_reflected_visible_h(wo, h, h.dot(h)), R::splat(0.0))
     }
 }
 
