@@ -131,7 +131,7 @@ impl Node8 {
     #[inline(always)]
     fn hit(&self, r: &RayPre, tmax: Float8) -> (u32, Float8) {
         let near = |axis: usize| r.near[axis];
-        let slab = |axis: usize, side: usize| Float8::load(&self.bounds[side][axis]).sub(r.o[axis]).mul(r.inv_d[axis]);
+        let slab = |axis: usize, side: usize| (Float8::load(&self.bounds[side][axis]) - r.o[axis]) * r.inv_d[axis];
         let tnear = slab(0, near(0)).max_or_second(slab(1, near(1)).max_or_second(slab(2, near(2)).max_or_second(Float8::splat(0.0))));
         let tfar = slab(0, 1 - near(0)).min_or_second(slab(1, 1 - near(1)).min_or_second(slab(2, 1 - near(2)).min_or_second(tmax)));
         (tnear.le(tfar).bitmask(), tnear)
@@ -146,7 +146,7 @@ impl Node8 {
         let slab = |axis: usize, near: bool| {
             let (lo, hi) = (Float8::splat(self.bounds[0][axis][c]), Float8::splat(self.bounds[1][axis][c]));
             let plane = if near { Float8::select(r.neg[axis], hi, lo) } else { Float8::select(r.neg[axis], lo, hi) };
-            plane.sub(r.o[axis]).mul(r.inv_d[axis])
+            (plane - r.o[axis]) * r.inv_d[axis]
         };
         let tnear = slab(0, true).max_or_second(slab(1, true).max_or_second(slab(2, true).max_or_second(Float8::splat(0.0))));
         let tfar = slab(0, false).min_or_second(slab(1, false).min_or_second(slab(2, false).min_or_second(tmax)));

@@ -20,9 +20,16 @@
 //! so a kernel on `Avx8` gives the single calls' results bit for bit (tests below, and
 //! `bsdf::tests::batches_equal_single_calls`).
 //!
-//! Safety: `Avx8` and `Mask8` are crate-private, and values of them exist only inside the batch
-//! drivers' `#[target_feature(enable = "avx2,fma")]` functions, which are entered only when [`detected`]
-//! says the CPU has those features (`bsdf::lanes`). Their methods use the intrinsics on that basis.
+//! It is also the renderer's [`Float8`](super::simd::Float8) in builds that enable AVX2 and FMA at compile
+//! time (`-C target-cpu=native` on such a CPU, `x86-64-v3`): one type for both, so that each AVX operation
+//! is written once. Its inherent methods are `Float8`'s interface (`load`, `min_or_second`, `bitmask`, …);
+//! the renderer's kernels call them where [`Real`] has no such operation.
+//!
+//! Safety: values of `Avx8` and `Mask8` exist only where the CPU has AVX2 and FMA. In builds that enable
+//! both at compile time every CPU the program runs on has them, and the types are public (as `Float8`).
+//! In other builds they are crate-private, and values of them exist only inside the batch drivers'
+//! `#[target_feature(enable = "avx2,fma")]` functions, which are entered only when [`detected`] says the
+//! CPU has those features (`bsdf::lanes`). Their methods use the intrinsics on that basis.
 
 use super::lanes::{Real, Rows, V3};
 use super::{Vec2, Vec3};
@@ -40,15 +47,24 @@ pub fn detected() -> bool {
     std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma")
 }
 
-/// Eight `f32` lanes in one AVX register (see the module doc).
-#[derive(Clone, Copy)]
-#[repr(transparent)]
-pub(crate) struct Avx8(__m256);
+// Public where the build enables AVX2 and FMA (`Avx8` is then `Float8`), else crate-private (module doc).
+macro_rules! lane_types {
+    ($vis:vis) => {
+        /// Eight `f32` lanes in one AVX register (see the module doc).
+        #[derive(Clone, Copy, Debug)]
+        #[repr(transparent)]
+        $vis struct Avx8(__m256);
 
-/// Eight comparison results: all bits set (true) or clear per lane.
-#[derive(Clone, Copy)]
-#[repr(transparent)]
-pub(crate) struct Mask8(__m256);
+        /// Eight comparison results: all bits set (true) or clear per lane.
+        #[derive(Clone, Copy, Debug)]
+        #[repr(transparent)]
+        $vis struct Mask8(__m256);
+    };
+}
+#[cfg(all(target_feature = "avx2", target_feature = "fma"))]
+lane_types!(pub);
+#[cfg(not(all(target_feature = "avx2", target_feature = "fma")))]
+lane_types!(pub(crate));
 
 /// `_MM_SHUFFLE(z, y, x, w)`: the elements of the first, first, second and second operand that go to each
 /// place of a 128-bit half.
@@ -64,10 +80,13 @@ macro_rules! avx {
     };
 }
 
+/// `Float8`'s interface (see the module doc): operations [`Real`] does not have, and [`Real`]'s own as
+/// inherent methods, which the renderer's kernels call without importing the trait.
 impl Avx8 {
-    /// The lanes as an array (for `map`).
+    /// The lanes as an array.
     #[inline(always)]
-    pub(crate) fn to_array(self) -> [f32; 8] {
+    #[must_use]
+    pub fn to_array(self) -> [f32; 8] {
         let mut a = [0.0; 8];
         avx!(_mm256_storeu_ps(a.as_mut_ptr(), self.0));
         a
@@ -75,8 +94,128 @@ impl Avx8 {
 
     /// Lanes from an array.
     #[inline(always)]
-    pub(crate) fn from_array(a: [f32; 8]) -> Self {
+    #[must_use]
+    pub fn load(a: &[f32; 8]) -> Self {
         Avx8(avx!(_mm256_loadu_ps(a.as_ptr())))
+    }
+
+    /// Every lane `v`.
+    #[inline(always)]
+    #[must_use]
+    pub fn splat(v: f32) -> Self {
+        Avx8(avx!(_mm256_set1_ps(v)))
+    }
+
+    #[inline(always)]
+    #[must_use]
+    pub fn sqrt(self) -> Self {
+        Avx8(avx!(_mm256_sqrt_ps(self.0)))
+    }
+
+    #[inline(always)]
+    #[must_use]
+    pub fn abs(self) -> Self {
+        Avx8(avx!(_mm256_andnot_ps(_mm256_set1_ps(-0.0), self.0)))
+    }
+
+    /// x86's `minps`: `self < o ? self : o` (the second operand where either is NaN), one instruction.
+    #[inline(always)]
+    #[must_use]
+    pub fn min_or_second(self, o: Self) -> Self {
+        Avx8(avx!(_mm256_min_ps(self.0, o.0)))
+    }
+
+    /// x86's `maxps`: `self > o ? self : o` (the second operand where either is NaN).
+    #[inline(always)]
+    #[must_use]
+    pub fn max_or_second(self, o: Self) -> Self {
+        Avx8(avx!(_mm256_max_ps(self.0, o.0)))
+    }
+
+    /// Towards zero (`f32::trunc`).
+    #[inline(always)]
+    #[must_use]
+    pub fn trunc(self) -> Self {
+        Avx8(avx!(_mm256_round_ps::<{ _MM_FROUND_TO_ZERO | _MM_FROUND_NO_EXC }>(self.0)))
+    }
+
+    /// The bits of `self` with the sign bit of `o` flipped into them (`self ^ (o & sign)`).
+    #[inline(always)]
+    #[must_use]
+    pub fn xor_sign(self, o: Self) -> Self {
+        Avx8(avx!(_mm256_xor_ps(self.0, _mm256_and_ps(o.0, _mm256_set1_ps(-0.0)))))
+    }
+
+    /// `a` where `m` is set, else `b`.
+    #[inline(always)]
+    #[must_use]
+    pub fn select(m: Mask8, a: Self, b: Self) -> Self {
+        Avx8(avx!(_mm256_blendv_ps(b.0, a.0, m.0)))
+    }
+
+    #[inline(always)]
+    fn compare<const PREDICATE: i32>(self, o: Avx8) -> Mask8 {
+        Mask8(avx!(_mm256_cmp_ps::<PREDICATE>(self.0, o.0)))
+    }
+
+    #[inline(always)]
+    #[must_use]
+    pub fn lt(self, o: Self) -> Mask8 {
+        self.compare::<_CMP_LT_OQ>(o)
+    }
+    #[inline(always)]
+    #[must_use]
+    pub fn le(self, o: Self) -> Mask8 {
+        self.compare::<_CMP_LE_OQ>(o)
+    }
+    #[inline(always)]
+    #[must_use]
+    pub fn gt(self, o: Self) -> Mask8 {
+        self.compare::<_CMP_GT_OQ>(o)
+    }
+    #[inline(always)]
+    #[must_use]
+    pub fn ge(self, o: Self) -> Mask8 {
+        self.compare::<_CMP_GE_OQ>(o)
+    }
+    #[inline(always)]
+    #[must_use]
+    pub fn eq(self, o: Self) -> Mask8 {
+        self.compare::<_CMP_EQ_OQ>(o)
+    }
+    /// True where either is NaN, as `!=`.
+    #[inline(always)]
+    #[must_use]
+    pub fn ne(self, o: Self) -> Mask8 {
+        self.compare::<_CMP_NEQ_UQ>(o)
+    }
+    /// True where either is NaN.
+    #[inline(always)]
+    #[must_use]
+    pub fn unordered(self, o: Self) -> Mask8 {
+        self.compare::<_CMP_UNORD_Q>(o)
+    }
+}
+
+// `from_bitmask` is for the renderer, which uses these types only where they are `Float8`.
+#[cfg_attr(not(all(target_feature = "avx2", target_feature = "fma")), allow(dead_code))]
+impl Mask8 {
+    /// Bit `i` set where lane `i` is.
+    #[inline(always)]
+    #[must_use]
+    pub fn bitmask(self) -> u32 {
+        avx!(_mm256_movemask_ps(self.0)) as u32
+    }
+
+    /// Lane `i` set where bit `i` of `bits` is.
+    #[inline(always)]
+    #[must_use]
+    pub fn from_bitmask(bits: u32) -> Self {
+        avx!({
+            let lane_bits = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+            let b = _mm256_and_si256(_mm256_set1_epi32(bits as i32), lane_bits);
+            Mask8(_mm256_castsi256_ps(_mm256_cmpeq_epi32(b, lane_bits)))
+        })
     }
 }
 
@@ -129,38 +268,31 @@ impl Not for Mask8 {
     }
 }
 
-impl Avx8 {
-    #[inline(always)]
-    fn compare<const PREDICATE: i32>(self, o: Avx8) -> Mask8 {
-        Mask8(avx!(_mm256_cmp_ps::<PREDICATE>(self.0, o.0)))
-    }
-}
-
 impl Real for Avx8 {
     type Mask = Mask8;
     const LANES: usize = 8;
 
     #[inline(always)]
     fn splat(v: f32) -> Self {
-        Avx8(avx!(_mm256_set1_ps(v)))
+        Avx8::splat(v)
     }
     #[inline(always)]
     fn sqrt(self) -> Self {
-        Avx8(avx!(_mm256_sqrt_ps(self.0)))
+        Avx8::sqrt(self)
     }
     #[inline(always)]
     fn abs(self) -> Self {
-        Avx8(avx!(_mm256_andnot_ps(_mm256_set1_ps(-0.0), self.0)))
+        Avx8::abs(self)
     }
     /// `minps(self, o)` is self < o ? self : o, the `f32` form's result but where `o` is NaN.
     #[inline(always)]
     fn min(self, o: Self) -> Self {
-        Avx8::select(o.is_nan(), self, Avx8(avx!(_mm256_min_ps(self.0, o.0))))
+        Avx8::select(o.is_nan(), self, self.min_or_second(o))
     }
     /// As [`Self::min`], with self > o.
     #[inline(always)]
     fn max(self, o: Self) -> Self {
-        Avx8::select(o.is_nan(), self, Avx8(avx!(_mm256_max_ps(self.0, o.0))))
+        Avx8::select(o.is_nan(), self, self.max_or_second(o))
     }
     #[inline(always)]
     fn clamp(self, lo: f32, hi: f32) -> Self {
@@ -176,13 +308,12 @@ impl Real for Avx8 {
     /// x − t (exact) is at least one half. ±∞ and NaN stay (their rest is NaN).
     #[inline(always)]
     fn round(self) -> Self {
-        let t = Avx8(avx!(_mm256_round_ps::<{ _MM_FROUND_TO_ZERO | _MM_FROUND_NO_EXC }>(self.0)));
-        let step = Avx8(avx!(_mm256_or_ps(_mm256_and_ps(self.0, _mm256_set1_ps(-0.0)), _mm256_set1_ps(1.0))));
-        Avx8::select((self - t).abs().ge(Avx8::splat(0.5)), t + step, t)
+        let t = self.trunc();
+        Avx8::select((self - t).abs().ge(Avx8::splat(0.5)), t + Avx8::splat(1.0).xor_sign(self), t)
     }
     #[inline(always)]
     fn map(self, f: impl Fn(f32) -> f32) -> Self {
-        Avx8::from_array(self.to_array().map(f))
+        Avx8::load(&self.to_array().map(f))
     }
     /// The index arithmetic and the interpolation in lanes, the two table entries of each lane by gathers:
     /// per lane the operations of the `f32` form.
@@ -204,28 +335,28 @@ impl Real for Avx8 {
     }
     #[inline(always)]
     fn lt(self, o: Self) -> Mask8 {
-        self.compare::<_CMP_LT_OQ>(o)
+        Avx8::lt(self, o)
     }
     #[inline(always)]
     fn le(self, o: Self) -> Mask8 {
-        self.compare::<_CMP_LE_OQ>(o)
+        Avx8::le(self, o)
     }
     #[inline(always)]
     fn gt(self, o: Self) -> Mask8 {
-        self.compare::<_CMP_GT_OQ>(o)
+        Avx8::gt(self, o)
     }
     #[inline(always)]
     fn ge(self, o: Self) -> Mask8 {
-        self.compare::<_CMP_GE_OQ>(o)
+        Avx8::ge(self, o)
     }
     #[inline(always)]
     fn eq(self, o: Self) -> Mask8 {
-        self.compare::<_CMP_EQ_OQ>(o)
+        Avx8::eq(self, o)
     }
     /// True where either is NaN, as `!=`.
     #[inline(always)]
     fn ne(self, o: Self) -> Mask8 {
-        self.compare::<_CMP_NEQ_UQ>(o)
+        Avx8::ne(self, o)
     }
     #[inline(always)]
     fn is_finite(self) -> Mask8 {
@@ -233,15 +364,15 @@ impl Real for Avx8 {
     }
     #[inline(always)]
     fn is_nan(self) -> Mask8 {
-        self.compare::<_CMP_UNORD_Q>(self)
+        self.unordered(self)
     }
     #[inline(always)]
     fn select(m: Mask8, a: Self, b: Self) -> Self {
-        Avx8(avx!(_mm256_blendv_ps(b.0, a.0, m.0)))
+        Avx8::select(m, a, b)
     }
     #[inline(always)]
     fn any(m: Mask8) -> bool {
-        avx!(_mm256_movemask_ps(m.0)) != 0
+        m.bitmask() != 0
     }
 }
 
