@@ -17,17 +17,22 @@
 //! Instructions per row (AVX2 build machine, 10⁵ rows): first with the kernels' loops compiled for the
 //! baseline target (before `simd_batch!` was fixed), then for AVX2 + FMA with `F32x8` (its lanes
 //! vectorised by LLVM's SLP pass), then (2026-11) on `Avx8`, whose every operation is its AVX instruction,
-//! with rows moved in and out by shuffles and roughplastic's table lookups by gathers (`math::avx2`):
+//! with rows moved in and out by shuffles and roughplastic's table lookups by gathers (`math::avx2`), then
+//! (2026-12) with the GGX terms taken from the unnormalised half vector (`Ggx::reflection_term`) and the
+//! conductor Fresnel term over one division per channel:
 //!
-//! | model (GGX α = 0.3)   | f              | pdf           | sample          |
-//! |-----------------------|----------------|---------------|-----------------|
-//! | diffuse               | 7 → 8 → 4.8    | 6 → 5 → 3.5   | 119 → 72 → 18.9 |
-//! | roughconductor (Au)   | 189 → 54 → 38.3 | 45 → 26 → 13.3 | 425 → 158 → 78.5 |
-//! | roughplastic          | 226 → 198 → 37.5 | 92 → 57 → 24.4 | 562 → 245 → 97.3 |
+//! | model (GGX α = 0.3)   | f                       | pdf                   | sample                  |
+//! |-----------------------|-------------------------|-----------------------|-------------------------|
+//! | diffuse               | 7 → 8 → 4.8 → 4.8       | 6 → 5 → 3.5 → 3.5     | 119 → 72 → 18.9 → 18.9  |
+//! | roughconductor (Au)   | 189 → 54 → 38.3 → 37.5  | 45 → 26 → 13.3 → 9.6  | 425 → 158 → 78.5 → 75.4 |
+//! | roughplastic          | 226 → 198 → 37.5 → 28.5 | 92 → 57 → 24.4 → 16.6 | 562 → 245 → 97.3 → 87.0 |
 //!
 //! roughplastic's `f` spent most of its 198 instructions in the per-lane lookup of the transmittance table.
-//! What remains is arithmetic; the glossy models' is bound by divisions and square roots (roughconductor's
-//! `f`: 34 per register of rows, 3 + 3 per RGB channel in the conductor Fresnel term).
+//! What remains is arithmetic; the glossy models' is bound by divisions and square roots, which the
+//! instruction counts hardly show: roughconductor's `f` takes 13 per register of rows (it took 20): √(h·h),
+//! the two masking sums' roots and one division for D G1 G1 / (4 cos θo cos θi), then two roots and one
+//! division per RGB channel of the Fresnel term. One thread with AVX-512 (criterion, `batch` group of
+//! `benches/bsdf.rs`): 2.50 → 1.95 ns per row.
 
 use gonio::bsdf::{Bsdf, BsdfModel, SampleColumns};
 use gonio::math::{Vec2, Vec3};

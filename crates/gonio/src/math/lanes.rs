@@ -5,7 +5,8 @@
 //! | [`Real`]    | the arithmetic a formula needs: + − × ÷, √, fused multiply–add, min/max, comparisons into a mask, `select`, a table lookup |
 //! | `f32`       | one lane; its mask is `bool` and `select` a branch — the renderer's single calls      |
 //! | [`F32x8`]   | eight lanes as plain Rust: each operation a loop over the lanes, for CPUs without AVX2 (and other architectures) |
-//! | `avx2::Avx8`, `avx512::Avx16` | eight or sixteen lanes in one AVX / AVX-512 register, each operation its instruction; what the batch drivers run on where the CPU has them (crate-private: see `math::avx2`) |
+//! | `avx2::Avx8`, `avx512::Avx16` | eight or sixteen lanes in one AVX / AVX-512 register, each operation its instruction; what the batch drivers run on where the CPU has them (crate-private unless the build enables AVX2 and FMA: see `math::avx2`) |
+//! | `simd::Float8` | the renderer's eight lanes, chosen at compile time: `Avx8` itself where the build enables AVX2 and FMA, else two SSE registers (or an array) |
 //! | `twice::Twice<R>` | two registers of `R` as one, their operations alternating (two dependency chains in flight): the AVX-512 drivers run `Twice<Twice<Avx16>>` |
 //! | [`V3`]      | a direction of lanes (structure of arrays: x, y and z each one `Real`)               |
 //! | `Rows`      | moving a register of rows between slices and lanes (the batch drivers' side)          |
