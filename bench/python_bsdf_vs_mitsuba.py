@@ -1,12 +1,20 @@
 """Benchmark (not a test): gonio's batched `f` and `sample` from Python against Mitsuba 3's `llvm_ad_rgb`
 `bsdf.eval` / `bsdf.sample` on the same 10⁶ direction pairs, in one run.
 
-    .venv/bin/python bench/python_bsdf_vs_mitsuba.py [--n 1000000] [--repeat 7]
+    .venv/bin/python bench/python_bsdf_vs_mitsuba.py [--n 1000000] [--repeat 7] [--rounds 3] [--one-process]
 
 Inputs are float32 arrays of shape (N, 3) (gonio reads them in place); Mitsuba gets the same numbers as
 `mi.Vector3f` built from the (contiguous) columns, outside the timing. Every figure is the median of
 `--repeat` runs after one warm-up (which also compiles Mitsuba's kernels). The issue's target: gonio at
 least as fast as Mitsuba's LLVM variant (whose `f`-equivalent is `eval`, which includes the cosine).
+
+Each library is timed alone, in a child process of its own that draws the same arrays from the same seed,
+the two alternating for `--rounds` rounds; each figure printed is the median over the rounds. Why: both
+libraries keep a pool of worker threads, one per core, and on two cores the one timed right after the
+other's kernel shares the CPU with the other's still-active workers (2026-12-01: gonio's roughconductor
+`f` took 1.4 ms per million alone and 3.6–5.7 ms right after a Mitsuba kernel in the same process, where
+the order of the script always put it). `--one-process` times both in this process (all of gonio's calls,
+then all of Mitsuba's), for comparison.
 
 What each side's timed call does, so that like is compared with like:
 - `f`: gonio checks every direction (finite, unit length within 10⁻³) and returns f as an (N, 3) float32
@@ -28,9 +36,11 @@ Mitsuba's LLVM variant needs libLLVM ≥ 16 (19 here): set DRJIT_LIBLLVM_PATH, o
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import statistics
 import subprocess
+import sys
 import time
 
 import numpy as np
@@ -74,66 +84,130 @@ def directions(rng, n):
     return (w / np.linalg.norm(w, axis=1, keepdims=True)).astype(np.float32)
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--n", type=int, default=1_000_000)
-    parser.add_argument("--repeat", type=int, default=7)
-    args = parser.parse_args()
-    n = args.n
+MODEL_NAMES = list(MODELS)
+
+
+def time_gonio(wo, wi, uc, u, repeat: int) -> dict:
+    """ms per call of gonio's `f` and `sample` for each model."""
+    out = {}
+    for name, spec in MODELS.items():
+        g = gonio.load_bsdf(spec)
+        out[name] = (median_ms(lambda: g.f(wo, wi), repeat), median_ms(lambda: g.sample(wo, uc, u), repeat))
+    return out
+
+
+def load_mitsuba():
+    """(mi, dr) with the `llvm_ad_rgb` variant set, or None (with the reason printed)."""
+    llvm = find_llvm()
+    if not llvm:
+        print("libLLVM-19 not found; timing gonio only")
+        return None
+    os.environ["DRJIT_LIBLLVM_PATH"] = llvm
+    try:
+        import drjit as dr
+        import mitsuba as mi
+
+        mi.set_variant("llvm_ad_rgb")
+    except (ImportError, AttributeError, RuntimeError) as e:
+        print(f"Mitsuba llvm_ad_rgb unavailable ({e}); timing gonio only")
+        return None
+    return mi, dr
+
+
+def time_mitsuba(mi, dr, wo, wi, uc, u, repeat: int) -> dict:
+    """ms per call of Mitsuba's `eval` and `sample` (with the copies to NumPy) for each model."""
+    n = len(wo)
+    mi_wo = mi.Vector3f(*(np.ascontiguousarray(wo[:, k]) for k in range(3)))
+    mi_wi = mi.Vector3f(*(np.ascontiguousarray(wi[:, k]) for k in range(3)))
+    mi_uc = mi.Float(uc)
+    mi_u = mi.Point2f(np.ascontiguousarray(u[:, 0]), np.ascontiguousarray(u[:, 1]))
+    si = dr.zeros(mi.SurfaceInteraction3f, n)
+    si.wi = mi_wo
+    ctx = mi.BSDFContext()
+    out = {}
+    for name, spec in MODELS.items():
+        m = mi.load_dict(spec)
+
+        def mi_eval():
+            v = m.eval(ctx, si, mi_wi)
+            return np.array(v)
+
+        def mi_sample():
+            bs, weight = m.sample(ctx, si, mi_uc, mi_u)
+            dr.eval(bs, weight)
+            fields = (bs.wo, bs.pdf, bs.eta, bs.sampled_type, bs.sampled_component, weight)
+            return [np.array(v) for v in fields]
+
+        out[name] = (median_ms(mi_eval, repeat), median_ms(mi_sample, repeat))
+    return out
+
+
+def inputs(n: int):
     rng = np.random.default_rng(1)
     wo, wi = directions(rng, n), directions(rng, n)
     uc = rng.random(n, dtype=np.float32)
     u = rng.random((n, 2), dtype=np.float32)
+    return wo, wi, uc, u
 
-    mi = dr = None
-    llvm = find_llvm()
-    if llvm:
-        os.environ["DRJIT_LIBLLVM_PATH"] = llvm
-        try:
-            import drjit as dr
-            import mitsuba as mi
 
-            mi.set_variant("llvm_ad_rgb")
-        except (ImportError, AttributeError, RuntimeError) as e:
-            print(f"Mitsuba llvm_ad_rgb unavailable ({e}); timing gonio only")
-            mi = None
+def child(side: str, n: int, repeat: int) -> None:
+    """One side's timings as JSON on stdout (`--side`)."""
+    wo, wi, uc, u = inputs(n)
+    if side == "gonio":
+        result = time_gonio(wo, wi, uc, u, repeat)
     else:
-        print("libLLVM-19 not found; timing gonio only")
+        loaded = load_mitsuba()
+        result = None if loaded is None else time_mitsuba(*loaded, wo, wi, uc, u, repeat)
+    print(json.dumps(result))
 
-    if mi is not None:
-        mi_wo = mi.Vector3f(*(np.ascontiguousarray(wo[:, k]) for k in range(3)))
-        mi_wi = mi.Vector3f(*(np.ascontiguousarray(wi[:, k]) for k in range(3)))
-        mi_uc = mi.Float(uc)
-        mi_u = mi.Point2f(np.ascontiguousarray(u[:, 0]), np.ascontiguousarray(u[:, 1]))
-        si = dr.zeros(mi.SurfaceInteraction3f, n)
-        si.wi = mi_wo
-        ctx = mi.BSDFContext()
 
+def run_child(side: str, args) -> dict | None:
+    cmd = [sys.executable, __file__, "--side", side, "--n", str(args.n), "--repeat", str(args.repeat)]
+    p = subprocess.run(cmd, capture_output=True, text=True, check=False)
+    if p.returncode != 0:
+        raise SystemExit(f"the {side} child failed (exit {p.returncode}):\n{p.stderr}")
+    lines = [line for line in p.stdout.splitlines() if line.strip()]
+    for line in lines[:-1]:
+        print(line)  # a child's messages (e.g. why Mitsuba is not timed)
+    return json.loads(lines[-1])
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--n", type=int, default=1_000_000)
+    parser.add_argument("--repeat", type=int, default=7)
+    parser.add_argument("--rounds", type=int, default=3, help="alternating child processes per library")
+    parser.add_argument("--one-process", action="store_true", help="time both libraries in this process (gonio, then Mitsuba)")
+    parser.add_argument("--side", choices=["gonio", "mitsuba"], help=argparse.SUPPRESS)
+    args = parser.parse_args()
+    if args.side:
+        child(args.side, args.n, args.repeat)
+        return
+    n = args.n
     print(f"load average {os.getloadavg()[0]:.2f} ({os.cpu_count()} cores)")
-    print(f"{n:,} direction pairs, float32 (N, 3) inputs, median of {args.repeat}; ms per million pairs")
+    if args.one_process:
+        wo, wi, uc, u = inputs(n)
+        g = time_gonio(wo, wi, uc, u, args.repeat)
+        loaded = load_mitsuba()
+        m = None if loaded is None else time_mitsuba(*loaded, wo, wi, uc, u, args.repeat)
+        how = "both in one process"
+    else:
+        rounds_g, rounds_m = [], []
+        for _ in range(args.rounds):
+            rounds_g.append(run_child("gonio", args))
+            rounds_m.append(run_child("mitsuba", args))
+        g = {k: tuple(statistics.median(r[k][j] for r in rounds_g) for j in range(2)) for k in MODEL_NAMES}
+        m = None if rounds_m[0] is None else {k: tuple(statistics.median(r[k][j] for r in rounds_m) for j in range(2)) for k in MODEL_NAMES}
+        how = f"each alone in its own process, median of {args.rounds} alternating rounds"
+    print(f"{n:,} direction pairs, float32 (N, 3) inputs, median of {args.repeat} calls; {how}; ms per million pairs")
     header = f"{'model':<22} {'gonio f':>9} {'mi eval':>9} {'ratio':>7}   {'gonio sample':>12} {'mi sample':>10} {'ratio':>7}"
     print(header)
     print("-" * len(header))
     per_million = 1e6 / n
-    for name, spec in MODELS.items():
-        g = gonio.load_bsdf(spec)
-        g_f = median_ms(lambda: g.f(wo, wi), args.repeat) * per_million
-        g_s = median_ms(lambda: g.sample(wo, uc, u), args.repeat) * per_million
-        if mi is not None:
-            m = mi.load_dict(spec)
-
-            def mi_eval():
-                v = m.eval(ctx, si, mi_wi)
-                return np.array(v)
-
-            def mi_sample():
-                bs, weight = m.sample(ctx, si, mi_uc, mi_u)
-                dr.eval(bs, weight)
-                fields = (bs.wo, bs.pdf, bs.eta, bs.sampled_type, bs.sampled_component, weight)
-                return [np.array(v) for v in fields]
-
-            m_f = median_ms(mi_eval, args.repeat) * per_million
-            m_s = median_ms(mi_sample, args.repeat) * per_million
+    for name in MODEL_NAMES:
+        g_f, g_s = (v * per_million for v in g[name])
+        if m is not None:
+            m_f, m_s = (v * per_million for v in m[name])
             print(f"{name:<22} {g_f:9.2f} {m_f:9.2f} {m_f / g_f:6.2f}×   {g_s:12.2f} {m_s:10.2f} {m_s / g_s:6.2f}×")
         else:
             print(f"{name:<22} {g_f:9.2f} {'—':>9} {'':>7}   {g_s:12.2f} {'—':>10}")
