@@ -49,7 +49,7 @@
 //!
 //! # Compared with Mitsuba 3 (3.9.1, 2026-11; crates/gonio-py/tests/test_mitsuba.py)
 //! T(μ), against an independent f64 integral at the 64 table nodes (`coating_transmittance_f64` there):
-//! gonio's table is within 5.5e-6; Mitsuba's (a 32 × 32 Gauss–Legendre rule in f32 over its sampler, with
+//! gonio's table is within 4.3e-6 (2026-12, read off f32 pdfs; 5.5e-6 with the visible-normal rule); Mitsuba's (a 32 × 32 Gauss–Legendre rule in f32 over its sampler, with
 //! its rational Beckmann G1) is 3e-5 to 3.7e-4 above it for GGX and up to ±1.6e-3 off for Beckmann α = 1.
 //! That makes the raw pdfs differ by up to 3.3e-3 (1.4e-2 Beckmann α = 1); with the integral's T in
 //! Mitsuba's mixture they agree within 7.8e-5. The diffuse term then differs by one constant per set,
