@@ -835,8 +835,9 @@ def test_roughplastic_specular(params):
 
 # --- the coating's transmittance T(μ), independently of both renderers ------------------------------------
 # Both renderers tabulate T(μ) at μ = k/63 (the horizon node at 1e-6) and interpolate linearly; gonio integrates
-# each node by a 128 × 128 Gauss–Legendre rule in f64, Mitsuba 3.9.1 by a 32 × 32 rule in f32 (for η > 1) over
-# its visible-normal sampler, with its rational Beckmann G1. `coating_transmittance_f64` integrates T without
+# each node by Gauss–Legendre rules on panels of the microfacet normals' polar angles, cut at the integrand's
+# kinks (`RoughDielectric::energy_split_by_panels`, f64 sums of f32 integrands), Mitsuba 3.9.1 by a 32 × 32 rule
+# in f32 (for η > 1) over its visible-normal sampler, with its rational Beckmann G1. `coating_transmittance_f64` integrates T without
 # either renderer, so the tests below can say which table is right and undo the other one's error.
 
 TABLE_MU = np.maximum(np.arange(64, dtype=np.float32) / np.float32(63), np.float32(1e-6))
