@@ -9,18 +9,11 @@ use gonio::microfacet::{MicrofacetDistribution, MicrofacetKind};
 use std::hint::black_box;
 use std::time::Instant;
 
+mod common;
+use common::cpu_seconds;
+
 /// Integrations per coating.
 const REPEAT: usize = 10;
-
-/// CPU seconds used by this process so far (user + system, all threads); 0 where /proc is missing.
-fn cpu_seconds() -> f64 {
-    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
-    // Fields after the parenthesised command name; utime and stime are fields 14 and 15 (1-based).
-    let rest = stat.rsplit(')').next().unwrap_or("");
-    let fields: Vec<&str> = rest.split_whitespace().collect();
-    let ticks = |i: usize| fields.get(i).and_then(|v| v.parse::<f64>().ok()).unwrap_or(0.0);
-    (ticks(11) + ticks(12)) / 100.0
-}
 
 fn main() {
     let polypropylene = 1.49f32 / 1.000_277;
