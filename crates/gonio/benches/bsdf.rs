@@ -5,7 +5,7 @@
 
 use criterion::Throughput;
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
-use gonio::bsdf::{Bsdf, BsdfModel, SampleColumns};
+use gonio::bsdf::{Bsdf, BsdfModel, SampleBuffers};
 use gonio::math::{Vec2, Vec3};
 use gonio::sampling::Pcg32;
 use gonio::Rgb;
@@ -45,21 +45,9 @@ fn bench_batches(c: &mut Criterion) {
         let mut pdf = vec![0.0f32; N];
         group.bench_function(format!("f {name}"), |b| b.iter(|| bsdf.f_batch(black_box(&wo), black_box(&wi), &mut f)));
         group.bench_function(format!("pdf {name}"), |b| b.iter(|| bsdf.pdf_batch(black_box(&wo), black_box(&wi), &mut pdf)));
-        let (mut wi_s, mut weight) = (vec![Vec3::ZERO; N], vec![Rgb::ZERO; N]);
-        let (mut flags, mut eta, mut valid) = (vec![0; N], vec![0.0; N], vec![false; N]);
+        let mut rows = SampleBuffers::new(N);
         group.bench_function(format!("sample {name}"), |b| {
-            b.iter(|| {
-                let mut columns = SampleColumns {
-                    wi: &mut wi_s,
-                    f: &mut f,
-                    pdf: &mut pdf,
-                    weight: &mut weight,
-                    flags: &mut flags,
-                    eta: &mut eta,
-                    valid: &mut valid,
-                };
-                bsdf.sample_batch(black_box(&wo), black_box(&uc), black_box(&u), &mut columns);
-            });
+            b.iter(|| bsdf.sample_batch(black_box(&wo), black_box(&uc), black_box(&u), &mut rows.columns()));
         });
     }
     group.finish();

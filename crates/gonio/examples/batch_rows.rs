@@ -34,7 +34,7 @@
 //! division per RGB channel of the Fresnel term. One thread with AVX-512 (criterion, `batch` group of
 //! `benches/bsdf.rs`): 2.50 → 1.95 ns per row.
 
-use gonio::bsdf::{Bsdf, BsdfModel, SampleColumns};
+use gonio::bsdf::{Bsdf, BsdfModel, SampleBuffers};
 use gonio::math::{Vec2, Vec3};
 use gonio::sampling::Pcg32;
 use gonio::Rgb;
@@ -74,19 +74,9 @@ fn main() {
             black_box(&out);
         }
         "sample" => {
-            let (mut wi_s, mut f, mut pdf, mut weight) = (vec![Vec3::ZERO; n], vec![Rgb::ZERO; n], vec![0.0; n], vec![Rgb::ZERO; n]);
-            let (mut flags, mut eta, mut valid) = (vec![0; n], vec![0.0; n], vec![false; n]);
-            let mut columns = SampleColumns {
-                wi: &mut wi_s,
-                f: &mut f,
-                pdf: &mut pdf,
-                weight: &mut weight,
-                flags: &mut flags,
-                eta: &mut eta,
-                valid: &mut valid,
-            };
-            bsdf.sample_batch(&wo, &uc, &u, &mut columns);
-            black_box(&valid);
+            let mut rows = SampleBuffers::new(n);
+            bsdf.sample_batch(&wo, &uc, &u, &mut rows.columns());
+            black_box(&rows.valid);
         }
         other => panic!("unknown method {other}: f, pdf or sample"),
     }

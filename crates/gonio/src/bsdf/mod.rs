@@ -471,6 +471,50 @@ impl SampleColumns<'_> {
     }
 }
 
+/// Owned rows for [`BsdfModel::sample_batch`], lent as [`SampleColumns`] by [`columns`](Self::columns): for
+/// callers that keep the results in vectors (tests, benchmarks; the Python package writes into numpy's
+/// arrays instead). Every row starts as a value the batch overwrites (ones, flags 7, not valid), so that a
+/// row left unwritten shows.
+#[derive(Clone, Debug)]
+pub struct SampleBuffers {
+    pub wi: Vec<Vec3>,
+    pub f: Vec<Rgb>,
+    pub pdf: Vec<f32>,
+    pub weight: Vec<Rgb>,
+    pub flags: Vec<u32>,
+    pub eta: Vec<f32>,
+    pub valid: Vec<bool>,
+}
+
+impl SampleBuffers {
+    /// `n` rows.
+    #[must_use]
+    pub fn new(n: usize) -> Self {
+        SampleBuffers {
+            wi: vec![Vec3::ONE; n],
+            f: vec![Rgb::ONE; n],
+            pdf: vec![1.0; n],
+            weight: vec![Rgb::ONE; n],
+            flags: vec![7; n],
+            eta: vec![1.0; n],
+            valid: vec![false; n],
+        }
+    }
+
+    /// All the rows, as the columns a batch writes.
+    pub fn columns(&mut self) -> SampleColumns<'_> {
+        SampleColumns {
+            wi: &mut self.wi,
+            f: &mut self.f,
+            pdf: &mut self.pdf,
+            weight: &mut self.weight,
+            flags: &mut self.flags,
+            eta: &mut self.eta,
+            valid: &mut self.valid,
+        }
+    }
+}
+
 /// The loop of [`BsdfModel::sample_batch`] (see [`f_each`]), for `k` below the shortest length.
 #[inline(always)]
 pub fn sample_each<M: BsdfModel + ?Sized>(m: &M, wo: &[Vec3], uc: &[f32], u: &[Vec2], out: &mut SampleColumns<'_>) {
@@ -682,32 +726,23 @@ mod tests {
                 assert!(f.iter().zip(&f_checked).all(|(a, c)| a.0.map(f32::to_bits) == c.0.map(f32::to_bits)), "{spec}: f");
                 assert!(pdf.iter().zip(&pdf_checked).all(|(a, c)| a.to_bits() == c.to_bits()), "{spec}: pdf");
                 let sample = |checked: bool| {
-                    let (mut wi_s, mut f_s, mut pdf_s, mut weight_s) =
-                        (vec![Vec3::ONE; n], vec![Rgb::ONE; n], vec![1.0; n], vec![Rgb::ONE; n]);
-                    let (mut flags_s, mut eta_s, mut valid_s) = (vec![7; n], vec![1.0; n], vec![false; n]);
-                    let mut columns = SampleColumns {
-                        wi: &mut wi_s,
-                        f: &mut f_s,
-                        pdf: &mut pdf_s,
-                        weight: &mut weight_s,
-                        flags: &mut flags_s,
-                        eta: &mut eta_s,
-                        valid: &mut valid_s,
-                    };
+                    let mut rows = SampleBuffers::new(n);
+                    let mut columns = rows.columns();
                     let ok = if checked {
                         b.sample_batch_checked(wo, uc, u, &mut columns, check)
                     } else {
                         b.sample_batch(wo, uc, u, &mut columns);
                         true
                     };
-                    let bits: Vec<u32> = wi_s
+                    let bits: Vec<u32> = rows
+                        .wi
                         .iter()
                         .flat_map(|v| v.to_array())
-                        .chain(weight_s.iter().flat_map(|c| c.0))
-                        .chain(pdf_s)
+                        .chain(rows.weight.iter().flat_map(|c| c.0))
+                        .chain(rows.pdf)
                         .map(f32::to_bits)
                         .collect();
-                    (ok, bits, flags_s, valid_s)
+                    (ok, bits, rows.flags, rows.valid)
                 };
                 let (plain, checked) = (sample(false), sample(true));
                 assert_eq!((&plain.1, &plain.2, &plain.3), (&checked.1, &checked.2, &checked.3), "{spec}: sample");
@@ -776,25 +811,15 @@ mod tests {
         for spec in cheap.chain(plastics) {
             let b = Bsdf::from_json(spec).unwrap();
             let (mut f, mut pdf) = (vec![Rgb::ZERO; n], vec![0.0; n]);
-            let (mut wi_s, mut f_s, mut pdf_s, mut weight_s) = (vec![Vec3::ONE; n], vec![Rgb::ONE; n], vec![1.0; n], vec![Rgb::ONE; n]);
-            let (mut flags_s, mut eta_s, mut valid_s) = (vec![7; n], vec![1.0; n], vec![false; n]);
+            let mut rows = SampleBuffers::new(n);
             b.f_batch(&wo, &wi, &mut f);
             b.pdf_batch(&wo, &wi, &mut pdf);
-            let mut columns = SampleColumns {
-                wi: &mut wi_s,
-                f: &mut f_s,
-                pdf: &mut pdf_s,
-                weight: &mut weight_s,
-                flags: &mut flags_s,
-                eta: &mut eta_s,
-                valid: &mut valid_s,
-            };
-            b.sample_batch(&wo, &uc, &u, &mut columns);
+            b.sample_batch(&wo, &uc, &u, &mut rows.columns());
             for k in 0..n {
                 assert_eq!(bits(f[k]), bits(b.f(wo[k], wi[k])), "{spec}: f at {k}");
                 assert_eq!(pdf[k].to_bits(), b.pdf(wo[k], wi[k]).to_bits(), "{spec}: pdf at {k}");
                 let one = b.sample(wo[k], uc[k], u[k]);
-                assert_eq!(valid_s[k], one.is_some(), "{spec}: sample at {k}");
+                assert_eq!(rows.valid[k], one.is_some(), "{spec}: sample at {k}");
                 let one = one.unwrap_or(BsdfSample {
                     wi: Vec3::ZERO,
                     f: Rgb::ZERO,
@@ -805,12 +830,12 @@ mod tests {
                 });
                 assert_eq!(
                     (
-                        wi_s[k].to_array().map(f32::to_bits),
-                        bits(f_s[k]),
-                        pdf_s[k].to_bits(),
-                        bits(weight_s[k]),
-                        flags_s[k],
-                        eta_s[k].to_bits()
+                        rows.wi[k].to_array().map(f32::to_bits),
+                        bits(rows.f[k]),
+                        rows.pdf[k].to_bits(),
+                        bits(rows.weight[k]),
+                        rows.flags[k],
+                        rows.eta[k].to_bits()
                     ),
                     (one.wi.to_array().map(f32::to_bits), bits(one.f), one.pdf.to_bits(), bits(one.weight), one.flags.0, one.eta.to_bits()),
                     "{spec}: sample at {k}"

@@ -562,10 +562,7 @@ fn closest_from_t<H>(
                 // Sort the hit children by entry distance (at most eight: insertion sort, stable).
                 let mut hits = [(0u32, 0.0f32); LANES];
                 let mut n = 0;
-                let mut m = mask;
-                while m != 0 {
-                    let lane = m.trailing_zeros() as usize;
-                    m &= m - 1;
+                for lane in bits(mask) {
                     let entry = (node.child[lane], tnear[lane]);
                     let mut j = n;
                     while j > 0 && hits[j - 1].1 > entry.1 {
@@ -616,10 +613,8 @@ fn any_from(bvh: &Bvh, start: u32, ray: &Ray, mut leaf: impl FnMut(u32, u32) -> 
             }
         } else {
             let node = &bvh.nodes[cur as usize];
-            let (mut mask, _) = node.hit(&pre, tmax);
-            while mask != 0 {
-                let lane = mask.trailing_zeros() as usize;
-                mask &= mask - 1;
+            let (mask, _) = node.hit(&pre, tmax);
+            for lane in bits(mask) {
                 stack[sp].write(node.child[lane]);
                 sp += 1;
             }

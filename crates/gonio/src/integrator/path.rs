@@ -22,6 +22,7 @@
 use super::{emitter_hit, start, BsdfSampled, CameraSample};
 use crate::bsdf::diffuse::{diffuse_f, diffuse_pdf, diffuse_sample};
 use crate::bsdf::{Bsdf, BsdfFlags, BsdfModel};
+use crate::geometry::bvh::bits;
 use crate::geometry::mesh::uniform_triangle_point;
 use crate::geometry::ray::{offset_origin_lanes, spawn_ray_to_lanes, RayLanes};
 use crate::geometry::shape::solid_angle_density;
@@ -97,18 +98,6 @@ impl RayRows {
         store(&mut self.d, d);
         self.tmax = Float8::select(m, r.tmax, Float8::load(&self.tmax)).to_array();
     }
-}
-
-/// The lanes of the bit mask `bits`, lowest first.
-#[inline(always)]
-fn lanes(mut bits: u32) -> impl Iterator<Item = usize> {
-    std::iter::from_fn(move || {
-        (bits != 0).then(|| {
-            let lane = bits.trailing_zeros() as usize;
-            bits &= bits - 1;
-            lane
-        })
-    })
 }
 
 /// Eight paths in flight.
@@ -249,7 +238,7 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
     let mut next = 0;
     loop {
         // Lanes without a path take the next camera sample.
-        for lane in lanes(!p.live & ((1 << W) - 1)) {
+        for lane in bits(!p.live & ((1 << W) - 1)) {
             if next == samples.len() {
                 break;
             }
@@ -265,14 +254,14 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
         let mut hits: [Option<SurfaceInteraction>; W] = [None; W];
         let rays = RayLanes { o: load(&p.o), d: load(&p.d), tmax: Float8::splat(f32::INFINITY) };
         let found = scene.intersect_rays(&rays, p.live);
-        for lane in lanes(p.live) {
+        for lane in bits(p.live) {
             if found.slot[lane] != EMPTY_SLOT {
                 hits[lane] = scene.interaction_at(found.slot[lane], &p.ray(lane));
             }
         }
 
         // Emission found by the ray; paths that escaped or reached the longest length end.
-        for lane in lanes(p.live) {
+        for lane in bits(p.live) {
             let depth = p.depth[lane];
             if !(depth == 0 && hide_emitters) {
                 let prev = (depth > 0).then(|| BsdfSampled {
@@ -297,7 +286,7 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
         // The surfaces as lanes; diffuse ones are evaluated in lanes, the others by their model.
         let mut surf = Surfaces::default();
         let mut models: [Option<Cow<'_, Bsdf>>; W] = Default::default();
-        for lane in lanes(p.live) {
+        for lane in bits(p.live) {
             let Some(si) = &hits[lane] else { continue };
             surf.p.set(lane, si.p);
             surf.n.set(lane, si.n);
@@ -326,7 +315,7 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
         // Next-event estimation (on lanes whose model has a smooth component): a light chosen uniformly and
         // sampled, its contribution weighted against BSDF sampling by the power heuristic.
         let smooth = surf.diffuse
-            | lanes(p.live & !surf.diffuse)
+            | bits(p.live & !surf.diffuse)
                 .fold(0, |m, lane| m | (u32::from(models[lane].as_ref().is_some_and(|b| b.flags().has_smooth())) << lane));
         if n_lights > 0 && smooth != 0 {
             // Per lane, the light and (for a flat mesh's area light, the common case) the triangle; the
@@ -341,7 +330,7 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
             // `(u · n) as usize`, at most n − 1: u · n is in [0, n), so truncation is the cast.
             let chosen = (u_light * n_lights as f32).trunc().min(Float8::splat((n_lights - 1) as f32)).to_array();
             let (u_c, u_x, u_y) = (u_c.to_array(), u_x.to_array(), u_y.to_array());
-            for lane in lanes(smooth) {
+            for lane in bits(smooth) {
                 let index = chosen[lane] as usize;
                 let (uc, u) = (u_c[lane], Vec2::new(u_x[lane], u_y[lane]));
                 let light = &scene.lights[index];
@@ -406,7 +395,7 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
                     store(&mut r, wi_local);
                     r
                 };
-                for lane in lanes(others) {
+                for lane in bits(others) {
                     let (bsdf, wo, wi) = (models[lane].as_deref().expect("a model"), wo_rows.get(lane), wi_rows.get(lane));
                     f_rows.set_rgb(lane, bsdf.f(wo, wi));
                     if delta & (1 << lane) == 0 {
@@ -456,7 +445,7 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
             let (mut pdf_rows, mut eta_rows) = (s_pdf.to_array(), s_eta.to_array());
             store(&mut wi_rows, s_wi);
             store_rgb(&mut w_rows, s_weight);
-            for lane in lanes(others) {
+            for lane in bits(others) {
                 let bsdf = models[lane].as_deref().expect("a model");
                 let Some(s) = bsdf.sample(wo_rows.get(lane), uc[lane], Vec2::new(ux[lane], uy[lane])) else { continue };
                 wi_rows.set(lane, s.wi);
@@ -468,7 +457,7 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
             }
             (s_wi, s_weight, s_pdf, s_eta) = (load(&wi_rows), load_rgb(&w_rows), Float8::load(&pdf_rows), Float8::load(&eta_rows));
         }
-        for lane in lanes(p.live & !valid) {
+        for lane in bits(p.live & !valid) {
             p.finish(lane, out);
         }
         for c in 0..3 {
@@ -488,7 +477,7 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
         let q = (beta_max * eta * eta).min(Float8::splat(0.95));
         let dead = (!beta_max.gt(Float8::splat(0.0))).bitmask();
         let mut roulette = 0u32;
-        for lane in lanes(p.live) {
+        for lane in bits(p.live) {
             p.depth[lane] += 1;
             if dead & (1 << lane) != 0 {
                 p.finish(lane, out);
@@ -497,7 +486,7 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
             roulette |= u32::from(p.depth[lane] >= rr_depth) << lane;
         }
         let survive_scale = roulette & !p.rng.next_f32(roulette).ge(q).bitmask();
-        for lane in lanes(roulette & !survive_scale) {
+        for lane in bits(roulette & !survive_scale) {
             p.finish(lane, out);
         }
         let scaled = Mask8::from_bitmask(survive_scale);

@@ -148,21 +148,17 @@ impl Primitives {
                 continue;
             }
             if let Some(spheres) = self.spheres.get(self.sphere_packet[packet] as usize) {
-                let (mut mask, t) = spheres.intersect(ray, tmax);
+                let (mask, t) = spheres.intersect(ray, tmax);
                 // The smallest t, the first lane among equals.
-                while mask != 0 {
-                    let lane = mask.trailing_zeros() as usize;
-                    mask &= mask - 1;
+                for lane in bits(mask) {
                     if t[lane] < tmax {
                         tmax = t[lane];
                         best = Some((tmax, (packet * LANES + lane) as u32));
                     }
                 }
             }
-            let mut others = u32::from(self.others[packet]);
-            while others != 0 {
-                let slot = packet * LANES + others.trailing_zeros() as usize;
-                others &= others - 1;
+            for lane in bits(u32::from(self.others[packet])) {
+                let slot = packet * LANES + lane;
                 let r = self.slots[slot];
                 let clipped = Ray { tmax, ..*ray };
                 if let Some(hit) = shapes[r.shape as usize].intersect(r.prim, &clipped) {
@@ -189,10 +185,8 @@ impl Primitives {
                     return true;
                 }
             }
-            let mut others = u32::from(self.others[packet]);
-            while others != 0 {
-                let r = self.slots[packet * LANES + others.trailing_zeros() as usize];
-                others &= others - 1;
+            for lane in bits(u32::from(self.others[packet])) {
+                let r = self.slots[packet * LANES + lane];
                 if shapes[r.shape as usize].intersect(r.prim, ray).is_some() {
                     return true;
                 }
