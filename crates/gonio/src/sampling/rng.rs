@@ -10,6 +10,20 @@ pub struct Pcg32 {
 
 const MULT: u64 = 0x5851_f42d_4c95_7f2d;
 
+/// PCG32's output for the state `old` before a step: XSH-RR, a xorshift of the high bits rotated by the
+/// top five.
+#[inline(always)]
+fn xsh_rr(old: u64) -> u32 {
+    let xorshifted = (((old >> 18) ^ old) >> 27) as u32;
+    xorshifted.rotate_right((old >> 59) as u32)
+}
+
+/// A uniform `f32` in [0, 1) from 32 random bits: the top 24, so that 1 is never returned.
+#[inline(always)]
+fn unit_f32(bits: u32) -> f32 {
+    (bits >> 8) as f32 * (1.0 / 16_777_216.0)
+}
+
 impl Pcg32 {
     /// A generator for `seed`, on stream `stream` (different streams are independent sequences).
     #[must_use]
@@ -26,15 +40,13 @@ impl Pcg32 {
     pub fn next_u32(&mut self) -> u32 {
         let old = self.state;
         self.state = old.wrapping_mul(MULT).wrapping_add(self.inc);
-        let xorshifted = (((old >> 18) ^ old) >> 27) as u32;
-        let rot = (old >> 59) as u32;
-        xorshifted.rotate_right(rot)
+        xsh_rr(old)
     }
 
     /// A uniform `f32` in [0, 1): the top 24 bits, so that 1 is never returned.
     #[inline]
     pub fn next_f32(&mut self) -> f32 {
-        (self.next_u32() >> 8) as f32 * (1.0 / 16_777_216.0)
+        unit_f32(self.next_u32())
     }
 
     /// A uniform `f64` in [0, 1) from 53 random bits.
@@ -112,9 +124,7 @@ impl Pcg32x8 {
             // All ones where the lane draws.
             let keep = 0u64.wrapping_sub(u64::from(draw >> i & 1));
             self.state[i] = (stepped & keep) | (old & !keep);
-            let xorshifted = (((old >> 18) ^ old) >> 27) as u32;
-            let x = xorshifted.rotate_right((old >> 59) as u32);
-            out[i] = (x >> 8) as f32 * (1.0 / 16_777_216.0);
+            out[i] = unit_f32(xsh_rr(old));
         }
         crate::math::simd::Float8::load(&out)
     }
