@@ -98,6 +98,29 @@ fn max_depth_one_shows_only_emitters_on_their_front() {
     assert!(run(&scene(&xml(true))).data.iter().all(|&v| v == 0.0));
 }
 
+/// The camera's clipping planes bound its rays in both integrators: an emitter 3 away is seen with
+/// `far_clip` 4, not with 2 (the constant environment, 0.5, is seen instead).
+#[test]
+fn far_clip_hides_what_lies_beyond() {
+    for integrator in ["path", "direct"] {
+        let xml = |far: f32| {
+            format!(
+                r#"<scene version="3.0.0"><integrator type="{integrator}"/>
+                <sensor type="perspective"><float name="fov" value="30"/><float name="far_clip" value="{far}"/>
+                    <transform name="to_world"><lookat origin="0, 0, 3" target="0, 0, 0" up="0, 1, 0"/></transform>
+                    <sampler type="independent"><integer name="sample_count" value="2"/></sampler>
+                    <film type="hdrfilm"><integer name="width" value="4"/><integer name="height" value="4"/></film></sensor>
+                <emitter type="constant"><rgb name="radiance" value="0.5"/></emitter>
+                <shape type="rectangle"><transform name="to_world"><scale value="10"/></transform>
+                    <bsdf type="diffuse"><rgb name="reflectance" value="0"/></bsdf>
+                    <emitter type="area"><rgb name="radiance" value="3, 2, 1"/></emitter></shape></scene>"#
+            )
+        };
+        assert!(run(&scene(&xml(4.0))).data.chunks(3).all(|p| p == [3.0, 2.0, 1.0]), "{integrator}");
+        assert!(run(&scene(&xml(2.0))).data.iter().all(|&v| v == 0.5), "{integrator}");
+    }
+}
+
 /// A small Cornell-like box: same seed, same bits with one and with two threads.
 #[test]
 fn same_seed_same_image_with_one_or_two_threads() {

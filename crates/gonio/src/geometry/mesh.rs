@@ -35,9 +35,9 @@ pub struct Mesh {
     area: f32,
     /// Unit geometric normal of each triangle (after `flip_normals`; zero for degenerate triangles).
     tri_normals: Vec<Vec3>,
-    /// For a flat-shaded mesh with texture coordinates (the built-in `rectangle` and `cube`): each
+    /// For a flat-shaded mesh (no vertex normals; the built-in `rectangle` and `cube` among them): each
     /// triangle's shading frame, which is then constant over the triangle (2026-11: computing it at every
-    /// hit was a tenth of a Cornell box's intersection cost). Empty otherwise.
+    /// hit was a tenth of a Cornell box's intersection cost). Empty for smooth-shaded meshes.
     flat_frames: Vec<Frame>,
 }
 
@@ -127,9 +127,9 @@ impl Mesh {
         Ok(mesh)
     }
 
-    /// Fill [`Mesh::flat_frames`] when the mesh is flat-shaded and has texture coordinates, else empty it.
+    /// Fill [`Mesh::flat_frames`] when the mesh is flat-shaded, else empty it.
     fn update_flat_frames(&mut self) {
-        self.flat_frames = if self.normals.is_none() && self.uvs.is_some() {
+        self.flat_frames = if self.normals.is_none() {
             // Degenerate triangles (zero normal) are never hit nor sampled: any frame stands for theirs.
             let frame = |t: usize| match self.tri_normals[t] {
                 Vec3::ZERO => Frame::from_normal(Vec3::Z),
@@ -183,34 +183,20 @@ impl Mesh {
     #[inline]
     fn surface_at(&self, tri: u32, b: Vec2, uv: bool) -> (Vec3, Vec3, Vec2) {
         let ng = self.tri_normals[tri as usize];
-        let uv_of = |b: Vec2| if uv { b } else { Vec2::ZERO };
-        if self.normals.is_none() && (self.uvs.is_none() || !uv) {
-            return (ng, ng, uv_of(b));
-        }
+        let uv = if uv { self.uv_at(tri, b) } else { Vec2::ZERO };
+        let Some(ns) = &self.normals else { return (ng, ng, uv) };
         let idx = self.indices[tri as usize];
-        let b0 = 1.0 - b.x - b.y;
-        let ns = match &self.normals {
-            Some(ns) => {
-                let n = ns[idx[0] as usize] * b0 + ns[idx[1] as usize] * b.x + ns[idx[2] as usize] * b.y;
-                // Vertex normals are not flipped in storage; `flip_normals` reverses them here.
-                let n = if self.flip_normals { -n } else { n };
-                n.try_normalize().unwrap_or(ng)
-            }
-            None => ng,
-        };
-        let uv = match &self.uvs {
-            Some(uvs) if uv => uvs[idx[0] as usize] * b0 + uvs[idx[1] as usize] * b.x + uvs[idx[2] as usize] * b.y,
-            _ => uv_of(b),
-        };
-        (ng, ns, uv)
+        let n = ns[idx[0] as usize] * (1.0 - b.x - b.y) + ns[idx[1] as usize] * b.x + ns[idx[2] as usize] * b.y;
+        // Vertex normals are not flipped in storage; `flip_normals` reverses them here.
+        let n = if self.flip_normals { -n } else { n };
+        (ng, n.try_normalize().unwrap_or(ng), uv)
     }
 
     #[must_use]
     pub fn interaction(&self, tri: u32, ray: &Ray, hit: &PrimHit, uv: bool) -> SurfaceInteraction {
-        let [p0, p1, p2] = self.vertices(tri);
+        let [p0, e1, e2] = self.triangle_edges(tri);
         let b = hit.uv;
-        // The barycentric point is more accurate than o + t d (pbrt-v4 §6.8.6).
-        let p = p0 * (1.0 - b.x - b.y) + p1 * b.x + p2 * b.y;
+        let p = barycentric_point::<f32>(p0.into(), e1.into(), e2.into(), b.x, b.y).into();
         let (ng, ns, uv) = self.surface_at(tri, b, uv);
         let _ = ray;
         let shading = match self.flat_frames.get(tri as usize) {
@@ -239,6 +225,28 @@ impl Mesh {
         match (dp_du - ns * ns.dot(dp_du)).try_normalize() {
             Some(s) => Frame { s, t: ns.cross(s), n: ns },
             None => Frame::from_normal(ns),
+        }
+    }
+
+    /// The shading frame of triangle `tri` of a flat-shaded mesh (its `n` is the geometric normal), `None`
+    /// for a smooth-shaded one.
+    #[inline]
+    #[must_use]
+    pub fn flat_frame(&self, tri: u32) -> Option<&Frame> {
+        self.flat_frames.get(tri as usize)
+    }
+
+    /// The texture coordinates at barycentrics (b₁, b₂) of triangle `tri`: interpolated where the mesh has
+    /// them, else (b₁, b₂) themselves (Mitsuba's convention).
+    #[inline]
+    #[must_use]
+    pub fn uv_at(&self, tri: u32, b: Vec2) -> Vec2 {
+        match &self.uvs {
+            Some(uvs) => {
+                let idx = self.indices[tri as usize];
+                uvs[idx[0] as usize] * (1.0 - b.x - b.y) + uvs[idx[1] as usize] * b.x + uvs[idx[2] as usize] * b.y
+            }
+            None => b,
         }
     }
 
@@ -274,6 +282,14 @@ impl Mesh {
         };
         PositionSample { p, n: ns, ng, pdf_area: 1.0 / self.area }
     }
+}
+
+/// The point p₀ + b₁ e₁ + b₂ e₂ of the triangle with corner p₀ and edges e₁, e₂, in lanes. From the
+/// barycentrics rather than as o + t d, which is less accurate (pbrt-v4 §6.8.6).
+#[inline(always)]
+#[must_use]
+pub fn barycentric_point<R: Real>(p0: V3<R>, e1: V3<R>, e2: V3<R>, b1: R, b2: R) -> V3<R> {
+    p0.add(e1.scale(b1)).add(e2.scale(b2))
 }
 
 /// The point of triangle (p₀, p₁, p₂) at barycentrics (1 − √u₁, u₂ √u₁) — uniform by area for uniform
@@ -402,6 +418,29 @@ impl Triangle8 {
         let rows = |r: &[[f32; 8]; 3]| V3::new(Float8::load(&r[0]), Float8::load(&r[1]), Float8::load(&r[2]));
         let (p0, e2, ne1, m) = (rows(&self.p0), rows(&self.e2), rows(&self.neg_e1), rows(&self.m));
         intersect_triangle_lanes(V3::splat(ray.o), V3::splat(ray.d), p0, e2, ne1, m, Float8::splat(tmax))
+    }
+
+    /// Put lane `from` of `src` in lane `lane`.
+    #[inline(always)]
+    pub fn copy_lane(&mut self, lane: usize, src: &Triangle8, from: usize) {
+        for axis in 0..3 {
+            self.p0[axis][lane] = src.p0[axis][from];
+            self.e2[axis][lane] = src.e2[axis][from];
+            self.neg_e1[axis][lane] = src.neg_e1[axis][from];
+            self.m[axis][lane] = src.m[axis][from];
+        }
+    }
+
+    /// Each lane's triangle against the same lane's ray, for rays known to hit them (a packet's closest
+    /// hits, gathered by [`Self::copy_lane`]): the points hit and their barycentrics (b₁, b₂), as
+    /// [`intersect_triangle`] computes them.
+    #[inline(always)]
+    #[must_use]
+    pub fn points_hit(&self, o: V3<Float8>, d: V3<Float8>) -> (V3<Float8>, Float8, Float8) {
+        let rows = |r: &[[f32; 8]; 3]| V3::new(Float8::load(&r[0]), Float8::load(&r[1]), Float8::load(&r[2]));
+        let (p0, e2, ne1) = (rows(&self.p0), rows(&self.e2), rows(&self.neg_e1));
+        let (_, _, b1, b2) = intersect_triangle_lanes(o, d, p0, e2, ne1, rows(&self.m), Float8::splat(f32::INFINITY));
+        (barycentric_point(p0, ne1.neg(), e2, b1, b2), b1, b2)
     }
 
     /// Whether lane `lane` holds a triangle (padding and other shapes are zero).

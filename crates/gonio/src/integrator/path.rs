@@ -26,14 +26,15 @@ use crate::geometry::bvh::bits;
 use crate::geometry::mesh::uniform_triangle_point;
 use crate::geometry::ray::{offset_origin_lanes, spawn_ray_to_lanes, RayLanes};
 use crate::geometry::shape::solid_angle_density;
-use crate::geometry::{Ray, Shape, SurfaceInteraction};
+use crate::geometry::{Ray, Shape};
 use crate::light::area::towards;
 use crate::light::Light;
 use crate::math::lanes::{Real, V3};
 use crate::math::simd::{Float8, Mask8};
-use crate::math::{Vec2, Vec3};
+use crate::math::Vec2;
 use crate::sampling::{Pcg32, Pcg32x8};
-use crate::scene::{Scene, EMPTY_SLOT};
+use crate::scene::surfaces::Rows3;
+use crate::scene::Scene;
 use crate::spectrum::Rgb;
 use std::borrow::Cow;
 
@@ -46,32 +47,6 @@ pub struct Settings {
     pub max_depth: i32,
     pub rr_depth: i32,
     pub hide_emitters: bool,
-}
-
-/// Three numbers per lane (a direction, a point or an RGB value), as rows x, y, z (or r, g, b).
-#[derive(Clone, Copy, Debug, Default)]
-struct Rows3([[f32; W]; 3]);
-
-impl Rows3 {
-    #[inline(always)]
-    fn get(&self, lane: usize) -> Vec3 {
-        Vec3::new(self.0[0][lane], self.0[1][lane], self.0[2][lane])
-    }
-
-    #[inline(always)]
-    fn set(&mut self, lane: usize, v: Vec3) {
-        (self.0[0][lane], self.0[1][lane], self.0[2][lane]) = (v.x, v.y, v.z);
-    }
-
-    #[inline(always)]
-    fn rgb(&self, lane: usize) -> Rgb {
-        Rgb([self.0[0][lane], self.0[1][lane], self.0[2][lane]])
-    }
-
-    #[inline(always)]
-    fn set_rgb(&mut self, lane: usize, v: Rgb) {
-        (self.0[0][lane], self.0[1][lane], self.0[2][lane]) = (v.0[0], v.0[1], v.0[2]);
-    }
 }
 
 /// Rays as rows of lanes.
@@ -109,9 +84,10 @@ struct Packet {
     rng: Pcg32x8,
     /// Segments traced so far.
     depth: [i32; W],
-    /// The ray to trace next.
+    /// The ray to trace next (`tmax` the camera's far clip for camera rays, else infinite).
     o: Rows3,
     d: Rows3,
+    tmax: [f32; W],
     /// Throughput and radiance gathered.
     beta: Rows3,
     l: Rows3,
@@ -133,6 +109,7 @@ impl Packet {
             depth: [0; W],
             o: Rows3::default(),
             d: Rows3::default(),
+            tmax: [f32::INFINITY; W],
             beta: Rows3::default(),
             l: Rows3::default(),
             eta: [1.0; W],
@@ -144,7 +121,7 @@ impl Packet {
 
     #[inline(always)]
     fn ray(&self, lane: usize) -> Ray {
-        Ray::new(self.o.get(lane), self.d.get(lane), f32::INFINITY)
+        Ray::new(self.o.get(lane), self.d.get(lane), self.tmax[lane])
     }
 
     /// Lane `lane` starts camera sample `index`.
@@ -155,6 +132,7 @@ impl Packet {
         self.depth[lane] = 0;
         self.o.set(lane, ray.o);
         self.d.set(lane, ray.d);
+        self.tmax[lane] = ray.tmax;
         self.beta.set_rgb(lane, Rgb::ONE);
         self.l.set_rgb(lane, Rgb::ZERO);
         self.eta[lane] = 1.0;
@@ -166,22 +144,6 @@ impl Packet {
         out[self.sample[lane]] = self.l.rgb(lane);
         self.live &= !(1 << lane);
     }
-}
-
-/// The surfaces the packet's rays found, as lanes (rows), for the phases that run in SIMD.
-#[derive(Default)]
-struct Surfaces {
-    p: Rows3,
-    /// Geometric normal.
-    n: Rows3,
-    /// Shading frame.
-    s: Rows3,
-    t: Rows3,
-    ns: Rows3,
-    /// Diffuse reflectance, for the lanes in `diffuse`.
-    rho: Rows3,
-    /// Lanes whose surface is `diffuse` (textured or not), evaluated in lanes; the others call their model.
-    diffuse: u32,
 }
 
 /// `Rows3` as lanes.
@@ -251,19 +213,20 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
         }
 
         // Trace.
-        let mut hits: [Option<SurfaceInteraction>; W] = [None; W];
-        let rays = RayLanes { o: load(&p.o), d: load(&p.d), tmax: Float8::splat(f32::INFINITY) };
+        let rays = RayLanes { o: load(&p.o), d: load(&p.d), tmax: Float8::load(&p.tmax) };
         let found = scene.intersect_rays(&rays, p.live);
-        for lane in bits(p.live) {
-            if found.slot[lane] != EMPTY_SLOT {
-                hits[lane] = scene.interaction_at(found.slot[lane], &p.ray(lane));
-            }
-        }
+        let hit = scene.surfaces(&rays, &found, p.live);
 
-        // Emission found by the ray; paths that escaped or reached the longest length end.
+        // Emission found by the ray (looked up only where the surface emits or an environment is seen), in
+        // lanes L += β Le, Le zero elsewhere (as a path traced alone adds it: a non-finite β spoils the
+        // sample either way); paths that escaped or reached the longest length end.
+        let mut le = Rows3::default();
+        let t = found.t.to_array();
         for lane in bits(p.live) {
             let depth = p.depth[lane];
-            if !(depth == 0 && hide_emitters) {
+            let on_surface = hit.found & (1 << lane) != 0;
+            let emits = if on_surface { scene.shape_lights[hit.shape[lane] as usize].is_some() } else { scene.environment.is_some() };
+            if emits && !(depth == 0 && hide_emitters) {
                 let prev = (depth > 0).then(|| BsdfSampled {
                     from: p.from.get(lane),
                     pdf: p.pdf[lane],
@@ -271,11 +234,18 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
                     n_bsdf: 1.0,
                     n_light: 1.0,
                 });
-                let le = emitter_hit(scene, &p.ray(lane), hits[lane].as_ref(), prev.as_ref());
-                p.l.set_rgb(lane, p.l.rgb(lane) + p.beta.rgb(lane) * le);
+                let si = on_surface.then(|| hit.interaction(lane, t[lane]));
+                le.set_rgb(lane, emitter_hit(scene, &p.ray(lane), si.as_ref(), prev.as_ref()));
             }
+        }
+        let (mut l, beta, le) = (load_rgb(&p.l), load_rgb(&p.beta), load_rgb(&le));
+        for c in 0..3 {
+            l[c] = l[c] + beta[c] * le[c];
+        }
+        store_rgb(&mut p.l, l);
+        for lane in bits(p.live) {
             // A vertex at `depth` can extend the path only if the next one is within max_depth.
-            if hits[lane].is_none() || (max_depth >= 0 && depth + 1 >= max_depth) {
+            if hit.found & (1 << lane) == 0 || (max_depth >= 0 && p.depth[lane] + 1 >= max_depth) {
                 p.finish(lane, out);
             }
         }
@@ -283,39 +253,34 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
             continue;
         }
 
-        // The surfaces as lanes; diffuse ones are evaluated in lanes, the others by their model.
-        let mut surf = Surfaces::default();
+        // The materials: diffuse ones are evaluated in lanes, the others by their model.
+        let (mut rho_rows, mut diffuse) = (Rows3::default(), 0u32);
         let mut models: [Option<Cow<'_, Bsdf>>; W] = Default::default();
         for lane in bits(p.live) {
-            let Some(si) = &hits[lane] else { continue };
-            surf.p.set(lane, si.p);
-            surf.n.set(lane, si.n);
-            surf.s.set(lane, si.shading.s);
-            surf.t.set(lane, si.shading.t);
-            surf.ns.set(lane, si.shading.n);
-            let material = &scene.materials[si.shape as usize];
-            match material.diffuse_reflectance(si.uv) {
+            let material = &scene.materials[hit.shape[lane] as usize];
+            let uv = Vec2::new(hit.uv[0][lane], hit.uv[1][lane]);
+            match material.diffuse_reflectance(uv) {
                 Some(rho) => {
-                    surf.rho.set_rgb(lane, rho);
-                    surf.diffuse |= 1 << lane;
+                    rho_rows.set_rgb(lane, rho);
+                    diffuse |= 1 << lane;
                 }
-                None => models[lane] = Some(material.at(si.uv)),
+                None => models[lane] = Some(material.at(uv)),
             }
         }
-        let (fs, ft, fn_) = (load(&surf.s), load(&surf.t), load(&surf.ns));
+        let (fs, ft, fn_) = (load(&hit.s), load(&hit.t), load(&hit.ns));
         let wo = to_local(fs, ft, fn_, load(&p.d).neg());
         let wo_rows = {
             let mut r = Rows3::default();
             store(&mut r, wo);
             r
         };
-        let rho = load_rgb(&surf.rho);
+        let rho = load_rgb(&rho_rows);
         let mut beta = load_rgb(&p.beta);
 
         // Next-event estimation (on lanes whose model has a smooth component): a light chosen uniformly and
         // sampled, its contribution weighted against BSDF sampling by the power heuristic.
-        let smooth = surf.diffuse
-            | bits(p.live & !surf.diffuse)
+        let smooth = diffuse
+            | bits(p.live & !diffuse)
                 .fold(0, |m, lane| m | (u32::from(models[lane].as_ref().is_some_and(|b| b.flags().has_smooth())) << lane));
         if n_lights > 0 && smooth != 0 {
             // Per lane, the light and (for a flat mesh's area light, the common case) the triangle; the
@@ -350,7 +315,7 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
                         }
                     }
                 }
-                let Some(ls) = light.sample_li(&scene.shapes, surf.p.get(lane), surf.n.get(lane), uc, u) else { continue };
+                let Some(ls) = light.sample_li(&scene.shapes, hit.p.get(lane), hit.n.get(lane), uc, u) else { continue };
                 if !(ls.pdf > 0.0) || ls.li.is_black() {
                     continue;
                 }
@@ -363,7 +328,7 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
             }
             if on_mesh != 0 {
                 // `AreaLight::sample_li` on a flat mesh, in lanes.
-                let (sp, sn) = (load(&surf.p), load(&surf.n));
+                let (sp, sn) = (load(&hit.p), load(&hit.n));
                 let q = uniform_triangle_point(load(&tri[0]), load(&tri[1]), load(&tri[2]), Float8::load(&ux), Float8::load(&uy));
                 let ng = load(&tri_n);
                 let (pdf, by_area) = solid_angle_density(sp, q, ng, Float8::load(&pdf_area));
@@ -386,7 +351,7 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
             // f and the BSDF's density: in lanes for diffuse surfaces, by the model for the others.
             let mut f = diffuse_f(rho, wo, wi_local);
             let mut bsdf_pdf = diffuse_pdf(wo, wi_local);
-            let others = sampled & !surf.diffuse;
+            let others = sampled & !diffuse;
             if others != 0 {
                 let (mut f_rows, mut pdf_rows) = (Rows3::default(), [0.0f32; W]);
                 store_rgb(&mut f_rows, f);
@@ -436,10 +401,10 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
         let (uc, ux, uy) = (p.rng.next_f32(p.live), p.rng.next_f32(p.live), p.rng.next_f32(p.live));
         let ds = diffuse_sample(rho, wo, ux, uy);
         let (uc, ux, uy) = (uc.to_array(), ux.to_array(), uy.to_array());
-        let mut valid = ds.valid.bitmask() & surf.diffuse;
+        let mut valid = ds.valid.bitmask() & diffuse;
         let (mut s_wi, mut s_pdf, mut s_eta, mut s_weight) = (ds.wi, ds.pdf, ds.eta, ds.weight);
         let mut s_delta = 0u32;
-        let others = p.live & !surf.diffuse;
+        let others = p.live & !diffuse;
         if others != 0 {
             let (mut wi_rows, mut w_rows) = (Rows3::default(), Rows3::default());
             let (mut pdf_rows, mut eta_rows) = (s_pdf.to_array(), s_eta.to_array());
@@ -465,9 +430,10 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
         }
         let eta = Float8::load(&p.eta) * s_eta;
         let wi = to_world(fs, ft, fn_, s_wi);
-        let sp = load(&surf.p);
-        store(&mut p.o, offset_origin_lanes(sp, load(&surf.n), wi));
+        let sp = load(&hit.p);
+        store(&mut p.o, offset_origin_lanes(sp, load(&hit.n), wi));
         store(&mut p.d, wi);
+        p.tmax = [f32::INFINITY; W];
         store(&mut p.from, sp);
         p.pdf = s_pdf.to_array();
         p.eta = eta.to_array();

@@ -8,6 +8,7 @@ pub mod material;
 pub mod mesh_files;
 pub mod mitsuba_dict;
 pub mod mitsuba_xml;
+pub mod surfaces;
 
 pub use material::Material;
 

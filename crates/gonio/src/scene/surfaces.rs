@@ -1,0 +1,216 @@
+//! The surfaces a packet of rays found, in lanes: what the path tracer's phases read at each vertex.
+//!
+//! Packet traversal keeps only each ray's distance and slot. Where the slot holds a triangle of a
+//! flat-shaded mesh (the common case: every built-in `rectangle`, `cube` and face-normal mesh), the
+//! triangles hit are gathered into one [`Triangle8`] and the eight rays' barycentrics and points come from
+//! one lane test ([`Triangle8::points_hit`]); the shading frame, constant over such a triangle, is copied.
+//! Other shapes (spheres, disks, smooth-shaded meshes) build their interaction one lane at a time, as
+//! [`Scene::interaction_at`] does for a single ray, spheres from the packet's distance without testing
+//! again. 2026-12: building interactions one lane at a time
+//! had been a tenth of a Cornell box render.
+
+use super::{Scene, EMPTY_SLOT};
+use crate::geometry::bvh::{bits, Hits8, LANES};
+use crate::geometry::mesh::Triangle8;
+use crate::geometry::ray::RayLanes;
+use crate::geometry::{PrimHit, Ray, Shape, SurfaceInteraction};
+use crate::math::lanes::V3;
+use crate::math::simd::{Float8, Mask8};
+use crate::math::Frame;
+use crate::spectrum::Rgb;
+use glam::{Vec2, Vec3};
+
+/// Three numbers per lane (a direction, a point or an RGB value), as rows x, y, z (or r, g, b).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Rows3(pub [[f32; LANES]; 3]);
+
+impl Rows3 {
+    #[inline(always)]
+    pub fn get(&self, lane: usize) -> Vec3 {
+        Vec3::new(self.0[0][lane], self.0[1][lane], self.0[2][lane])
+    }
+
+    #[inline(always)]
+    pub fn set(&mut self, lane: usize, v: Vec3) {
+        (self.0[0][lane], self.0[1][lane], self.0[2][lane]) = (v.x, v.y, v.z);
+    }
+
+    #[inline(always)]
+    pub fn rgb(&self, lane: usize) -> Rgb {
+        Rgb([self.0[0][lane], self.0[1][lane], self.0[2][lane]])
+    }
+
+    #[inline(always)]
+    pub fn set_rgb(&mut self, lane: usize, v: Rgb) {
+        (self.0[0][lane], self.0[1][lane], self.0[2][lane]) = (v.0[0], v.0[1], v.0[2]);
+    }
+}
+
+/// The surfaces found by eight rays: meaningful in the lanes of `found`.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Surfaces8 {
+    /// Lanes whose ray hit a surface.
+    pub found: u32,
+    /// The point hit.
+    pub p: Rows3,
+    /// Geometric normal (unit, the shape's outward side).
+    pub n: Rows3,
+    /// Shading frame (s, t, ns).
+    pub s: Rows3,
+    pub t: Rows3,
+    pub ns: Rows3,
+    /// Texture coordinates, for lanes whose material is textured (else zero).
+    pub uv: [[f32; LANES]; 2],
+    /// The shape hit, and the primitive within it.
+    pub shape: [u32; LANES],
+    pub prim: [u32; LANES],
+}
+
+impl Surfaces8 {
+    /// Lane `lane` as an interaction record, `t` its ray's distance.
+    #[must_use]
+    pub fn interaction(&self, lane: usize, t: f32) -> SurfaceInteraction {
+        SurfaceInteraction {
+            t,
+            p: self.p.get(lane),
+            n: self.n.get(lane),
+            shading: Frame { s: self.s.get(lane), t: self.t.get(lane), n: self.ns.get(lane) },
+            uv: Vec2::new(self.uv[0][lane], self.uv[1][lane]),
+            shape: self.shape[lane],
+            prim: self.prim[lane],
+        }
+    }
+
+    #[inline(always)]
+    fn set_frame(&mut self, lane: usize, f: &Frame) {
+        self.s.set(lane, f.s);
+        self.t.set(lane, f.t);
+        self.ns.set(lane, f.n);
+    }
+}
+
+impl Scene {
+    /// The surfaces at the closest hits `hits` of the rays `rays` in `lanes` (from
+    /// [`Scene::intersect_rays`]), as [`Scene::interaction_at`] would build them one by one, but for the
+    /// point on flat-shaded triangles, computed from the barycentrics as p₀ + b₁ e₁ + b₂ e₂ in lanes.
+    #[must_use]
+    pub fn surfaces(&self, rays: &RayLanes<Float8>, hits: &Hits8, lanes: u32) -> Surfaces8 {
+        let mut out = Surfaces8::default();
+        let mut tris = Triangle8::default();
+        // Lanes on flat triangles, and those of them whose material reads texture coordinates.
+        let (mut flat, mut flat_uv) = (0u32, 0u32);
+        let (o, d) = ([rays.o.x, rays.o.y, rays.o.z].map(Float8::to_array), [rays.d.x, rays.d.y, rays.d.z].map(Float8::to_array));
+        let t = hits.t.to_array();
+        for lane in bits(lanes) {
+            let slot = hits.slot[lane];
+            if slot == EMPTY_SLOT {
+                continue;
+            }
+            out.found |= 1 << lane;
+            let r = self.prims.slots[slot as usize];
+            (out.shape[lane], out.prim[lane]) = (r.shape, r.prim);
+            let textured = self.textured[r.shape as usize];
+            let shape = &self.shapes[r.shape as usize];
+            if let Shape::Mesh(mesh) = shape {
+                if let Some(frame) = mesh.flat_frame(r.prim) {
+                    tris.copy_lane(lane, &self.prims.triangles[slot as usize / LANES], slot as usize % LANES);
+                    out.set_frame(lane, frame);
+                    out.n.set(lane, frame.n);
+                    flat |= 1 << lane;
+                    flat_uv |= u32::from(textured) << lane;
+                    continue;
+                }
+            }
+            let ray = Ray::new(Vec3::new(o[0][lane], o[1][lane], o[2][lane]), Vec3::new(d[0][lane], d[1][lane], d[2][lane]), f32::INFINITY);
+            // A sphere's interaction needs only the distance, which the packet test computed as the scalar
+            // test does; other shapes test again for their coordinates.
+            let si = match shape {
+                Shape::Sphere(_) => shape.interaction(r.shape, r.prim, &ray, &PrimHit { t: t[lane], uv: Vec2::ZERO }, textured),
+                _ => match self.interaction_at(slot, &ray) {
+                    Some(si) => si,
+                    None => continue,
+                },
+            };
+            out.p.set(lane, si.p);
+            out.n.set(lane, si.n);
+            out.set_frame(lane, &si.shading);
+            (out.uv[0][lane], out.uv[1][lane]) = (si.uv.x, si.uv.y);
+        }
+        if flat != 0 {
+            let (p, b1, b2) = tris.points_hit(rays.o, rays.d);
+            let old = V3::new(Float8::load(&out.p.0[0]), Float8::load(&out.p.0[1]), Float8::load(&out.p.0[2]));
+            let p = V3::select(Mask8::from_bitmask(flat), p, old);
+            out.p.0 = [p.x.to_array(), p.y.to_array(), p.z.to_array()];
+            if flat_uv != 0 {
+                let (b1, b2) = (b1.to_array(), b2.to_array());
+                for lane in bits(flat_uv) {
+                    let r = self.prims.slots[hits.slot[lane] as usize];
+                    if let Shape::Mesh(mesh) = &self.shapes[r.shape as usize] {
+                        let uv = mesh.uv_at(r.prim, Vec2::new(b1[lane], b2[lane]));
+                        (out.uv[0][lane], out.uv[1][lane]) = (uv.x, uv.y);
+                    }
+                }
+            }
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sampling::Pcg32;
+    use crate::scene::mitsuba_xml;
+    use std::path::Path;
+
+    /// Rectangles (flat, with texture coordinates), a cube, a face-normal mesh without texture coordinates
+    /// (a disk is not a mesh: tested again) and spheres, one of each material kind the lanes treat apart.
+    const SCENE: &str = r#"<scene version="3.0.0">
+        <sensor type="perspective"><film type="hdrfilm"><integer name="width" value="4"/><integer name="height" value="4"/></film></sensor>
+        <shape type="rectangle"><transform name="to_world"><rotate x="1" angle="-90"/><scale value="3"/><translate y="-1"/></transform>
+            <bsdf type="diffuse"><texture type="checkerboard" name="reflectance"/></bsdf></shape>
+        <shape type="cube"><transform name="to_world"><scale value="0.4"/><rotate y="1" angle="30"/><translate x="0.8"/></transform></shape>
+        <shape type="sphere"><point name="center" x="-0.8" y="0" z="0"/><float name="radius" value="0.5"/>
+            <bsdf type="diffuse"><texture type="checkerboard" name="reflectance"/></bsdf></shape>
+        <shape type="sphere"><point name="center" x="0" y="0.9" z="-0.5"/><float name="radius" value="0.3"/><boolean name="flip_normals" value="true"/></shape>
+        <shape type="disk"><transform name="to_world"><translate z="-1.5"/></transform></shape>
+    </scene>"#;
+
+    /// Each lane of [`Scene::surfaces`] is the interaction [`Scene::intersect`] finds for its ray alone: the
+    /// same shape, primitive, normals, frame and texture coordinates, and the point within rounding.
+    #[test]
+    fn lanes_match_single_rays() {
+        let scene = Scene::build(mitsuba_xml::load_str(SCENE, "t.xml", Path::new("."), &[]).unwrap()).unwrap();
+        let mut rng = Pcg32::new(3, 9);
+        let (mut flat, mut other) = (0, 0);
+        for _ in 0..200 {
+            let mut rays = [Ray::new(Vec3::ZERO, Vec3::Z, f32::INFINITY); LANES];
+            for r in &mut rays {
+                let o = Vec3::new(rng.next_f32() * 4.0 - 2.0, rng.next_f32() * 2.0, 3.0);
+                let target = Vec3::new(rng.next_f32() * 4.0 - 2.0, rng.next_f32() * 2.0 - 1.0, rng.next_f32() * 2.0 - 1.5);
+                *r = Ray::new(o, (target - o).normalize(), f32::INFINITY);
+            }
+            let lanes = RayLanes {
+                o: V3::new(Float8::load(&rays.map(|r| r.o.x)), Float8::load(&rays.map(|r| r.o.y)), Float8::load(&rays.map(|r| r.o.z))),
+                d: V3::new(Float8::load(&rays.map(|r| r.d.x)), Float8::load(&rays.map(|r| r.d.y)), Float8::load(&rays.map(|r| r.d.z))),
+                tmax: Float8::splat(f32::INFINITY),
+            };
+            let live = 0b1011_1111;
+            let hits = scene.intersect_rays(&lanes, live);
+            let s = scene.surfaces(&lanes, &hits, live);
+            for (lane, ray) in rays.iter().enumerate() {
+                let want = if live & (1 << lane) != 0 { scene.intersect(ray) } else { None };
+                assert_eq!(s.found & (1 << lane) != 0, want.is_some(), "lane {lane}");
+                let Some(want) = want else { continue };
+                let got = s.interaction(lane, want.t);
+                assert_eq!((got.shape, got.prim, got.n, got.shading, got.uv), (want.shape, want.prim, want.n, want.shading, want.uv));
+                assert!((got.p - want.p).length() <= 1e-6 * (1.0 + want.p.abs().max_element()), "{} vs {}", got.p, want.p);
+                match scene.shapes[want.shape as usize] {
+                    Shape::Mesh(_) => flat += 1,
+                    _ => other += 1,
+                }
+            }
+        }
+        assert!(flat > 300 && other > 100, "{flat} mesh and {other} other hits");
+    }
+}
