@@ -62,23 +62,25 @@ impl Sphere {
         hit.then_some(PrimHit { t, uv: Vec2::ZERO })
     }
 
+    /// The texture coordinates at the point with outward normal `outward`: Mitsuba's parametrisation,
+    /// u = φ / 2π, v = θ / π in object space.
+    #[must_use]
+    pub fn uv_at(&self, outward: Vec3) -> Vec2 {
+        let local = self.to_object.vector(outward).normalize();
+        let mut phi = local.y.atan2(local.x);
+        if phi < 0.0 {
+            phi += 2.0 * PI;
+        }
+        Vec2::new(phi / (2.0 * PI), local.z.clamp(-1.0, 1.0).acos() / PI)
+    }
+
     /// The interaction at parameter `t` of `ray`; the point is re-projected onto the surface.
     #[must_use]
     pub fn interaction(&self, ray: &Ray, t: f32, uv: bool) -> SurfaceInteraction {
-        let outward = (ray.at(t) - self.center).normalize();
-        let p = self.center + outward * self.radius;
+        let (p, outward) = sphere_surface::<f32>(ray.o.into(), ray.d.into(), t, self.center.into(), self.radius);
+        let (p, outward) = (Vec3::from(p), Vec3::from(outward));
         let n = if self.flip_normals { -outward } else { outward };
-        let uv = if uv {
-            // Mitsuba's parametrisation: u = φ / 2π, v = θ / π in object space.
-            let local = self.to_object.vector(outward).normalize();
-            let mut phi = local.y.atan2(local.x);
-            if phi < 0.0 {
-                phi += 2.0 * PI;
-            }
-            Vec2::new(phi / (2.0 * PI), local.z.clamp(-1.0, 1.0).acos() / PI)
-        } else {
-            Vec2::ZERO
-        };
+        let uv = if uv { self.uv_at(outward) } else { Vec2::ZERO };
         SurfaceInteraction { t, p, n, shading: Frame::from_normal(n), uv, shape: 0, prim: 0 }
     }
 
@@ -146,6 +148,15 @@ impl Sphere {
         let n = if self.flip_normals { -outward } else { outward };
         PositionSample { p: self.center + outward * self.radius, n, ng: n, pdf_area: 1.0 / self.area() }
     }
+}
+
+/// The point at distance `t` along the ray (o, d) re-projected onto the sphere, and the outward unit normal
+/// there, in lanes.
+#[inline(always)]
+#[must_use]
+pub fn sphere_surface<R: Real>(o: V3<R>, d: V3<R>, t: R, center: V3<R>, radius: R) -> (V3<R>, V3<R>) {
+    let outward = o.add(d.scale(t)).sub(center).normalize();
+    (center.add(outward.scale(radius)), outward)
 }
 
 /// The nearer hit in (0, tmax) of the ray o + t d with the sphere (`center`, `radius`), in lanes (of rays,

@@ -68,9 +68,9 @@ impl RayRows {
     /// The lanes of `r` where `m` is set.
     #[inline(always)]
     fn merge(&mut self, m: Mask8, r: &RayLanes<Float8>) {
-        let (o, d) = (V3::select(m, r.o, load(&self.o)), V3::select(m, r.d, load(&self.d)));
-        store(&mut self.o, o);
-        store(&mut self.d, d);
+        let (o, d) = (V3::select(m, r.o, self.o.lanes()), V3::select(m, r.d, self.d.lanes()));
+        self.o.store(o);
+        self.d.store(d);
         self.tmax = Float8::select(m, r.tmax, Float8::load(&self.tmax)).to_array();
     }
 }
@@ -146,17 +146,6 @@ impl Packet {
     }
 }
 
-/// `Rows3` as lanes.
-#[inline(always)]
-fn load(r: &Rows3) -> V3<Float8> {
-    V3::new(Float8::load(&r.0[0]), Float8::load(&r.0[1]), Float8::load(&r.0[2]))
-}
-
-#[inline(always)]
-fn store(r: &mut Rows3, v: V3<Float8>) {
-    r.0 = [v.x.to_array(), v.y.to_array(), v.z.to_array()];
-}
-
 #[inline(always)]
 fn load_rgb(r: &Rows3) -> [Float8; 3] {
     [Float8::load(&r.0[0]), Float8::load(&r.0[1]), Float8::load(&r.0[2])]
@@ -213,7 +202,7 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
         }
 
         // Trace.
-        let rays = RayLanes { o: load(&p.o), d: load(&p.d), tmax: Float8::load(&p.tmax) };
+        let rays = RayLanes { o: p.o.lanes(), d: p.d.lanes(), tmax: Float8::load(&p.tmax) };
         let found = scene.intersect_rays(&rays, p.live);
         let hit = scene.surfaces(&rays, &found, p.live);
 
@@ -267,11 +256,11 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
                 None => models[lane] = Some(material.at(uv)),
             }
         }
-        let (fs, ft, fn_) = (load(&hit.s), load(&hit.t), load(&hit.ns));
-        let wo = to_local(fs, ft, fn_, load(&p.d).neg());
+        let (fs, ft, fn_) = (hit.s.lanes(), hit.t.lanes(), hit.ns.lanes());
+        let wo = to_local(fs, ft, fn_, p.d.lanes().neg());
         let wo_rows = {
             let mut r = Rows3::default();
-            store(&mut r, wo);
+            r.store(wo);
             r
         };
         let rho = load_rgb(&rho_rows);
@@ -328,18 +317,18 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
             }
             if on_mesh != 0 {
                 // `AreaLight::sample_li` on a flat mesh, in lanes.
-                let (sp, sn) = (load(&hit.p), load(&hit.n));
-                let q = uniform_triangle_point(load(&tri[0]), load(&tri[1]), load(&tri[2]), Float8::load(&ux), Float8::load(&uy));
-                let ng = load(&tri_n);
+                let (sp, sn) = (hit.p.lanes(), hit.n.lanes());
+                let q = uniform_triangle_point(tri[0].lanes(), tri[1].lanes(), tri[2].lanes(), Float8::load(&ux), Float8::load(&uy));
+                let ng = tri_n.lanes();
                 let (pdf, by_area) = solid_angle_density(sp, q, ng, Float8::load(&pdf_area));
                 let (dir, facing) = towards(sp, q, ng, pdf);
                 let ray = spawn_ray_to_lanes(sp, sn, q, ng);
                 let ok = by_area & facing & Mask8::from_bitmask(on_mesh);
                 let m = ok.bitmask();
-                let (mut w, mut pdfs) = (load(&wi), Float8::load(&light_pdf));
+                let (mut w, mut pdfs) = (wi.lanes(), Float8::load(&light_pdf));
                 w = V3::select(ok, dir, w);
                 pdfs = Float8::select(ok, pdf, pdfs);
-                store(&mut wi, w);
+                wi.store(w);
                 light_pdf = pdfs.to_array();
                 shadow.merge(ok, &ray);
                 sampled |= m;
@@ -347,7 +336,7 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
             for v in light_pdf.iter_mut() {
                 *v /= n_lights as f32;
             }
-            let wi_local = to_local(fs, ft, fn_, load(&wi));
+            let wi_local = to_local(fs, ft, fn_, wi.lanes());
             // f and the BSDF's density: in lanes for diffuse surfaces, by the model for the others.
             let mut f = diffuse_f(rho, wo, wi_local);
             let mut bsdf_pdf = diffuse_pdf(wo, wi_local);
@@ -357,7 +346,7 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
                 store_rgb(&mut f_rows, f);
                 let wi_rows = {
                     let mut r = Rows3::default();
-                    store(&mut r, wi_local);
+                    r.store(wi_local);
                     r
                 };
                 for lane in bits(others) {
@@ -373,7 +362,7 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
             // Shadow rays where the sample carries light.
             let nonzero = (f[0].ne(Float8::splat(0.0)) | f[1].ne(Float8::splat(0.0)) | f[2].ne(Float8::splat(0.0))).bitmask();
             let tested = sampled & nonzero;
-            let rays = RayLanes { o: load(&shadow.o), d: load(&shadow.d), tmax: Float8::load(&shadow.tmax) };
+            let rays = RayLanes { o: shadow.o.lanes(), d: shadow.d.lanes(), tmax: Float8::load(&shadow.tmax) };
             let visible = tested & !scene.occluded_rays(&rays, tested);
             // L += β · f · Lᵢ · |cos θi| · w / p_light, or β · 0 where the sample carries nothing (as a path
             // traced alone adds it: a non-finite β spoils the sample either way).
@@ -408,7 +397,7 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
         if others != 0 {
             let (mut wi_rows, mut w_rows) = (Rows3::default(), Rows3::default());
             let (mut pdf_rows, mut eta_rows) = (s_pdf.to_array(), s_eta.to_array());
-            store(&mut wi_rows, s_wi);
+            wi_rows.store(s_wi);
             store_rgb(&mut w_rows, s_weight);
             for lane in bits(others) {
                 let bsdf = models[lane].as_deref().expect("a model");
@@ -420,7 +409,7 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
                 s_delta |= u32::from(s.flags.contains(BsdfFlags::DELTA)) << lane;
                 valid |= 1 << lane;
             }
-            (s_wi, s_weight, s_pdf, s_eta) = (load(&wi_rows), load_rgb(&w_rows), Float8::load(&pdf_rows), Float8::load(&eta_rows));
+            (s_wi, s_weight, s_pdf, s_eta) = (wi_rows.lanes(), load_rgb(&w_rows), Float8::load(&pdf_rows), Float8::load(&eta_rows));
         }
         for lane in bits(p.live & !valid) {
             p.finish(lane, out);
@@ -430,11 +419,11 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
         }
         let eta = Float8::load(&p.eta) * s_eta;
         let wi = to_world(fs, ft, fn_, s_wi);
-        let sp = load(&hit.p);
-        store(&mut p.o, offset_origin_lanes(sp, load(&hit.n), wi));
-        store(&mut p.d, wi);
+        let sp = hit.p.lanes();
+        p.o.store(offset_origin_lanes(sp, hit.n.lanes(), wi));
+        p.d.store(wi);
         p.tmax = [f32::INFINITY; W];
-        store(&mut p.from, sp);
+        p.from.store(sp);
         p.pdf = s_pdf.to_array();
         p.eta = eta.to_array();
         p.delta = s_delta;

@@ -3,7 +3,23 @@
 //! The helpers below read angles straight off a unit direction `w` expressed in the frame
 //! (`cos θ = w.z`, `sin²θ = 1 − z²`, `cos φ = x / sin θ`, …), as pbrt-v4's `CosTheta` family does.
 
+use crate::math::lanes::{Real, V3};
 use glam::Vec3;
+
+/// The tangents (s, t) of [`Frame::from_normal`] around the unit normal `n`, in lanes: Duff et al. 2017,
+/// "Building an Orthonormal Basis, Revisited" (JCGT 6(1), Listing 3), the sign of n_z taken as the sign of
+/// a comparison (so n_z = −0 counts as positive).
+#[inline(always)]
+#[must_use]
+pub fn tangents<R: Real>(n: V3<R>) -> (V3<R>, V3<R>) {
+    let one = R::splat(1.0);
+    let sign = R::select(n.z.lt(R::splat(0.0)), -one, one);
+    let a = -one / (sign + n.z);
+    let b = n.x * n.y * a;
+    let s = V3::new(one + sign * n.x * n.x * a, sign * b, -sign * n.x);
+    let t = V3::new(b, sign + n.y * n.y * a, -n.y);
+    (s, t)
+}
 
 /// An orthonormal basis `(s, t, n)`; `to_local` and `to_world` convert directions.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -19,12 +35,8 @@ impl Frame {
     #[must_use]
     pub fn from_normal(n: Vec3) -> Self {
         debug_assert!((n.length_squared() - 1.0).abs() < 1e-4, "normal must be unit length");
-        let sign = 1.0f32.copysign(n.z);
-        let a = -1.0 / (sign + n.z);
-        let b = n.x * n.y * a;
-        let s = Vec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
-        let t = Vec3::new(b, sign + n.y * n.y * a, -n.y);
-        Frame { s, t, n }
+        let (s, t) = tangents::<f32>(n.into());
+        Frame { s: s.into(), t: t.into(), n }
     }
 
     #[inline]

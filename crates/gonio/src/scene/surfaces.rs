@@ -4,16 +4,18 @@
 //! flat-shaded mesh (the common case: every built-in `rectangle`, `cube` and face-normal mesh), the
 //! triangles hit are gathered into one [`Triangle8`] and the eight rays' barycentrics and points come from
 //! one lane test ([`Triangle8::points_hit`]); the shading frame, constant over such a triangle, is copied.
-//! Other shapes (spheres, disks, smooth-shaded meshes) build their interaction one lane at a time, as
-//! [`Scene::interaction_at`] does for a single ray, spheres from the packet's distance without testing
-//! again. 2026-12: building interactions one lane at a time
+//! Spheres need only the distance, which the packet test computed as the scalar test does: their points,
+//! normals and frames are computed in lanes too. Other shapes (disks, smooth-shaded meshes) build their
+//! interaction one lane at a time, as [`Scene::interaction_at`] does for a single ray. 2026-12: building interactions one lane at a time
 //! had been a tenth of a Cornell box render.
 
 use super::{Scene, EMPTY_SLOT};
 use crate::geometry::bvh::{bits, Hits8, LANES};
 use crate::geometry::mesh::Triangle8;
 use crate::geometry::ray::RayLanes;
-use crate::geometry::{PrimHit, Ray, Shape, SurfaceInteraction};
+use crate::geometry::sphere::sphere_surface;
+use crate::geometry::{Ray, Shape, SurfaceInteraction};
+use crate::math::frame::tangents;
 use crate::math::lanes::V3;
 use crate::math::simd::{Float8, Mask8};
 use crate::math::Frame;
@@ -25,6 +27,18 @@ use glam::{Vec2, Vec3};
 pub struct Rows3(pub [[f32; LANES]; 3]);
 
 impl Rows3 {
+    /// The rows as lanes.
+    #[inline(always)]
+    #[must_use]
+    pub fn lanes(&self) -> V3<Float8> {
+        V3::new(Float8::load(&self.0[0]), Float8::load(&self.0[1]), Float8::load(&self.0[2]))
+    }
+
+    #[inline(always)]
+    pub fn store(&mut self, v: V3<Float8>) {
+        self.0 = [v.x.to_array(), v.y.to_array(), v.z.to_array()];
+    }
+
     #[inline(always)]
     pub fn get(&self, lane: usize) -> Vec3 {
         Vec3::new(self.0[0][lane], self.0[1][lane], self.0[2][lane])
@@ -99,8 +113,9 @@ impl Scene {
         let mut tris = Triangle8::default();
         // Lanes on flat triangles, and those of them whose material reads texture coordinates.
         let (mut flat, mut flat_uv) = (0u32, 0u32);
+        // Lanes on spheres (their centres and radii), those with flipped normals, and those textured.
+        let (mut centers, mut radii, mut round, mut flipped, mut round_uv) = (Rows3::default(), [1.0f32; LANES], 0u32, 0u32, 0u32);
         let (o, d) = ([rays.o.x, rays.o.y, rays.o.z].map(Float8::to_array), [rays.d.x, rays.d.y, rays.d.z].map(Float8::to_array));
-        let t = hits.t.to_array();
         for lane in bits(lanes) {
             let slot = hits.slot[lane];
             if slot == EMPTY_SLOT {
@@ -121,16 +136,18 @@ impl Scene {
                     continue;
                 }
             }
+            if let Shape::Sphere(sphere) = shape {
+                // A sphere's surface needs only the distance, which the packet test computed as the scalar
+                // test does.
+                centers.set(lane, sphere.center);
+                radii[lane] = sphere.radius;
+                round |= 1 << lane;
+                flipped |= u32::from(sphere.flip_normals) << lane;
+                round_uv |= u32::from(textured) << lane;
+                continue;
+            }
             let ray = Ray::new(Vec3::new(o[0][lane], o[1][lane], o[2][lane]), Vec3::new(d[0][lane], d[1][lane], d[2][lane]), f32::INFINITY);
-            // A sphere's interaction needs only the distance, which the packet test computed as the scalar
-            // test does; other shapes test again for their coordinates.
-            let si = match shape {
-                Shape::Sphere(_) => shape.interaction(r.shape, r.prim, &ray, &PrimHit { t: t[lane], uv: Vec2::ZERO }, textured),
-                _ => match self.interaction_at(slot, &ray) {
-                    Some(si) => si,
-                    None => continue,
-                },
-            };
+            let Some(si) = self.interaction_at(slot, &ray) else { continue };
             out.p.set(lane, si.p);
             out.n.set(lane, si.n);
             out.set_frame(lane, &si.shading);
@@ -138,9 +155,7 @@ impl Scene {
         }
         if flat != 0 {
             let (p, b1, b2) = tris.points_hit(rays.o, rays.d);
-            let old = V3::new(Float8::load(&out.p.0[0]), Float8::load(&out.p.0[1]), Float8::load(&out.p.0[2]));
-            let p = V3::select(Mask8::from_bitmask(flat), p, old);
-            out.p.0 = [p.x.to_array(), p.y.to_array(), p.z.to_array()];
+            out.p.store(V3::select(Mask8::from_bitmask(flat), p, out.p.lanes()));
             if flat_uv != 0 {
                 let (b1, b2) = (b1.to_array(), b2.to_array());
                 for lane in bits(flat_uv) {
@@ -149,6 +164,22 @@ impl Scene {
                         let uv = mesh.uv_at(r.prim, Vec2::new(b1[lane], b2[lane]));
                         (out.uv[0][lane], out.uv[1][lane]) = (uv.x, uv.y);
                     }
+                }
+            }
+        }
+        if round != 0 {
+            let (p, outward) = sphere_surface(rays.o, rays.d, hits.t, centers.lanes(), Float8::load(&radii));
+            let n = V3::select(Mask8::from_bitmask(flipped), outward.neg(), outward);
+            let (s, t) = tangents(n);
+            let m = Mask8::from_bitmask(round);
+            for (rows, v) in [(&mut out.p, p), (&mut out.n, n), (&mut out.s, s), (&mut out.t, t), (&mut out.ns, n)] {
+                rows.store(V3::select(m, v, rows.lanes()));
+            }
+            for lane in bits(round_uv) {
+                let r = self.prims.slots[hits.slot[lane] as usize];
+                if let Shape::Sphere(sphere) = &self.shapes[r.shape as usize] {
+                    let uv = sphere.uv_at(if flipped & (1 << lane) != 0 { -out.n.get(lane) } else { out.n.get(lane) });
+                    (out.uv[0][lane], out.uv[1][lane]) = (uv.x, uv.y);
                 }
             }
         }
