@@ -511,8 +511,9 @@ impl Triangle8 {
     }
 
     /// The nearest lane hit within (0, tmax), and its distance: what closest-hit traversal needs (the
-    /// barycentrics of the one triangle finally hit are recomputed by [`intersect_triangle`], which gives
-    /// the same numbers, rather than kept for every packet on the way).
+    /// barycentrics of the triangles finally hit are recomputed, by [`Self::points_hit`] for a packet or
+    /// [`intersect_triangle`] for one ray, which give the same numbers, rather than kept for every packet
+    /// on the way).
     #[inline(always)]
     #[must_use]
     pub fn nearest(&self, ray: &Ray, tmax: f32) -> Option<(f32, u32)> {

@@ -148,12 +148,13 @@ impl Packet {
 
 #[inline(always)]
 fn load_rgb(r: &Rows3) -> [Float8; 3] {
-    [Float8::load(&r.0[0]), Float8::load(&r.0[1]), Float8::load(&r.0[2])]
+    let v = r.lanes();
+    [v.x, v.y, v.z]
 }
 
 #[inline(always)]
 fn store_rgb(r: &mut Rows3, v: [Float8; 3]) {
-    r.0 = [v[0].to_array(), v[1].to_array(), v[2].to_array()];
+    r.store(V3::new(v[0], v[1], v[2]));
 }
 
 /// `v` in the frame (s, t, n), as [`crate::math::Frame::to_local`].
@@ -258,11 +259,7 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
         }
         let (fs, ft, fn_) = (hit.s.lanes(), hit.t.lanes(), hit.ns.lanes());
         let wo = to_local(fs, ft, fn_, p.d.lanes().neg());
-        let wo_rows = {
-            let mut r = Rows3::default();
-            r.store(wo);
-            r
-        };
+        let wo_rows = Rows3::from_lanes(wo);
         let rho = load_rgb(&rho_rows);
         let mut beta = load_rgb(&p.beta);
 
@@ -344,11 +341,7 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
             if others != 0 {
                 let (mut f_rows, mut pdf_rows) = (Rows3::default(), [0.0f32; W]);
                 store_rgb(&mut f_rows, f);
-                let wi_rows = {
-                    let mut r = Rows3::default();
-                    r.store(wi_local);
-                    r
-                };
+                let wi_rows = Rows3::from_lanes(wi_local);
                 for lane in bits(others) {
                     let (bsdf, wo, wi) = (models[lane].as_deref().expect("a model"), wo_rows.get(lane), wi_rows.get(lane));
                     f_rows.set_rgb(lane, bsdf.f(wo, wi));

@@ -410,7 +410,8 @@ impl Scene {
     }
 
     /// The closest hits of eight rays (the lanes of `rays` set in `lanes`): per lane the distance and the
-    /// BVH slot of the primitive hit ([`EMPTY_SLOT`] for none), for [`Self::interaction_at`].
+    /// BVH slot of the primitive hit ([`EMPTY_SLOT`] for none), for [`Self::surfaces`] (or [`Self::interaction_at`] one
+    /// by one).
     #[must_use]
     pub fn intersect_rays(&self, rays: &RayLanes<Float8>, lanes: u32) -> Hits8 {
         self.bvh.closest_rays(rays, lanes, &Leaves { prims: &self.prims, shapes: &self.shapes })

@@ -36,7 +36,14 @@ impl Rows3 {
 
     #[inline(always)]
     pub fn store(&mut self, v: V3<Float8>) {
-        self.0 = [v.x.to_array(), v.y.to_array(), v.z.to_array()];
+        *self = Self::from_lanes(v);
+    }
+
+    /// Lanes as rows.
+    #[inline(always)]
+    #[must_use]
+    pub fn from_lanes(v: V3<Float8>) -> Self {
+        Rows3([v.x.to_array(), v.y.to_array(), v.z.to_array()])
     }
 
     #[inline(always)]
