@@ -263,6 +263,36 @@ impl Mesh {
         Some((self.vertices(tri), self.tri_normals[tri as usize], 1.0 / self.area))
     }
 
+    /// [`Self::sample_flat_triangle`] in lanes, for a flat-shaded mesh of at most eight triangles of
+    /// positive total area (a `rectangle` is two); `None` for others.
+    #[must_use]
+    pub fn flat_triangles8(&self) -> Option<FlatTriangles8> {
+        let n = self.triangle_count();
+        if self.normals.is_some() || n > LANES || !(self.area > 0.0) {
+            return None;
+        }
+        let mut t = FlatTriangles8 {
+            thresholds: [f32::INFINITY; LANES],
+            vertices: [[[0.0; LANES]; 3]; 3],
+            normals: [[0.0; LANES]; 3],
+            density: 1.0 / self.area,
+        };
+        for (k, th) in self.areas.index_thresholds().into_iter().enumerate() {
+            t.thresholds[k] = th;
+        }
+        for tri in 0..n {
+            for (rows, v) in t.vertices.iter_mut().zip(self.vertices(tri as u32)) {
+                for axis in 0..3 {
+                    rows[axis][tri] = v[axis];
+                }
+            }
+            for axis in 0..3 {
+                t.normals[axis][tri] = self.tri_normals[tri][axis];
+            }
+        }
+        Some(t)
+    }
+
     /// A point uniformly distributed over the whole mesh: a triangle by area, then uniform barycentrics
     /// (the square-root warp, pbrt-v4 §6.5.4 / Osada et al. 2002).
     #[must_use]
@@ -281,6 +311,39 @@ impl Mesh {
             (ng, ns)
         };
         PositionSample { p, n: ns, ng, pdf_area: 1.0 / self.area }
+    }
+}
+
+/// Lanes per [`FlatTriangles8`].
+const LANES: usize = 8;
+
+/// A flat-shaded mesh of at most eight triangles as rows of lanes ([`Mesh::flat_triangles8`]): the path
+/// tracer's next-event estimation chooses a small area light's triangle for eight paths at once, with the
+/// same choice and vertices as [`Mesh::sample_flat_triangle`] per lane.
+#[derive(Clone, Debug)]
+pub struct FlatTriangles8 {
+    /// The area CDF's [`Distribution1D::index_thresholds`], +∞ after them.
+    thresholds: [f32; LANES],
+    /// `vertices[v][axis][triangle]`.
+    vertices: [[[f32; LANES]; 3]; 3],
+    /// `normals[axis][triangle]`: the unit geometric normals.
+    normals: [[f32; LANES]; 3],
+    /// 1 / the mesh's area.
+    pub density: f32,
+}
+
+impl FlatTriangles8 {
+    /// The triangle chosen by `uc` in each lane, as its vertices and unit normal.
+    #[inline(always)]
+    #[must_use]
+    pub fn sample(&self, uc: Float8) -> ([V3<Float8>; 3], V3<Float8>) {
+        let (zero, one) = (Float8::splat(0.0), Float8::splat(1.0));
+        // The index: how many thresholds lie at or below uc (at most seven; +∞ never does).
+        let index = self.thresholds[..LANES - 1].iter().fold(zero, |k, &t| k + Float8::select(uc.ge(Float8::splat(t)), one, zero));
+        let row = |r: &[[f32; LANES]; 3]| {
+            V3::new(Float8::load(&r[0]).permute(index), Float8::load(&r[1]).permute(index), Float8::load(&r[2]).permute(index))
+        };
+        ([row(&self.vertices[0]), row(&self.vertices[1]), row(&self.vertices[2])], row(&self.normals))
     }
 }
 
@@ -611,6 +674,49 @@ mod tests {
     }
 
     /// The 8-wide test agrees with the scalar one, lane by lane, bit for bit.
+    /// The lanes choose the triangle [`Mesh::sample_flat_triangle`] chooses, with its vertices and normal,
+    /// for random u and for u at and next to every CDF step, on meshes of one to eight triangles of unequal
+    /// areas.
+    #[test]
+    fn flat_triangles8_choose_as_the_cdf() {
+        let mut rng = crate::sampling::Pcg32::new(11, 3);
+        for n in 1..=8usize {
+            let positions: Vec<Vec3> = (0..3 * n).map(|_| Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 3.0).collect();
+            let indices: Vec<[u32; 3]> = (0..n as u32).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect();
+            let mesh = Mesh::new(positions, None, None, indices, &Transform::IDENTITY, true, false, "test").unwrap();
+            let table = mesh.flat_triangles8().expect("a small flat mesh");
+            let mut us: Vec<f32> = (0..64).map(|_| rng.next_f32()).collect();
+            for t in mesh.areas.index_thresholds() {
+                us.extend([t, f32::from_bits(t.to_bits() - 1), f32::from_bits(t.to_bits() + 1)]);
+            }
+            us.extend([0.0, 1.0 - f32::EPSILON / 2.0]);
+            for chunk in us.chunks(8) {
+                let uc = Float8::from_fn(|i| chunk.get(i).copied().unwrap_or(0.0));
+                let (vertices, normal) = table.sample(uc);
+                for (i, &u) in chunk.iter().enumerate() {
+                    let (want, want_n, density) = mesh.sample_flat_triangle(u).unwrap();
+                    for (v, w) in vertices.iter().zip(want) {
+                        assert_eq!(Vec3::new(v.x.lane(i), v.y.lane(i), v.z.lane(i)), w, "n = {n}, u = {u}");
+                    }
+                    assert_eq!(Vec3::new(normal.x.lane(i), normal.y.lane(i), normal.z.lane(i)), want_n);
+                    assert_eq!(table.density, density);
+                }
+            }
+        }
+        let smooth = Mesh::new(
+            vec![Vec3::ZERO, Vec3::X, Vec3::Y],
+            Some(vec![Vec3::Z; 3]),
+            None,
+            vec![[0, 1, 2]],
+            &Transform::IDENTITY,
+            false,
+            false,
+            "test",
+        )
+        .unwrap();
+        assert!(smooth.flat_triangles8().is_none(), "smooth-shaded meshes sample by their vertex normals");
+    }
+
     #[test]
     fn eight_wide_test_matches_scalar() {
         let mut rng = crate::sampling::Pcg32::new(9, 2);

@@ -31,7 +31,7 @@ use crate::light::area::towards;
 use crate::light::Light;
 use crate::math::lanes::{Real, V3};
 use crate::math::simd::{Float8, Mask8};
-use crate::math::Vec2;
+use crate::math::{Vec2, Vec3};
 use crate::sampling::{Pcg32, Pcg32x8};
 use crate::scene::surfaces::Rows3;
 use crate::scene::Scene;
@@ -269,21 +269,43 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
             | bits(p.live & !diffuse)
                 .fold(0, |m, lane| m | (u32::from(models[lane].as_ref().is_some_and(|b| b.flags().has_smooth())) << lane));
         if n_lights > 0 && smooth != 0 {
-            // Per lane, the light and (for a flat mesh's area light, the common case) the triangle; the
-            // point on it in lanes. Other lights sample in full per lane.
+            // The light, chosen per lane. For an area light on a flat mesh (the common case) the triangle, and
+            // the point on it in lanes; other lights sample in full per lane.
             let (mut wi, mut li, mut light_pdf) = (Rows3::default(), Rows3::default(), [0.0f32; W]);
-            let (mut tri, mut tri_n, mut pdf_area, mut ux, mut uy) =
-                ([Rows3::default(); 3], Rows3::default(), [0.0f32; W], [0.0f32; W], [0.0f32; W]);
+            let (mut tri, mut tri_n, mut pdf_area) = ([Rows3::default(); 3], Rows3::default(), Float8::splat(0.0));
             let (mut sampled, mut on_mesh, mut delta) = (0u32, 0u32, 0u32);
             let mut shadow = RayRows::default();
             let u_light = p.rng.next_f32(smooth);
             let (u_c, u_x, u_y) = (p.rng.next_f32(smooth), p.rng.next_f32(smooth), p.rng.next_f32(smooth));
             // `(u · n) as usize`, at most n − 1: u · n is in [0, n), so truncation is the cast.
-            let chosen = (u_light * n_lights as f32).trunc().min(Float8::splat((n_lights - 1) as f32)).to_array();
-            let (u_c, u_x, u_y) = (u_c.to_array(), u_x.to_array(), u_y.to_array());
-            for lane in bits(smooth) {
+            let chosen_lanes = (u_light * n_lights as f32).trunc().min(Float8::splat((n_lights - 1) as f32));
+            let chosen = chosen_lanes.to_array();
+            // Small flat meshes (a `rectangle` light, say): the triangles of the lanes that chose the same
+            // light, chosen and loaded in lanes.
+            let mut rest = smooth;
+            let mut todo = smooth;
+            while todo != 0 {
+                let index = chosen[todo.trailing_zeros() as usize];
+                let same = todo & chosen_lanes.eq(Float8::splat(index)).bitmask();
+                todo &= !same;
+                let (Light::Area(area), Some(tris)) = (&scene.lights[index as usize], &scene.light_triangles[index as usize]) else {
+                    continue;
+                };
+                let m = Mask8::from_bitmask(same);
+                let (vertices, n) = tris.sample(u_c);
+                for (rows, v) in tri.iter_mut().zip(vertices) {
+                    rows.store(V3::select(m, v, rows.lanes()));
+                }
+                tri_n.store(V3::select(m, n, tri_n.lanes()));
+                pdf_area = Float8::select(m, Float8::splat(tris.density), pdf_area);
+                li.store(V3::select(m, V3::splat(Vec3::from_array(area.radiance.0)), li.lanes()));
+                on_mesh |= same;
+                rest &= !same;
+            }
+            let (uc_rows, ux_rows, uy_rows) = (u_c.to_array(), u_x.to_array(), u_y.to_array());
+            for lane in bits(rest) {
                 let index = chosen[lane] as usize;
-                let (uc, u) = (u_c[lane], Vec2::new(u_x[lane], u_y[lane]));
+                let (uc, u) = (uc_rows[lane], Vec2::new(ux_rows[lane], uy_rows[lane]));
                 let light = &scene.lights[index];
                 if let Light::Area(area) = light {
                     if let Shape::Mesh(mesh) = &scene.shapes[area.shape as usize] {
@@ -293,7 +315,7 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
                                     rows.set(lane, v);
                                 }
                                 tri_n.set(lane, n);
-                                (pdf_area[lane], ux[lane], uy[lane]) = (density, u.x, u.y);
+                                pdf_area = Float8::select(Mask8::from_bitmask(1 << lane), Float8::splat(density), pdf_area);
                                 li.set_rgb(lane, area.radiance);
                                 on_mesh |= 1 << lane;
                             }
@@ -315,9 +337,9 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
             if on_mesh != 0 {
                 // `AreaLight::sample_li` on a flat mesh, in lanes.
                 let (sp, sn) = (hit.p.lanes(), hit.n.lanes());
-                let q = uniform_triangle_point(tri[0].lanes(), tri[1].lanes(), tri[2].lanes(), Float8::load(&ux), Float8::load(&uy));
+                let q = uniform_triangle_point(tri[0].lanes(), tri[1].lanes(), tri[2].lanes(), u_x, u_y);
                 let ng = tri_n.lanes();
-                let (pdf, by_area) = solid_angle_density(sp, q, ng, Float8::load(&pdf_area));
+                let (pdf, by_area) = solid_angle_density(sp, q, ng, pdf_area);
                 let (dir, facing) = towards(sp, q, ng, pdf);
                 let ray = spawn_ray_to_lanes(sp, sn, q, ng);
                 let ok = by_area & facing & Mask8::from_bitmask(on_mesh);

@@ -132,6 +132,15 @@ impl Avx8 {
         Avx8(avx!(_mm256_max_ps(self.0, o.0)))
     }
 
+    /// Lane `i` is lane `idx[i]` of `self`, for whole numbers `idx` in 0..8 (a lookup in a table of eight:
+    /// one `vpermps`). The renderer's; the batch kernels have no use for it.
+    #[cfg_attr(not(all(target_feature = "avx2", target_feature = "fma")), allow(dead_code))]
+    #[inline(always)]
+    #[must_use]
+    pub fn permute(self, idx: Self) -> Self {
+        Avx8(avx!(_mm256_permutevar8x32_ps(self.0, _mm256_cvttps_epi32(idx.0))))
+    }
+
     /// Towards zero (`f32::trunc`).
     #[inline(always)]
     #[must_use]

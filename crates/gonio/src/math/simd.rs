@@ -361,6 +361,19 @@ impl Float8 {
     }
 }
 
+/// [`Float8::permute`] where `Float8` is two SSE registers or an array (AVX2's is one instruction, in
+/// `math::avx2`).
+#[cfg(not(all(target_arch = "x86_64", target_feature = "avx2", target_feature = "fma")))]
+impl Float8 {
+    /// Lane `i` is lane `idx[i]` of `self`, for whole numbers `idx` in 0..8 (a lookup in a table of eight).
+    #[inline(always)]
+    #[must_use]
+    pub fn permute(self, idx: Float8) -> Self {
+        let (a, idx) = (self.to_array(), idx.to_array());
+        Float8::from_fn(|i| a[idx[i] as usize & 7])
+    }
+}
+
 impl Float8 {
     /// The smallest lane (as `min_or_second` across the lanes: a NaN lane may or may not win).
     #[inline(always)]

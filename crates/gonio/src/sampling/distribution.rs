@@ -213,6 +213,25 @@ impl Distribution1D {
         self.find_cell(f64::from(u))
     }
 
+    /// Thresholds t₁ … t_{n−1} for choosing a cell in lanes: for every `f32` u in [0, 1),
+    /// [`Self::sample_index`]`(u)` is the number of them at or below u. t_k is the smallest `f32` at or
+    /// above cdf[k], so that u ≥ t_k exactly when cdf[k] ≤ u in `f64`, as [`Self::find_cell`] compares.
+    #[must_use]
+    pub fn index_thresholds(&self) -> Vec<f32> {
+        self.cdf[1..self.len()]
+            .iter()
+            .map(|&c| {
+                let f = c as f32;
+                // c ∈ [0, 1]: the next f32 up is the next bit pattern.
+                if f64::from(f) < c {
+                    f32::from_bits(f.to_bits() + 1)
+                } else {
+                    f
+                }
+            })
+            .collect()
+    }
+
     /// The probability with which [`Self::sample_discrete`] chooses cell `index`.
     #[must_use]
     pub fn pmf(&self, index: usize) -> f32 {

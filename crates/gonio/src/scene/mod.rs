@@ -17,7 +17,7 @@ use crate::error::Result;
 use crate::film::FilmSpec;
 use crate::geometry::bvh::{bits, PacketLeaves, LANES, PACKET};
 pub use crate::geometry::bvh::{Hits8, EMPTY_SLOT};
-use crate::geometry::mesh::{intersect_triangle, Triangle8};
+use crate::geometry::mesh::{intersect_triangle, FlatTriangles8, Triangle8};
 use crate::geometry::ray::RayLanes;
 use crate::geometry::sphere::Sphere8;
 use crate::geometry::{Bvh, Ray, Shape, SurfaceInteraction};
@@ -54,6 +54,10 @@ pub struct Scene {
     pub lights: Vec<Light>,
     /// Index of the environment light (`constant` or `envmap`), seen by rays that escape.
     pub environment: Option<u32>,
+    /// Per light: an area light that emits on a flat mesh of at most eight triangles, as lanes
+    /// ([`Mesh::flat_triangles8`](crate::geometry::mesh::Mesh::flat_triangles8)), for the path tracer's
+    /// next-event estimation.
+    pub light_triangles: Vec<Option<FlatTriangles8>>,
     pub camera: PerspectiveCamera,
     pub film: FilmSpec,
     pub sampler: SamplerSpec,
@@ -366,12 +370,23 @@ impl Scene {
         let bvh_seconds = start.elapsed().as_secs_f64();
         let environment = lights.iter().position(Light::is_environment).map(|i| i as u32);
         let textured = (0..shapes.len()).map(|s| materials.get(s).is_some_and(Material::is_textured)).collect();
+        let light_triangles = lights
+            .iter()
+            .map(|light| match light {
+                Light::Area(area) if !area.radiance.is_black() => match &shapes[area.shape as usize] {
+                    Shape::Mesh(mesh) => mesh.flat_triangles8(),
+                    _ => None,
+                },
+                _ => None,
+            })
+            .collect();
         Scene {
             shapes,
             materials,
             shape_lights,
             lights,
             environment,
+            light_triangles,
             camera,
             film,
             sampler,
