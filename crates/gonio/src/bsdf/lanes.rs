@@ -12,7 +12,9 @@
 //! lanes already loaded, so that checking a batch's inputs costs no pass of its own. Measured with callgrind
 //! (instructions per row): see the table in the `batch_rows` example's doc.
 
-use super::{BsdfFlags, BsdfSample, SampleColumns};
+use super::rough_conductor::GgxConductor;
+use super::rough_plastic::GgxPlastic;
+use super::{Bsdf, BsdfFlags, BsdfSample, SampleColumns};
 use crate::math::lanes::{channels, F32x8, Real, Rows, V3};
 use crate::math::{Vec2, Vec3};
 use crate::spectrum::Rgb;
@@ -68,6 +70,54 @@ pub trait LaneModel {
     fn pdf_lanes<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> R;
     /// sample(ωo, uc, (ux, uy)).
     fn sample_lanes<R: Real>(&self, wo: V3<R>, uc: R, ux: R, uy: R) -> LaneSample<R>;
+}
+
+/// The kernel of a model whose configuration has one, for callers that run rows of one model in lanes
+/// outside the batch drivers: the path tracer's packets, for the lanes whose surfaces share a material.
+#[derive(Clone, Copy, Debug)]
+pub enum LaneKernel<'a> {
+    Conductor(GgxConductor),
+    Plastic(GgxPlastic<'a>),
+}
+
+impl Bsdf {
+    /// This model's [`LaneKernel`], `None` for models and configurations without one (`diffuse` has its
+    /// own lanes in the renderer).
+    #[inline]
+    #[must_use]
+    pub fn lane_kernel(&self) -> Option<LaneKernel<'_>> {
+        match self {
+            Bsdf::RoughConductor(m) => m.0.lanes().map(LaneKernel::Conductor),
+            Bsdf::RoughPlastic(m) => m.lanes().map(LaneKernel::Plastic),
+            _ => None,
+        }
+    }
+}
+
+impl LaneModel for LaneKernel<'_> {
+    #[inline(always)]
+    fn f_lanes<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> [R; 3] {
+        match self {
+            LaneKernel::Conductor(k) => k.f_lanes(wo, wi),
+            LaneKernel::Plastic(k) => k.f_lanes(wo, wi),
+        }
+    }
+
+    #[inline(always)]
+    fn pdf_lanes<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> R {
+        match self {
+            LaneKernel::Conductor(k) => k.pdf_lanes(wo, wi),
+            LaneKernel::Plastic(k) => k.pdf_lanes(wo, wi),
+        }
+    }
+
+    #[inline(always)]
+    fn sample_lanes<R: Real>(&self, wo: V3<R>, uc: R, ux: R, uy: R) -> LaneSample<R> {
+        match self {
+            LaneKernel::Conductor(k) => k.sample_lanes(wo, uc, ux, uy),
+            LaneKernel::Plastic(k) => k.sample_lanes(wo, uc, ux, uy),
+        }
+    }
 }
 
 /// [`LaneModel::f_lanes`] for one pair.
@@ -344,4 +394,54 @@ fn sample_rows_in<R: Rows, K: LaneModel, const CHECK: bool>(
         out.set(j, sample_one(k, wo[j], uc[j], u[j]));
     }
     ok
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bsdf::BsdfModel;
+    use crate::math::simd::Float8;
+    use crate::sampling::Pcg32;
+
+    /// A model's [`LaneKernel`] on the renderer's eight lanes gives in every lane what the model's single
+    /// calls give, bit for bit; models without a kernel in their configuration have none.
+    #[test]
+    fn lane_kernels_equal_single_calls() {
+        let with = [
+            r#"{"type": "roughconductor", "distribution": "ggx", "alpha": 0.2, "material": "Au"}"#,
+            r#"{"type": "roughconductor", "distribution": "ggx", "alpha_u": 0.05, "alpha_v": 0.4}"#,
+            r#"{"type": "roughplastic", "distribution": "ggx", "alpha": 0.1, "diffuse_reflectance": [0.7, 0.1, 0.1]}"#,
+        ];
+        let without = [r#"{"type": "roughconductor", "alpha": 0.2}"#, r#"{"type": "diffuse"}"#, r#"{"type": "dielectric"}"#];
+        for spec in without {
+            assert!(Bsdf::from_json(spec).unwrap().lane_kernel().is_none(), "{spec}");
+        }
+        let mut rng = Pcg32::new(1, 2);
+        let dir = |rng: &mut Pcg32| crate::sampling::warp::sample_uniform_sphere(rng.next_vec2());
+        for spec in with {
+            let b = Bsdf::from_json(spec).unwrap();
+            let k = b.lane_kernel().expect("a GGX kernel");
+            for _ in 0..64 {
+                let (wo, wi): (Vec<Vec3>, Vec<Vec3>) = (0..8).map(|_| (dir(&mut rng), dir(&mut rng))).unzip();
+                let (uc, ux, uy) =
+                    (Float8::from_fn(|_| rng.next_f32()), Float8::from_fn(|_| rng.next_f32()), Float8::from_fn(|_| rng.next_f32()));
+                let lanes = |v: &[Vec3]| V3::new(Float8::from_fn(|i| v[i].x), Float8::from_fn(|i| v[i].y), Float8::from_fn(|i| v[i].z));
+                let (wo8, wi8) = (lanes(&wo), lanes(&wi));
+                let (f, pdf, s) = (k.f_lanes(wo8, wi8), k.pdf_lanes(wo8, wi8), k.sample_lanes(wo8, uc, ux, uy));
+                for i in 0..8 {
+                    let want = b.f(wo[i], wi[i]);
+                    assert_eq!(f.map(|c| c.lane(i).to_bits()), want.0.map(f32::to_bits), "{spec}: f");
+                    assert_eq!(pdf.lane(i).to_bits(), b.pdf(wo[i], wi[i]).to_bits(), "{spec}: pdf");
+                    let one = b.sample(wo[i], uc.lane(i), Vec2::new(ux.lane(i), uy.lane(i)));
+                    assert_eq!(s.valid.lane(i), one.is_some(), "{spec}: sample");
+                    if let Some(one) = one {
+                        assert_eq!([s.wi.x.lane(i), s.wi.y.lane(i), s.wi.z.lane(i)].map(f32::to_bits), one.wi.to_array().map(f32::to_bits));
+                        assert_eq!(s.weight.map(|c| c.lane(i).to_bits()), one.weight.0.map(f32::to_bits));
+                        assert_eq!((s.pdf.lane(i).to_bits(), s.eta.lane(i).to_bits()), (one.pdf.to_bits(), one.eta.to_bits()));
+                        assert_eq!(s.flags.lane(i) as u32, one.flags.0);
+                    }
+                }
+            }
+        }
+    }
 }

@@ -196,7 +196,7 @@ pub struct GgxConductor {
 impl MicrofacetConductor {
     /// The [`GgxConductor`] kernel of this model, `None` for other configurations.
     #[inline(always)]
-    fn lanes(&self) -> Option<GgxConductor> {
+    pub(crate) fn lanes(&self) -> Option<GgxConductor> {
         let d = self.distribution;
         (d.kind == MicrofacetKind::Ggx && self.shadowing == Shadowing::Smith && self.sample_visible && self.compensation.is_none())
             .then_some(GgxConductor { ggx: d.ggx(), eta_k: self.fresnel.eta_k, specular_reflectance: self.fresnel.specular_reflectance })

@@ -551,7 +551,7 @@ pub struct GgxPlastic<'a> {
 impl RoughPlastic {
     /// The [`GgxPlastic`] kernel of this model, `None` for other configurations.
     #[inline(always)]
-    fn lanes(&self) -> Option<GgxPlastic<'_>> {
+    pub(crate) fn lanes(&self) -> Option<GgxPlastic<'_>> {
         let c = &self.coating;
         (c.distribution.kind == MicrofacetKind::Ggx && c.sample_visible && c.compensation.is_none()).then(|| GgxPlastic {
             ggx: c.distribution.ggx(),

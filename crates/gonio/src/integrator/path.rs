@@ -21,6 +21,7 @@
 
 use super::{emitter_hit, start, BsdfSampled, CameraSample};
 use crate::bsdf::diffuse::{diffuse_f, diffuse_pdf, diffuse_sample};
+use crate::bsdf::lanes::{LaneKernel, LaneModel};
 use crate::bsdf::{Bsdf, BsdfFlags, BsdfModel};
 use crate::geometry::bvh::bits;
 use crate::geometry::mesh::uniform_triangle_point;
@@ -257,6 +258,24 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
                 None => models[lane] = Some(material.at(uv)),
             }
         }
+        // Lanes that share a model with a lane kernel (GGX `roughconductor` and `roughplastic`), at least
+        // two, run it in lanes; the other models run per lane.
+        let (mut kernels, mut grouped) = ([(0u32, None::<LaneKernel<'_>>); W], 0u32);
+        for lane in bits(p.live & !diffuse) {
+            if grouped & (1 << lane) != 0 {
+                continue;
+            }
+            let Some(Cow::Borrowed(model)) = models[lane] else { continue };
+            let Some(kernel) = model.lane_kernel() else { continue };
+            let same = bits(p.live & !diffuse & !grouped)
+                .filter(|&l| matches!(models[l], Some(Cow::Borrowed(m)) if std::ptr::eq(m, model)))
+                .fold(0u32, |m, l| m | 1 << l);
+            if same.count_ones() >= 2 {
+                kernels[lane] = (same, Some(kernel));
+                grouped |= same;
+            }
+        }
+        let kernels = || kernels.iter().filter_map(|&(m, k)| k.map(|k| (m, k)));
         let (fs, ft, fn_) = (hit.s.lanes(), hit.t.lanes(), hit.ns.lanes());
         let wo = to_local(fs, ft, fn_, p.d.lanes().neg());
         let wo_rows = Rows3::from_lanes(wo);
@@ -359,7 +378,16 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
             // f and the BSDF's density: in lanes for diffuse surfaces, by the model for the others.
             let mut f = diffuse_f(rho, wo, wi_local);
             let mut bsdf_pdf = diffuse_pdf(wo, wi_local);
-            let others = sampled & !diffuse;
+            for (lanes, kernel) in kernels() {
+                let m = Mask8::from_bitmask(lanes & sampled);
+                let fk = kernel.f_lanes(wo, wi_local);
+                for c in 0..3 {
+                    f[c] = Float8::select(m, fk[c], f[c]);
+                }
+                let pdf = Float8::select(Mask8::from_bitmask(delta), Float8::splat(0.0), kernel.pdf_lanes(wo, wi_local));
+                bsdf_pdf = Float8::select(m, pdf, bsdf_pdf);
+            }
+            let others = sampled & !diffuse & !grouped;
             if others != 0 {
                 let (mut f_rows, mut pdf_rows) = (Rows3::default(), [0.0f32; W]);
                 store_rgb(&mut f_rows, f);
@@ -404,11 +432,23 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
         // BSDF sampling: in lanes for diffuse surfaces, by the model for the others.
         let (uc, ux, uy) = (p.rng.next_f32(p.live), p.rng.next_f32(p.live), p.rng.next_f32(p.live));
         let ds = diffuse_sample(rho, wo, ux, uy);
-        let (uc, ux, uy) = (uc.to_array(), ux.to_array(), uy.to_array());
         let mut valid = ds.valid.bitmask() & diffuse;
         let (mut s_wi, mut s_pdf, mut s_eta, mut s_weight) = (ds.wi, ds.pdf, ds.eta, ds.weight);
         let mut s_delta = 0u32;
-        let others = p.live & !diffuse;
+        for (lanes, kernel) in kernels() {
+            let s = kernel.sample_lanes(wo, uc, ux, uy);
+            let m = Mask8::from_bitmask(lanes);
+            s_wi = V3::select(m, s.wi, s_wi);
+            for (w, k) in s_weight.iter_mut().zip(s.weight) {
+                *w = Float8::select(m, k, *w);
+            }
+            (s_pdf, s_eta) = (Float8::select(m, s.pdf, s_pdf), Float8::select(m, s.eta, s_eta));
+            valid |= s.valid.bitmask() & lanes;
+            let flags = s.flags.to_array();
+            s_delta |= bits(lanes).fold(0, |d, l| d | u32::from(BsdfFlags(flags[l] as u32).contains(BsdfFlags::DELTA)) << l);
+        }
+        let (uc, ux, uy) = (uc.to_array(), ux.to_array(), uy.to_array());
+        let others = p.live & !diffuse & !grouped;
         if others != 0 {
             let (mut wi_rows, mut w_rows) = (Rows3::default(), Rows3::default());
             let (mut pdf_rows, mut eta_rows) = (s_pdf.to_array(), s_eta.to_array());
