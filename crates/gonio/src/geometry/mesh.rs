@@ -673,7 +673,6 @@ mod tests {
         }
     }
 
-    /// The 8-wide test agrees with the scalar one, lane by lane, bit for bit.
     /// The lanes choose the triangle [`Mesh::sample_flat_triangle`] chooses, with its vertices and normal,
     /// for random u and for u at and next to every CDF step, on meshes of one to eight triangles of unequal
     /// areas.
@@ -717,6 +716,7 @@ mod tests {
         assert!(smooth.flat_triangles8().is_none(), "smooth-shaded meshes sample by their vertex normals");
     }
 
+    /// The 8-wide test agrees with the scalar one, lane by lane, bit for bit.
     #[test]
     fn eight_wide_test_matches_scalar() {
         let mut rng = crate::sampling::Pcg32::new(9, 2);
