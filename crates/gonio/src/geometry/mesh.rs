@@ -341,7 +341,8 @@ impl FlatTriangles8 {
         // The index: how many thresholds lie at or below uc (at most seven; +∞ never does).
         let index = self.thresholds[..LANES - 1].iter().fold(zero, |k, &t| k + Float8::select(uc.ge(Float8::splat(t)), one, zero));
         let row = |r: &[[f32; LANES]; 3]| {
-            V3::new(Float8::load(&r[0]).permute(index), Float8::load(&r[1]).permute(index), Float8::load(&r[2]).permute(index))
+            let v = lane_rows(r);
+            V3::new(v.x.permute(index), v.y.permute(index), v.z.permute(index))
         };
         ([row(&self.vertices[0]), row(&self.vertices[1]), row(&self.vertices[2])], row(&self.normals))
     }
