@@ -213,7 +213,19 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
         // sample either way); paths that escaped or reached the longest length end.
         let mut le = Rows3::default();
         let t = found.t.to_array();
-        for lane in bits(p.live) {
+        let first = bits(p.live).fold(0u32, |m, lane| m | u32::from(p.depth[lane] == 0) << lane);
+        let shown = p.live & !(if hide_emitters { first } else { 0 });
+        // A constant environment seen, in lanes: `emitter_hit`'s Le · w, with w the power heuristic
+        // against light sampling, one sample of each (1 after a delta lobe and for camera rays).
+        let (mut sky, mut sky_le) = (0u32, [Float8::splat(0.0); 3]);
+        if let Some(Light::Constant(constant)) = scene.environment.map(|i| &scene.lights[i as usize]) {
+            sky = shown & !hit.found;
+            let light_pdf = Float8::splat(constant.pdf_li(Vec3::Z) / n_lights as f32);
+            let unweighted = Mask8::from_bitmask(first | p.delta);
+            let w = Float8::select(unweighted, Float8::splat(1.0), power_heuristic_1(Float8::load(&p.pdf), light_pdf));
+            sky_le = constant.radiance.0.map(|c| w * c);
+        }
+        for lane in bits(p.live & !sky) {
             let depth = p.depth[lane];
             let on_surface = hit.found & (1 << lane) != 0;
             let emits = if on_surface { scene.shape_lights[hit.shape[lane] as usize].is_some() } else { scene.environment.is_some() };
@@ -229,7 +241,9 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
                 le.set_rgb(lane, emitter_hit(scene, &p.ray(lane), si.as_ref(), prev.as_ref()));
             }
         }
-        let (mut l, beta, le) = (load_rgb(&p.l), load_rgb(&p.beta), load_rgb(&le));
+        let le = load_rgb(&le);
+        let le: [Float8; 3] = std::array::from_fn(|c| Float8::select(Mask8::from_bitmask(sky), sky_le[c], le[c]));
+        let (mut l, beta) = (load_rgb(&p.l), load_rgb(&p.beta));
         for c in 0..3 {
             l[c] = l[c] + beta[c] * le[c];
         }

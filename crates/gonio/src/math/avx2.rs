@@ -92,6 +92,15 @@ impl Avx8 {
         a
     }
 
+    /// Lanes from eight numbers in registers (`vinsertps` and the like: see [`crate::math::simd`] on
+    /// store-to-load forwarding).
+    #[cfg_attr(not(all(target_feature = "avx2", target_feature = "fma")), allow(dead_code))]
+    #[inline(always)]
+    #[must_use]
+    pub fn new(a: [f32; 8]) -> Self {
+        Avx8(avx!(_mm256_setr_ps(a[0], a[1], a[2], a[3], a[4], a[5], a[6], a[7])))
+    }
+
     /// Lanes from an array.
     #[inline(always)]
     #[must_use]

@@ -15,6 +15,12 @@
 //! formula written over `Real` computes in each lane what it computes on one `f32`. Besides, the kernels
 //! use `min_or_second` and `max_or_second`, with the semantics of x86's `minps` / `maxps` (the second
 //! operand where either is NaN), one instruction where `f32::min` needs three.
+//!
+//! Store-to-load forwarding: a load of all eight lanes right after stores of single lanes to the same
+//! place cannot take its value from those stores (they are narrower) and waits until they have left the
+//! store buffer. Kernels that fill lanes one at a time therefore build the register instead:
+//! [`Float8::with_lane`] (a blend), or [`Float8::new`] from numbers already in registers (2026-12: the
+//! packet leaf tests' distances and `Pcg32x8::next_f32`, the material spheres about 4 % faster).
 
 // The x86 intrinsics are `unsafe fn` before Rust 1.87 (gonio's MSRV is 1.80) and safe afterwards where
 // the feature is enabled, as SSE2 always is on x86-64 and AVX is in the builds that select it: the
@@ -86,6 +92,12 @@ mod imp {
         pub fn load(a: &[f32; 8]) -> Self {
             // SAFETY: `a` holds eight floats (two groups of four); the loads have no alignment requirement.
             unsafe { Float8(_mm_loadu_ps(a.as_ptr()), _mm_loadu_ps(a.as_ptr().add(4))) }
+        }
+        /// Lanes from eight numbers in registers.
+        #[inline(always)]
+        pub fn new(a: [f32; 8]) -> Self {
+            // SAFETY: SSE, which x86-64 always has.
+            unsafe { Float8(_mm_setr_ps(a[0], a[1], a[2], a[3]), _mm_setr_ps(a[4], a[5], a[6], a[7])) }
         }
         #[inline(always)]
         pub fn to_array(self) -> [f32; 8] {
@@ -248,6 +260,11 @@ mod imp {
         pub fn load(a: &[f32; 8]) -> Self {
             Float8(*a)
         }
+        /// Lanes from eight numbers.
+        #[inline(always)]
+        pub fn new(a: [f32; 8]) -> Self {
+            Float8(a)
+        }
         #[inline(always)]
         pub fn to_array(self) -> [f32; 8] {
             self.0
@@ -358,6 +375,14 @@ impl Float8 {
     #[must_use]
     pub fn lane(self, i: usize) -> f32 {
         self.to_array()[i]
+    }
+
+    /// These lanes with lane `lane` set to `v`, in registers (see the module doc on store-to-load
+    /// forwarding).
+    #[inline(always)]
+    #[must_use]
+    pub fn with_lane(self, lane: usize, v: f32) -> Self {
+        Float8::select(Mask8::from_bitmask(1 << lane), Float8::splat(v), self)
     }
 }
 
@@ -625,6 +650,16 @@ mod tests {
         assert!(mask(x.le(y) & x.ge(y), &|p, q| p == q) && mask(x.lt(y) | x.gt(y), &|p, q| p.partial_cmp(&q).is_some_and(|o| o.is_ne())));
         assert!(mask(!x.lt(y), &|p, q| !(p < q)) && mask(x.le(y) & !x.lt(y), &|p, q| p == q));
         assert!(mask(Mask8::from_bitmask(0b1010_0110), &|_, _| false) || Mask8::from_bitmask(0b1010_0110).bitmask() == 0b1010_0110);
+    }
+
+    /// `new` is `load`, and `with_lane` replaces exactly its lane, bit for bit.
+    #[test]
+    fn lanes_built_in_registers() {
+        assert!(same(Float8::new(A), &|p, _| p));
+        for (lane, &b) in B.iter().enumerate() {
+            let x = Float8::load(&A).with_lane(lane, b);
+            assert!((0..8).all(|i| x.lane(i).to_bits() == if i == lane { B[i] } else { A[i] }.to_bits()), "lane {lane}");
+        }
     }
 
     /// `round` is `f32::round` (halves away from zero, signed zeros kept) across magnitudes.

@@ -126,7 +126,7 @@ impl Pcg32x8 {
             self.state[i] = (stepped & keep) | (old & !keep);
             out[i] = unit_f32(xsh_rr(old));
         }
-        crate::math::simd::Float8::load(&out)
+        crate::math::simd::Float8::new(out)
     }
 }
 

@@ -229,14 +229,13 @@ impl PacketLeaves for Leaves<'_> {
             let tris = u32::from(self.prims.tri_lanes[packet]);
             if tris != 0 {
                 if lanes.count_ones() < RAYS_PER_TRIANGLE * tris.count_ones() {
-                    let mut t = hits.t.to_array();
+                    let t = hits.t.to_array();
                     for lane in bits(lanes) {
                         if let Some((tl, l)) = tri.nearest(&each[lane], t[lane]) {
-                            t[lane] = tl;
+                            hits.t = hits.t.with_lane(lane, tl);
                             hits.slot[lane] = (packet * LANES) as u32 + l;
                         }
                     }
-                    hits.t = Float8::load(&t);
                 } else {
                     for l in bits(tris) {
                         let (hit, t) = tri.intersect_rays(l, rays.o, rays.d, hits.t);
@@ -356,16 +355,17 @@ impl Scene {
         integrator: IntegratorKind,
         warnings: Vec<String>,
     ) -> Scene {
-        let mut refs = Vec::new();
-        let mut bounds = Vec::new();
+        let (mut refs, mut bounds, mut alone) = (Vec::new(), Vec::new(), Vec::new());
         for (s, shape) in shapes.iter().enumerate() {
             for p in 0..shape.primitive_count() as u32 {
                 refs.push(SlotRef { shape: s as u32, prim: p });
                 bounds.push(shape.primitive_bounds(p));
+                // Triangles are tested eight at a time; a leaf's spheres and disks each by its own test.
+                alone.push(!matches!(shape, Shape::Mesh(_)));
             }
         }
         let start = std::time::Instant::now();
-        let bvh = Bvh::build(&bounds);
+        let bvh = Bvh::build_costed(&bounds, &alone);
         let prims = Primitives::new(&shapes, &refs, bvh.order());
         let bvh_seconds = start.elapsed().as_secs_f64();
         let environment = lights.iter().position(Light::is_environment).map(|i| i as u32);
