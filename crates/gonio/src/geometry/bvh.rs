@@ -175,8 +175,8 @@ impl Bvh {
     /// [`Self::build`] where the primitives `i` with `alone[i]` (missing entries are false) cost the SAH a
     /// test each rather than an eighth of one: shapes whose leaf test takes each of them in turn against
     /// the packet's rays (a sphere's test, bound by its divisions and square root), which the SAH should
-    /// then rather separate by nodes. 2026-12: the material spheres (five spheres) rendered about 4 %
-    /// faster with their spheres so costed than counted eight to a test.
+    /// then rather separate by nodes. 2026-12: the material spheres (five spheres) rendered about 2 %
+    /// faster with their spheres so costed than counted eight to a test (`docs/performance.md`).
     #[must_use]
     pub fn build_costed(bounds: &[Bounds3], alone: &[bool]) -> Bvh {
         debug_assert!(bounds.iter().all(|b| b.min.is_finite() && b.max.is_finite()), "primitive bounds must be finite");
