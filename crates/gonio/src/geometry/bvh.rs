@@ -710,6 +710,8 @@ fn sah_split(prims: &mut [BuildPrim], bounds: &Bounds3, cbounds: &Bounds3) -> Op
     let longest = cbounds.longest_axis();
     // (cost, axis, bin boundary)
     let mut best = (f32::INFINITY, 0, 0);
+    // The primitives tested alone, counted by the binning (every binned axis sees them all).
+    let mut all_alone = 0;
     // All three axes for small sets, where the better split is cheap to find; the longest one for large
     // sets, where binning three times would triple the build time (2026-11: 10⁶ triangles).
     let axes = if prims.len() <= ALL_AXES_BELOW { 0..3 } else { longest..longest + 1 };
@@ -727,6 +729,7 @@ fn sah_split(prims: &mut [BuildPrim], bounds: &Bounds3, cbounds: &Bounds3) -> Op
             alone[b] += usize::from(p.alone);
             bin_bounds[b] = bin_bounds[b].union(p.bounds);
         }
+        all_alone = alone.iter().sum();
         // Sweep from the right to get the area and count right of each boundary, then from the left.
         let mut right_area = [0.0f32; BINS];
         let (mut right_count, mut right_alone) = ([0usize; BINS], [0usize; BINS]);
@@ -748,9 +751,12 @@ fn sah_split(prims: &mut [BuildPrim], bounds: &Bounds3, cbounds: &Bounds3) -> Op
         }
     }
     let (cost, axis, boundary) = best;
-    let leaf_cost = tests(prims.len(), prims.iter().filter(|p| p.alone).count());
+    if boundary == 0 {
+        return None;
+    }
+    let leaf_cost = tests(prims.len(), all_alone);
     let split_cost = TRAVERSAL_COST + cost / bounds.surface_area().max(f32::MIN_POSITIVE);
-    if boundary == 0 || (split_cost >= leaf_cost && prims.len() <= MAX_LEAF) {
+    if split_cost >= leaf_cost && prims.len() <= MAX_LEAF {
         return None;
     }
     let (lo, hi) = (cbounds.min[axis], cbounds.max[axis]);

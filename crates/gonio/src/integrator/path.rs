@@ -229,7 +229,7 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
             let depth = p.depth[lane];
             let on_surface = hit.found & (1 << lane) != 0;
             let emits = if on_surface { scene.shape_lights[hit.shape[lane] as usize].is_some() } else { scene.environment.is_some() };
-            if emits && !(depth == 0 && hide_emitters) {
+            if emits && shown & (1 << lane) != 0 {
                 let prev = (depth > 0).then(|| BsdfSampled {
                     from: p.from.get(lane),
                     pdf: p.pdf[lane],
