@@ -33,6 +33,7 @@ use crate::light::Light;
 use crate::math::lanes::{Real, V3};
 use crate::math::simd::{Float8, Mask8};
 use crate::math::{Vec2, Vec3};
+use crate::sampling::warp::uniform_sphere;
 use crate::sampling::{Pcg32, Pcg32x8};
 use crate::scene::surfaces::Rows3;
 use crate::scene::Scene;
@@ -258,19 +259,39 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
             continue;
         }
 
-        // The materials: diffuse ones are evaluated in lanes, the others by their model.
-        let (mut rho_rows, mut diffuse) = (Rows3::default(), 0u32);
+        // The materials: diffuse ones are evaluated in lanes, the others by their model. The lanes on one
+        // shape share its material: a constant or checkerboard reflectance is found for them together,
+        // other materials lane by lane.
+        let (mut rho, mut rho_rows, mut diffuse, mut diffuse_rows) = ([Float8::splat(0.0); 3], Rows3::default(), 0u32, 0u32);
         let mut models: [Option<Cow<'_, Bsdf>>; W] = Default::default();
-        for lane in bits(p.live) {
-            let material = &scene.materials[hit.shape[lane] as usize];
-            let uv = Vec2::new(hit.uv[0][lane], hit.uv[1][lane]);
-            match material.diffuse_reflectance(uv) {
-                Some(rho) => {
-                    rho_rows.set_rgb(lane, rho);
-                    diffuse |= 1 << lane;
-                }
-                None => models[lane] = Some(material.at(uv)),
+        let (u, v) = (Float8::load(&hit.uv[0]), Float8::load(&hit.uv[1]));
+        let mut todo = p.live;
+        while todo != 0 {
+            let shape = hit.shape[todo.trailing_zeros() as usize];
+            let same = bits(todo).filter(|&lane| hit.shape[lane] == shape).fold(0u32, |m, lane| m | 1 << lane);
+            todo &= !same;
+            let material = &scene.materials[shape as usize];
+            if let Some(r) = material.diffuse_reflectance_lanes(u, v) {
+                let m = Mask8::from_bitmask(same);
+                rho = std::array::from_fn(|c| Float8::select(m, r[c], rho[c]));
+                diffuse |= same;
+                continue;
             }
+            for lane in bits(same) {
+                let uv = Vec2::new(hit.uv[0][lane], hit.uv[1][lane]);
+                match material.diffuse_reflectance(uv) {
+                    Some(r) => {
+                        rho_rows.set_rgb(lane, r);
+                        diffuse_rows |= 1 << lane;
+                    }
+                    None => models[lane] = Some(material.at(uv)),
+                }
+            }
+        }
+        if diffuse_rows != 0 {
+            let (m, r) = (Mask8::from_bitmask(diffuse_rows), load_rgb(&rho_rows));
+            rho = std::array::from_fn(|c| Float8::select(m, r[c], rho[c]));
+            diffuse |= diffuse_rows;
         }
         // Lanes that share a model with a lane kernel (GGX `roughconductor` and `roughplastic`), at least
         // two, run it in lanes; the other models run per lane.
@@ -293,7 +314,6 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
         let (fs, ft, fn_) = (hit.s.lanes(), hit.t.lanes(), hit.ns.lanes());
         let wo = to_local(fs, ft, fn_, p.d.lanes().neg());
         let wo_rows = Rows3::from_lanes(wo);
-        let rho = load_rgb(&rho_rows);
         let mut beta = load_rgb(&p.beta);
 
         // Next-event estimation (on lanes whose model has a smooth component): a light chosen uniformly and
@@ -306,7 +326,9 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
             // the point on it in lanes; other lights sample in full per lane.
             let (mut wi, mut li, mut light_pdf) = (Rows3::default(), Rows3::default(), [0.0f32; W]);
             let (mut tri, mut tri_n, mut pdf_area) = ([Rows3::default(); 3], Rows3::default(), Float8::splat(0.0));
-            let (mut sampled, mut on_mesh, mut delta) = (0u32, 0u32, 0u32);
+            let (mut sampled, mut on_mesh, mut on_sky, mut delta) = (0u32, 0u32, 0u32, 0u32);
+            // The density of a constant environment's samples (uniform: the same for every direction).
+            let mut sky_pdf = 0.0;
             let mut shadow = RayRows::default();
             let u_light = p.rng.next_f32(smooth);
             let (u_c, u_x, u_y) = (p.rng.next_f32(smooth), p.rng.next_f32(smooth), p.rng.next_f32(smooth));
@@ -314,17 +336,26 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
             let chosen_lanes = (u_light * n_lights as f32).trunc().min(Float8::splat((n_lights - 1) as f32));
             let chosen = chosen_lanes.to_array();
             // Small flat meshes (a `rectangle` light, say): the triangles of the lanes that chose the same
-            // light, chosen and loaded in lanes.
+            // light, chosen and loaded in lanes. A constant environment: its radiance.
             let mut rest = smooth;
             let mut todo = smooth;
             while todo != 0 {
                 let index = chosen[todo.trailing_zeros() as usize];
                 let same = todo & chosen_lanes.eq(Float8::splat(index)).bitmask();
                 todo &= !same;
+                let m = Mask8::from_bitmask(same);
+                if let Light::Constant(constant) = &scene.lights[index as usize] {
+                    if !constant.radiance.is_black() {
+                        li.store(V3::select(m, V3::splat(Vec3::from_array(constant.radiance.0)), li.lanes()));
+                        on_sky |= same;
+                        sky_pdf = constant.pdf_li(Vec3::Z);
+                    }
+                    rest &= !same;
+                    continue;
+                }
                 let (Light::Area(area), Some(tris)) = (&scene.lights[index as usize], &scene.light_triangles[index as usize]) else {
                     continue;
                 };
-                let m = Mask8::from_bitmask(same);
                 let (vertices, n) = tris.sample(u_c);
                 for (rows, v) in tri.iter_mut().zip(vertices) {
                     rows.store(V3::select(m, v, rows.lanes()));
@@ -367,9 +398,19 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
                 shadow.set(lane, &ls.shadow);
                 sampled |= 1 << lane;
             }
+            let (sp, sn) = (hit.p.lanes(), hit.n.lanes());
+            if on_sky != 0 {
+                // `ConstantLight::sample_li` in lanes (the surfaces' normals are never zero).
+                let m = Mask8::from_bitmask(on_sky);
+                let dir = uniform_sphere(u_x, u_y);
+                let ray = RayLanes { o: offset_origin_lanes(sp, sn, dir), d: dir, tmax: Float8::splat(f32::INFINITY) };
+                wi.store(V3::select(m, dir, wi.lanes()));
+                light_pdf = Float8::select(m, Float8::splat(sky_pdf), Float8::load(&light_pdf)).to_array();
+                shadow.merge(m, &ray);
+                sampled |= on_sky;
+            }
             if on_mesh != 0 {
                 // `AreaLight::sample_li` on a flat mesh, in lanes.
-                let (sp, sn) = (hit.p.lanes(), hit.n.lanes());
                 let q = uniform_triangle_point(tri[0].lanes(), tri[1].lanes(), tri[2].lanes(), u_x, u_y);
                 let ng = tri_n.lanes();
                 let (pdf, by_area) = solid_angle_density(sp, q, ng, pdf_area);

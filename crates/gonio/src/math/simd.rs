@@ -377,6 +377,15 @@ impl Float8 {
         self.to_array()[i]
     }
 
+    /// `f32::floor` per lane, from [`Float8::trunc`]: a lane whose truncation lies above it (a negative
+    /// non-integer) is one less. Exact: both are integers below 2²³ in magnitude there.
+    #[inline(always)]
+    #[must_use]
+    pub fn floor(self) -> Self {
+        let t = self.trunc();
+        t - Float8::select(t.gt(self), Float8::splat(1.0), Float8::splat(0.0))
+    }
+
     /// These lanes with lane `lane` set to `v`, in registers (see the module doc on store-to-load
     /// forwarding).
     #[inline(always)]
@@ -673,6 +682,25 @@ mod tests {
             let r = Real::round(Float8::load(&v));
             for (i, x) in v.iter().enumerate() {
                 assert_eq!(r.lane(i).to_bits(), x.round().to_bits(), "{x}");
+            }
+        }
+    }
+
+    /// `floor` is `f32::floor` (signed zeros, infinities and NaN kept) across magnitudes.
+    #[test]
+    fn floor_matches_std() {
+        let mut rng = crate::sampling::Pcg32::new(4, 5);
+        for k in 0..2000 {
+            let scale = [0.5f32, 3.0, 1e3, 1e7, 3e8][k % 5];
+            let v: [f32; 8] = std::array::from_fn(|_| (rng.next_f32() * 2.0 - 1.0) * scale);
+            let v = match k {
+                0 => [0.5, -0.5, -1.0, -0.0, 0.0, -0.99999994, -8_388_609.0, f32::NEG_INFINITY],
+                1 => [f32::INFINITY, f32::NAN, -f32::MIN_POSITIVE, 1e-40, -1e-40, 2.0, -3.5, f32::MAX],
+                _ => v,
+            };
+            let r = Float8::load(&v).floor();
+            for (i, x) in v.iter().enumerate() {
+                assert!(r.lane(i).to_bits() == x.floor().to_bits() || (x.is_nan() && r.lane(i).is_nan()), "{x}");
             }
         }
     }

@@ -4,6 +4,7 @@
 //! Composition follows Mitsuba's scene format: each operation inside `<transform>` *left*-multiplies the
 //! matrix accumulated so far, so `<scale/><rotate/><translate/>` means `T · R · S` (scale first).
 
+use super::lanes::{Real, V3};
 use glam::{Mat4, Vec3, Vec4};
 
 /// A 4×4 affine transform with its inverse.
@@ -95,6 +96,20 @@ impl Transform {
         }
     }
 
+    /// [`Self::point`] in lanes ([`Real`]), by the same operations: glam's column order
+    /// ((c₀x + c₁y) + c₂z) + c₃·1 per coordinate, and the division by w unless w is 1.
+    #[inline(always)]
+    #[must_use]
+    pub fn point_lanes<R: Real>(&self, p: V3<R>) -> V3<R> {
+        let m = &self.matrix;
+        let row = |i: usize| {
+            let c = |axis: Vec4| R::splat(axis[i]);
+            c(m.x_axis) * p.x + c(m.y_axis) * p.y + c(m.z_axis) * p.z + c(m.w_axis) * R::splat(1.0)
+        };
+        let (q, w) = (V3::new(row(0), row(1), row(2)), row(3));
+        V3::select(w.eq(R::splat(1.0)), q, q.div(w))
+    }
+
     #[inline]
     #[must_use]
     pub fn vector(&self, v: Vec3) -> Vec3 {
@@ -118,6 +133,32 @@ impl Transform {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::math::simd::Float8;
+
+    /// `point_lanes` computes `point`'s numbers bit for bit, on one `f32` and in eight lanes, for random
+    /// affine and projective matrices and points.
+    #[test]
+    fn points_in_lanes_match() {
+        let mut rng = crate::sampling::Pcg32::new(11, 2);
+        let mut r = || rng.next_f32() * 6.0 - 3.0;
+        for k in 0..200 {
+            let mut rows: [f64; 16] = std::array::from_fn(|_| f64::from(r()));
+            if k % 2 == 0 {
+                rows[12..].copy_from_slice(&[0.0, 0.0, 0.0, 1.0]);
+            }
+            let Some(t) = Transform::from_rows(&rows) else { continue };
+            let points: [Vec3; 8] = std::array::from_fn(|_| Vec3::new(r(), r(), r()));
+            let lanes = V3::new(Float8::from_fn(|i| points[i].x), Float8::from_fn(|i| points[i].y), Float8::from_fn(|i| points[i].z));
+            let got = t.point_lanes(lanes);
+            for (i, p) in points.iter().enumerate() {
+                let want = t.point(*p);
+                let one: Vec3 = t.point_lanes(V3::<f32>::from(*p)).into();
+                let lane = Vec3::new(got.x.lane(i), got.y.lane(i), got.z.lane(i));
+                assert_eq!(one.to_array().map(f32::to_bits), want.to_array().map(f32::to_bits), "{p} by {t:?}");
+                assert_eq!(lane.to_array().map(f32::to_bits), want.to_array().map(f32::to_bits), "{p} by {t:?}");
+            }
+        }
+    }
 
     #[test]
     fn composition_order_is_scale_then_rotate_then_translate() {

@@ -6,7 +6,7 @@
 //! three together.
 
 use crate::math::lanes::{Real, V3};
-use crate::math::trig::sin_cos_quarter;
+use crate::math::trig::{sin_cos_quarter, sin_cos_turn};
 use crate::math::{Vec2, Vec3};
 use std::f32::consts::{FRAC_1_PI, FRAC_PI_2, FRAC_PI_4, PI};
 
@@ -142,10 +142,19 @@ pub fn invert_uniform_hemisphere_sample(w: Vec3) -> Vec2 {
 #[inline]
 #[must_use]
 pub fn sample_uniform_sphere(u: Vec2) -> Vec3 {
-    let z = 1.0 - 2.0 * u.x;
-    let r = (1.0 - z * z).max(0.0).sqrt();
-    let phi = 2.0 * PI * u.y;
-    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+    uniform_sphere(u.x, u.y).into()
+}
+
+/// [`sample_uniform_sphere`] in lanes ([`Real`]): the direction for `(ux, uy)`, with φ's sine and cosine
+/// from [`sin_cos_turn`] so that one `f32` and the lanes compute the same numbers.
+#[inline(always)]
+#[must_use]
+pub fn uniform_sphere<R: Real>(ux: R, uy: R) -> V3<R> {
+    let one = R::splat(1.0);
+    let z = one - ux * 2.0;
+    let r = (one - z * z).max(R::splat(0.0)).sqrt();
+    let (sin_phi, cos_phi) = sin_cos_turn(uy);
+    V3::new(r * cos_phi, r * sin_phi, z)
 }
 
 /// Density of [`sample_uniform_sphere`]: 1/(4π).
@@ -345,6 +354,20 @@ mod tests {
     fn uniform_hemisphere_and_sphere_round_trip() {
         round_trip_z_phi(sample_uniform_hemisphere, invert_uniform_hemisphere_sample, "hemisphere");
         round_trip_z_phi(sample_uniform_sphere, invert_uniform_sphere_sample, "sphere");
+    }
+
+    /// The lanes of [`uniform_sphere`] are [`sample_uniform_sphere`]'s directions bit for bit (the path
+    /// tracer samples a constant environment in lanes, a single path with the scalar form).
+    #[test]
+    fn uniform_sphere_lanes_match() {
+        for chunk in square_points().chunks(8) {
+            let u = |i: usize| chunk.get(i).copied().unwrap_or(Vec2::ZERO);
+            let w = uniform_sphere(crate::math::simd::Float8::from_fn(|i| u(i).x), crate::math::simd::Float8::from_fn(|i| u(i).y));
+            for i in 0..chunk.len() {
+                let want = sample_uniform_sphere(u(i)).to_array().map(f32::to_bits);
+                assert_eq!([w.x.lane(i), w.y.lane(i), w.z.lane(i)].map(f32::to_bits), want, "u = {}", u(i));
+            }
+        }
     }
 
     #[test]

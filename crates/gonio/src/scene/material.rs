@@ -3,6 +3,7 @@
 
 use crate::bsdf::{Bsdf, Diffuse};
 use crate::error::Result;
+use crate::math::simd::Float8;
 use crate::props::{Props, Value};
 use crate::texture::Texture;
 use glam::Vec2;
@@ -93,7 +94,13 @@ impl Material {
     /// A textured `diffuse`'s reflectance at `uv`: the texture's value clamped to [0, 1].
     #[inline]
     fn texel(t: &Texture, uv: Vec2) -> crate::spectrum::Rgb {
-        t.eval(uv).map(|v| v.clamp(0.0, 1.0))
+        Self::clamped(t.eval(uv))
+    }
+
+    /// A texture value as a reflectance: clamped to [0, 1].
+    #[inline]
+    fn clamped(c: crate::spectrum::Rgb) -> crate::spectrum::Rgb {
+        c.map(|v| v.clamp(0.0, 1.0))
     }
 
     /// For a `diffuse` material (textured or not), its reflectance at `uv` — what [`Self::at`] would build a
@@ -104,6 +111,23 @@ impl Material {
         match self {
             Material::Fixed(Bsdf::Diffuse(d)) => Some(d.reflectance),
             Material::TexturedDiffuse(t) => Some(Self::texel(t, uv)),
+            _ => None,
+        }
+    }
+
+    /// [`Self::diffuse_reflectance`] in lanes, at texture coordinates (`u`, `v`), where it needs no lookup
+    /// per lane: a constant `diffuse`'s reflectance or a checkerboard's. `None` for other materials (and
+    /// for bitmaps, read per lane).
+    #[inline]
+    #[must_use]
+    pub fn diffuse_reflectance_lanes(&self, u: Float8, v: Float8) -> Option<[Float8; 3]> {
+        match self {
+            Material::Fixed(Bsdf::Diffuse(d)) => Some(d.reflectance.0.map(Float8::splat)),
+            Material::TexturedDiffuse(Texture::Checkerboard(c)) => {
+                let first = c.same_side_lanes(u, v);
+                let (c0, c1) = (Self::clamped(c.color0), Self::clamped(c.color1));
+                Some(std::array::from_fn(|i| Float8::select(first, Float8::splat(c0.0[i]), Float8::splat(c1.0[i]))))
+            }
             _ => None,
         }
     }

@@ -7,6 +7,8 @@
 //! | `to_uv`   | transform | identity | applied to (u, v, 0) before the lookup   |
 
 use crate::error::Result;
+use crate::math::lanes::V3;
+use crate::math::simd::{Float8, Mask8};
 use crate::math::Transform;
 use crate::props::Props;
 use crate::spectrum::Rgb;
@@ -33,6 +35,17 @@ impl Checkerboard {
     fn same_side(&self, uv: Vec2) -> bool {
         let q = self.to_uv.point(Vec3::new(uv.x, uv.y, 0.0));
         (q.x - q.x.floor() > 0.5) == (q.y - q.y.floor() > 0.5)
+    }
+
+    /// [`Self::same_side`] in lanes, by the same operations: the lanes whose (u, v) falls in a `color0`
+    /// square of the colour lookup.
+    #[inline(always)]
+    #[must_use]
+    pub fn same_side_lanes(&self, u: Float8, v: Float8) -> Mask8 {
+        let q = self.to_uv.point_lanes(V3::new(u, v, Float8::splat(0.0)));
+        let upper = |x: Float8| (x - x.floor()).gt(Float8::splat(0.5));
+        let (a, b) = (upper(q.x), upper(q.y));
+        (a & b) | !(a | b)
     }
 
     #[inline]
@@ -76,5 +89,30 @@ mod tests {
         let m = Checkerboard { color0: Rgb::splat(0.05), color1: Rgb::splat(0.3), to_uv: Transform::IDENTITY };
         assert_eq!((m.eval(Vec2::new(0.1, 0.1)).r(), m.eval_1(Vec2::new(0.1, 0.1))), (0.05, 0.3));
         assert_eq!((m.eval(Vec2::new(0.7, 0.1)).r(), m.eval_1(Vec2::new(0.7, 0.1))), (0.3, 0.05));
+    }
+
+    /// The lanes pick the square [`Checkerboard::eval`] picks, for scaled, rotated, shifted and projective
+    /// `to_uv` transforms, at random points (negative ones included), on square edges and at ±0, ±∞, NaN.
+    #[test]
+    fn lanes_pick_the_same_squares() {
+        let rotate = Transform::rotate(Vec3::Z, 30.0).unwrap();
+        let shift = Transform::translate(Vec3::new(-0.25, 3.5, 0.0));
+        let mut projective = Transform::IDENTITY;
+        projective.matrix.x_axis.w = 0.3;
+        projective.matrix.w_axis.w = 1.7;
+        let special = [0.0, -0.0, 0.5, -0.5, 1.0, -1.0, 2.5, 1e8, -1e8, f32::INFINITY, f32::NEG_INFINITY, f32::NAN];
+        let mut rng = crate::sampling::Pcg32::new(5, 1);
+        for to_uv in [Transform::IDENTITY, Transform::scale(Vec3::new(20.0, 7.0, 1.0)).unwrap(), rotate, shift, projective] {
+            let c = Checkerboard { color0: Rgb::ONE, color1: Rgb::ZERO, to_uv };
+            let mut points: Vec<Vec2> = special.iter().flat_map(|&u| special.iter().map(move |&v| Vec2::new(u, v))).collect();
+            points.extend((0..2000).map(|_| Vec2::new(rng.next_f32() * 8.0 - 4.0, rng.next_f32() * 8.0 - 4.0)));
+            for chunk in points.chunks(8) {
+                let uv = |i: usize| chunk.get(i).copied().unwrap_or(Vec2::ZERO);
+                let got = c.same_side_lanes(Float8::from_fn(|i| uv(i).x), Float8::from_fn(|i| uv(i).y));
+                for i in 0..chunk.len() {
+                    assert_eq!(got.lane(i), c.same_side(uv(i)), "uv {} with {:?}", uv(i), c.to_uv);
+                }
+            }
+        }
     }
 }
