@@ -309,7 +309,8 @@ impl MicrofacetDistribution {
         if !self.samples_visible(visible) {
             return self.sample_d_cos(u);
         }
-        debug_assert!(wo.z > 0.0, "visible normals are sampled for directions above the surface");
+        // NaN passes (and gives NaN): the checked batches feed bad rows through before rejecting them.
+        debug_assert!(!(wo.z <= 0.0), "visible normals are sampled for directions above the surface");
         match self.kind {
             MicrofacetKind::Ggx => self.ggx().sample_visible(wo.into(), u.x, u.y).into(),
             _ => self.sample_visible_beckmann(wo, u),
@@ -563,7 +564,7 @@ impl Ggx {
 /// Λ(a) = (erf(a) − 1)/2 + exp(−a²)/(2a√π) = (exp(−a²)/(a√π) − erfc(a))/2.
 #[must_use]
 pub fn beckmann_lambda(a: f64) -> f64 {
-    debug_assert!(a >= 0.0);
+    debug_assert!(!(a < 0.0), "Λ needs a ≥ 0 (NaN gives NaN)");
     if a == 0.0 {
         return f64::INFINITY;
     }
@@ -579,7 +580,7 @@ pub fn beckmann_lambda(a: f64) -> f64 {
 /// √π·exp(x²)·erfc(x) for x ≥ 3 by the continued fraction of Abramowitz & Stegun 7.1.14:
 /// 1/(x + (1/2)/(x + 1/(x + (3/2)/(x + …)))). 60 terms reach f64 precision for x ≥ 3.
 fn erfcx_cf(x: f64) -> f64 {
-    debug_assert!(x >= 3.0);
+    debug_assert!(!(x < 3.0), "the continued fraction needs x ≥ 3 (NaN gives NaN)");
     let mut t = x;
     for k in (1..=60).rev() {
         t = x + (k as f64 * 0.5) / t;

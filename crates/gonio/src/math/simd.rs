@@ -622,8 +622,14 @@ mod tests {
     const A: [f32; 8] = [0.5, -1.5, 0.0, -0.0, f32::INFINITY, f32::NAN, 3.0e-39, -2.5];
     const B: [f32; 8] = [2.0, -1.5, -0.0, 1.0, 1.0, 0.5, -7.0, f32::NAN];
 
+    /// Bit for bit, except that a NaN result may be any NaN: IEEE 754 leaves the sign and payload of the
+    /// NaN of an invalid operation open, and builds differ (2026-12: in the unoptimised test build the
+    /// lanes' 0 / −0 gave 0x7fc00000, the scalar division x86's default NaN 0xffc00000).
     fn same(l: Float8, f: &dyn Fn(f32, f32) -> f32) -> bool {
-        (0..8).all(|i| l.lane(i).to_bits() == f(A[i], B[i]).to_bits())
+        (0..8).all(|i| {
+            let (got, want) = (l.lane(i), f(A[i], B[i]));
+            got.to_bits() == want.to_bits() || (got.is_nan() && want.is_nan())
+        })
     }
 
     fn mask(m: Mask8, f: &dyn Fn(f32, f32) -> bool) -> bool {
