@@ -226,21 +226,18 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
             let w = Float8::select(unweighted, Float8::splat(1.0), power_heuristic_1(Float8::load(&p.pdf), light_pdf));
             sky_le = constant.radiance.0.map(|c| w * c);
         }
-        for lane in bits(p.live & !sky) {
-            let depth = p.depth[lane];
-            let on_surface = hit.found & (1 << lane) != 0;
-            let emits = if on_surface { scene.shape_lights[hit.shape[lane] as usize].is_some() } else { scene.environment.is_some() };
-            if emits && shown & (1 << lane) != 0 {
-                let prev = (depth > 0).then(|| BsdfSampled {
-                    from: p.from.get(lane),
-                    pdf: p.pdf[lane],
-                    delta: p.delta & (1 << lane) != 0,
-                    n_bsdf: 1.0,
-                    n_light: 1.0,
-                });
-                let si = on_surface.then(|| hit.interaction(lane, t[lane]));
-                le.set_rgb(lane, emitter_hit(scene, &p.ray(lane), si.as_ref(), prev.as_ref()));
-            }
+        // Other emitters seen, lane by lane: emitting surfaces, and an environment map.
+        let escaped = if scene.environment.is_some() { p.live & !hit.found & !sky } else { 0 };
+        for lane in bits(shown & (hit.emits | escaped)) {
+            let prev = (first & (1 << lane) == 0).then(|| BsdfSampled {
+                from: p.from.get(lane),
+                pdf: p.pdf[lane],
+                delta: p.delta & (1 << lane) != 0,
+                n_bsdf: 1.0,
+                n_light: 1.0,
+            });
+            let si = (hit.found & (1 << lane) != 0).then(|| hit.interaction(lane, t[lane]));
+            le.set_rgb(lane, emitter_hit(scene, &p.ray(lane), si.as_ref(), prev.as_ref()));
         }
         let le = load_rgb(&le);
         let le: [Float8; 3] = std::array::from_fn(|c| Float8::select(Mask8::from_bitmask(sky), sky_le[c], le[c]));

@@ -72,6 +72,8 @@ impl Rows3 {
 pub struct Surfaces8 {
     /// Lanes whose ray hit a surface.
     pub found: u32,
+    /// Lanes whose surface is an emitter's (an area light's shape).
+    pub emits: u32,
     /// The point hit.
     pub p: Rows3,
     /// Geometric normal (unit, the shape's outward side).
@@ -131,6 +133,7 @@ impl Scene {
             out.found |= 1 << lane;
             let r = self.prims.slots[slot as usize];
             (out.shape[lane], out.prim[lane]) = (r.shape, r.prim);
+            out.emits |= u32::from(self.shape_lights[r.shape as usize].is_some()) << lane;
             let textured = self.textured[r.shape as usize];
             let shape = &self.shapes[r.shape as usize];
             if let Shape::Mesh(mesh) = shape {
@@ -202,12 +205,14 @@ mod tests {
     use std::path::Path;
 
     /// Rectangles (flat, with texture coordinates), a cube, a face-normal mesh without texture coordinates
-    /// (a disk is not a mesh: tested again) and spheres, one of each material kind the lanes treat apart.
+    /// (a disk is not a mesh: tested again) and spheres, one of each material kind the lanes treat apart; the
+    /// cube emits.
     const SCENE: &str = r#"<scene version="3.0.0">
         <sensor type="perspective"><film type="hdrfilm"><integer name="width" value="4"/><integer name="height" value="4"/></film></sensor>
         <shape type="rectangle"><transform name="to_world"><rotate x="1" angle="-90"/><scale value="3"/><translate y="-1"/></transform>
             <bsdf type="diffuse"><texture type="checkerboard" name="reflectance"/></bsdf></shape>
-        <shape type="cube"><transform name="to_world"><scale value="0.4"/><rotate y="1" angle="30"/><translate x="0.8"/></transform></shape>
+        <shape type="cube"><transform name="to_world"><scale value="0.4"/><rotate y="1" angle="30"/><translate x="0.8"/></transform>
+            <emitter type="area"><rgb name="radiance" value="1"/></emitter></shape>
         <shape type="sphere"><point name="center" x="-0.8" y="0" z="0"/><float name="radius" value="0.5"/>
             <bsdf type="diffuse"><texture type="checkerboard" name="reflectance"/></bsdf></shape>
         <shape type="sphere"><point name="center" x="0" y="0.9" z="-0.5"/><float name="radius" value="0.3"/><boolean name="flip_normals" value="true"/></shape>
@@ -220,7 +225,7 @@ mod tests {
     fn lanes_match_single_rays() {
         let scene = Scene::build(mitsuba_xml::load_str(SCENE, "t.xml", Path::new("."), &[]).unwrap()).unwrap();
         let mut rng = Pcg32::new(3, 9);
-        let (mut flat, mut other) = (0, 0);
+        let (mut flat, mut other, mut emitting) = (0, 0, 0);
         for _ in 0..200 {
             let mut rays = [Ray::new(Vec3::ZERO, Vec3::Z, f32::INFINITY); LANES];
             for r in &mut rays {
@@ -242,12 +247,14 @@ mod tests {
                 let Some(want) = want else { continue };
                 let got = s.interaction(lane, want.t);
                 assert_eq!(got, want, "lane {lane}");
+                assert_eq!(s.emits & (1 << lane) != 0, scene.shape_lights[want.shape as usize].is_some(), "lane {lane}");
+                emitting += usize::from(s.emits & (1 << lane) != 0);
                 match scene.shapes[want.shape as usize] {
                     Shape::Mesh(_) => flat += 1,
                     _ => other += 1,
                 }
             }
         }
-        assert!(flat > 300 && other > 100, "{flat} mesh and {other} other hits");
+        assert!(flat > 300 && other > 100 && emitting > 20, "{flat} mesh, {other} other and {emitting} emitter hits");
     }
 }
