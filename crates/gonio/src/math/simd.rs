@@ -677,37 +677,34 @@ mod tests {
         }
     }
 
-    /// `round` is `f32::round` (halves away from zero, signed zeros kept) across magnitudes.
-    #[test]
-    fn round_matches_std() {
+    /// `lanes` computes `one` in each lane, bit for bit (any NaN for a NaN), on the special values of
+    /// `first` and on random numbers across magnitudes.
+    fn matches_across_magnitudes(first: &[[f32; 8]], lanes: impl Fn(Float8) -> Float8, one: impl Fn(f32) -> f32) {
         let mut rng = crate::sampling::Pcg32::new(4, 4);
         for k in 0..2000 {
             let scale = [0.5f32, 3.0, 1e3, 1e7, 3e8][k % 5];
-            let v: [f32; 8] = std::array::from_fn(|_| (rng.next_f32() * 2.0 - 1.0) * scale);
-            let v = if k == 0 { [0.5, -0.5, 1.5, -2.5, -0.3, 0.49999997, 8_388_609.0, -0.0] } else { v };
-            let r = Real::round(Float8::load(&v));
-            for (i, x) in v.iter().enumerate() {
-                assert_eq!(r.lane(i).to_bits(), x.round().to_bits(), "{x}");
+            let v: [f32; 8] = first.get(k).copied().unwrap_or_else(|| std::array::from_fn(|_| (rng.next_f32() * 2.0 - 1.0) * scale));
+            let r = lanes(Float8::load(&v));
+            for (i, &x) in v.iter().enumerate() {
+                assert!(r.lane(i).to_bits() == one(x).to_bits() || (one(x).is_nan() && r.lane(i).is_nan()), "{x}");
             }
         }
     }
 
-    /// `floor` is `f32::floor` (signed zeros, infinities and NaN kept) across magnitudes.
+    /// `round` is `f32::round` (halves away from zero, signed zeros kept).
+    #[test]
+    fn round_matches_std() {
+        let first = [[0.5, -0.5, 1.5, -2.5, -0.3, 0.49999997, 8_388_609.0, -0.0]];
+        matches_across_magnitudes(&first, Real::round, f32::round);
+    }
+
+    /// `floor` is `f32::floor` (signed zeros, infinities and NaN kept).
     #[test]
     fn floor_matches_std() {
-        let mut rng = crate::sampling::Pcg32::new(4, 5);
-        for k in 0..2000 {
-            let scale = [0.5f32, 3.0, 1e3, 1e7, 3e8][k % 5];
-            let v: [f32; 8] = std::array::from_fn(|_| (rng.next_f32() * 2.0 - 1.0) * scale);
-            let v = match k {
-                0 => [0.5, -0.5, -1.0, -0.0, 0.0, -0.99999994, -8_388_609.0, f32::NEG_INFINITY],
-                1 => [f32::INFINITY, f32::NAN, -f32::MIN_POSITIVE, 1e-40, -1e-40, 2.0, -3.5, f32::MAX],
-                _ => v,
-            };
-            let r = Float8::load(&v).floor();
-            for (i, x) in v.iter().enumerate() {
-                assert!(r.lane(i).to_bits() == x.floor().to_bits() || (x.is_nan() && r.lane(i).is_nan()), "{x}");
-            }
-        }
+        let first = [
+            [0.5, -0.5, -1.0, -0.0, 0.0, -0.99999994, -8_388_609.0, f32::NEG_INFINITY],
+            [f32::INFINITY, f32::NAN, -f32::MIN_POSITIVE, 1e-40, -1e-40, 2.0, -3.5, f32::MAX],
+        ];
+        matches_across_magnitudes(&first, Float8::floor, f32::floor);
     }
 }
