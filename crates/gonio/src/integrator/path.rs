@@ -257,15 +257,17 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
         }
 
         // The materials: diffuse ones are evaluated in lanes, the others by their model. The lanes on one
-        // shape share its material: a constant or checkerboard reflectance is found for them together,
-        // other materials lane by lane.
+        // shape, or on shapes of one constant reflectance (`Scene::material_class`), share their material:
+        // a constant or checkerboard reflectance is found for them together, other materials lane by lane.
         let (mut rho, mut rho_rows, mut diffuse, mut diffuse_rows) = ([Float8::splat(0.0); 3], Rows3::default(), 0u32, 0u32);
         let mut models: [Option<Cow<'_, Bsdf>>; W] = Default::default();
         let (u, v) = (Float8::load(&hit.uv[0]), Float8::load(&hit.uv[1]));
         let mut todo = p.live;
         while todo != 0 {
             let shape = hit.shape[todo.trailing_zeros() as usize];
-            let same = bits(todo).filter(|&lane| hit.shape[lane] == shape).fold(0u32, |m, lane| m | 1 << lane);
+            let class = scene.material_class[shape as usize];
+            let same =
+                bits(todo).filter(|&lane| scene.material_class[hit.shape[lane] as usize] == class).fold(0u32, |m, lane| m | 1 << lane);
             todo &= !same;
             let material = &scene.materials[shape as usize];
             if let Some(r) = material.diffuse_reflectance_lanes(u, v) {

@@ -68,6 +68,10 @@ pub struct Scene {
     pub bvh_seconds: f64,
     /// Whether each shape's material reads textures (only then are texture coordinates computed at hits).
     textured: Vec<bool>,
+    /// Per shape, the first shape with the same constant `diffuse` reflectance (shapes that share a
+    /// `<ref>`'d `bsdf`, or equal ones), else the shape itself: the path tracer finds the reflectance of
+    /// the lanes of one class together.
+    pub material_class: Vec<u32>,
     bvh: Bvh,
     /// The primitives in BVH leaf order.
     prims: Primitives,
@@ -370,6 +374,13 @@ impl Scene {
         let bvh_seconds = start.elapsed().as_secs_f64();
         let environment = lights.iter().position(Light::is_environment).map(|i| i as u32);
         let textured = (0..shapes.len()).map(|s| materials.get(s).is_some_and(Material::is_textured)).collect();
+        let mut first_with = std::collections::HashMap::new();
+        let material_class = (0..shapes.len() as u32)
+            .map(|s| match materials.get(s as usize) {
+                Some(Material::Fixed(crate::bsdf::Bsdf::Diffuse(d))) => *first_with.entry(d.reflectance.0.map(f32::to_bits)).or_insert(s),
+                _ => s,
+            })
+            .collect();
         let light_triangles = lights
             .iter()
             .map(|light| match light {
@@ -394,6 +405,7 @@ impl Scene {
             warnings,
             bvh_seconds,
             textured,
+            material_class,
             bvh,
             prims,
         }

@@ -219,6 +219,25 @@ mod tests {
         <shape type="disk"><transform name="to_world"><translate z="-1.5"/></transform></shape>
     </scene>"#;
 
+    /// Shapes with the same constant `diffuse` reflectance (through a `<ref>` or equal values) share a
+    /// material class; textured, other and differently coloured materials have their own.
+    #[test]
+    fn equal_diffuse_materials_share_a_class() {
+        const CLASSES: &str = r#"<scene version="3.0.0">
+            <sensor type="perspective"><film type="hdrfilm"><integer name="width" value="4"/><integer name="height" value="4"/></film></sensor>
+            <bsdf type="diffuse" id="white"><rgb name="reflectance" value="0.8, 0.7, 0.6"/></bsdf>
+            <shape type="rectangle"><ref id="white"/></shape>
+            <shape type="sphere"><bsdf type="diffuse"><rgb name="reflectance" value="0.5"/></bsdf></shape>
+            <shape type="rectangle"><ref id="white"/></shape>
+            <shape type="cube"><bsdf type="diffuse"><rgb name="reflectance" value="0.8, 0.7, 0.6"/></bsdf></shape>
+            <shape type="rectangle"><bsdf type="diffuse"><texture type="checkerboard" name="reflectance"/></bsdf></shape>
+            <shape type="rectangle"><bsdf type="conductor"/></shape>
+            <shape type="disk"><bsdf type="conductor"/></shape>
+        </scene>"#;
+        let scene = Scene::build(mitsuba_xml::load_str(CLASSES, "t.xml", Path::new("."), &[]).unwrap()).unwrap();
+        assert_eq!(scene.material_class, [0, 1, 0, 0, 4, 5, 6]);
+    }
+
     /// Each lane of [`Scene::surfaces`] is the interaction [`Scene::intersect`] finds for its ray alone: the
     /// same shape, primitive, point, normals, frame and texture coordinates, bit for bit.
     #[test]
