@@ -495,6 +495,20 @@ pub fn bits(mut m: u32) -> impl Iterator<Item = usize> {
     })
 }
 
+/// The set lanes of `m` in groups, lowest lane first: that lane and the mask of its group (`group(lane)`,
+/// kept to the lanes not yet grouped; the lane itself always belongs), until every lane is in one.
+#[inline(always)]
+pub fn groups(mut m: u32, mut group: impl FnMut(usize) -> u32) -> impl Iterator<Item = (usize, u32)> {
+    std::iter::from_fn(move || {
+        (m != 0).then(|| {
+            let lane = m.trailing_zeros() as usize;
+            let same = (group(lane) & m) | 1 << lane;
+            m &= !same;
+            (lane, same)
+        })
+    })
+}
+
 /// The rays of a packet one by one.
 #[inline(always)]
 #[must_use]
@@ -830,6 +844,17 @@ mod tests {
 
     /// Eight well separated boxes: as packed primitives one leaf holds them all (a single test costs less
     /// than a node), as primitives tested alone each gets a leaf of its own.
+    /// `groups` puts every set lane in exactly one group, lowest lane first, within the lanes left.
+    #[test]
+    fn lanes_fall_into_groups() {
+        let key = [3, 1, 3, 7, 1, 3, 9, 9];
+        let same = |l: usize| (0..8).filter(|&k| key[k] == key[l]).fold(0, |m, k| m | 1 << k);
+        let got: Vec<(usize, u32)> = groups(0b1111_0111, same).collect();
+        assert_eq!(got, [(0, 0b0010_0101), (1, 0b0001_0010), (6, 0b1100_0000)]);
+        // A group that leaves its own lane out still holds it.
+        assert_eq!(groups(0b101, |_| 0).collect::<Vec<_>>(), [(0, 0b001), (2, 0b100)]);
+    }
+
     #[test]
     fn primitives_tested_alone_get_their_own_leaves() {
         let boxes: Vec<Bounds3> = (0..8)

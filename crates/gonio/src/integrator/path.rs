@@ -23,7 +23,7 @@ use super::{emitter_hit, start, BsdfSampled, CameraSample};
 use crate::bsdf::diffuse::{diffuse_f, diffuse_pdf, diffuse_sample};
 use crate::bsdf::lanes::{LaneKernel, LaneModel};
 use crate::bsdf::{Bsdf, BsdfFlags, BsdfModel};
-use crate::geometry::bvh::bits;
+use crate::geometry::bvh::{bits, groups};
 use crate::geometry::mesh::uniform_triangle_point;
 use crate::geometry::ray::{offset_origin_lanes, spawn_ray_to_lanes, RayLanes};
 use crate::geometry::shape::solid_angle_density;
@@ -262,14 +262,10 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
         let (mut rho, mut rho_rows, mut diffuse, mut diffuse_rows) = ([Float8::splat(0.0); 3], Rows3::default(), 0u32, 0u32);
         let mut models: [Option<Cow<'_, Bsdf>>; W] = Default::default();
         let (u, v) = (Float8::load(&hit.uv[0]), Float8::load(&hit.uv[1]));
-        let mut todo = p.live;
-        while todo != 0 {
-            let shape = hit.shape[todo.trailing_zeros() as usize];
-            let class = scene.material_class[shape as usize];
-            let same =
-                bits(todo).filter(|&lane| scene.material_class[hit.shape[lane] as usize] == class).fold(0u32, |m, lane| m | 1 << lane);
-            todo &= !same;
-            let material = &scene.materials[shape as usize];
+        let class: [u32; W] =
+            std::array::from_fn(|l| if p.live & (1 << l) != 0 { scene.material_class[hit.shape[l] as usize] } else { u32::MAX });
+        for (first, same) in groups(p.live, |l| bits(p.live).filter(|&k| class[k] == class[l]).fold(0, |m, k| m | 1 << k)) {
+            let material = &scene.materials[hit.shape[first] as usize];
             if let Some(r) = material.diffuse_reflectance_lanes(u, v) {
                 let m = Mask8::from_bitmask(same);
                 rho = std::array::from_fn(|c| Float8::select(m, r[c], rho[c]));
@@ -325,34 +321,35 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
             // the point on it in lanes; other lights sample in full per lane.
             let (mut wi, mut li, mut light_pdf) = (Rows3::default(), Rows3::default(), [0.0f32; W]);
             let (mut tri, mut tri_n, mut pdf_area) = ([Rows3::default(); 3], Rows3::default(), Float8::splat(0.0));
-            let (mut sampled, mut on_mesh, mut on_sky, mut delta) = (0u32, 0u32, 0u32, 0u32);
-            // The density of a constant environment's samples (uniform: the same for every direction).
-            let mut sky_pdf = 0.0;
+            let (mut sampled, mut on_mesh, mut delta) = (0u32, 0u32, 0u32);
             let mut shadow = RayRows::default();
             let u_light = p.rng.next_f32(smooth);
             let (u_c, u_x, u_y) = (p.rng.next_f32(smooth), p.rng.next_f32(smooth), p.rng.next_f32(smooth));
             // `(u · n) as usize`, at most n − 1: u · n is in [0, n), so truncation is the cast.
             let chosen_lanes = (u_light * n_lights as f32).trunc().min(Float8::splat((n_lights - 1) as f32));
             let chosen = chosen_lanes.to_array();
-            // Small flat meshes (a `rectangle` light, say): the triangles of the lanes that chose the same
-            // light, chosen and loaded in lanes. A constant environment: its radiance.
+            // The lanes that chose the same light, in lanes where it is a constant environment
+            // (`ConstantLight::sample_li`; the surfaces' normals are never zero) or a small flat mesh (a
+            // `rectangle` light, say: its triangles chosen and loaded in lanes).
+            let (sp, sn) = (hit.p.lanes(), hit.n.lanes());
             let mut rest = smooth;
-            let mut todo = smooth;
-            while todo != 0 {
-                let index = chosen[todo.trailing_zeros() as usize];
-                let same = todo & chosen_lanes.eq(Float8::splat(index)).bitmask();
-                todo &= !same;
+            for (first, same) in groups(smooth, |l| chosen_lanes.eq(Float8::splat(chosen[l])).bitmask()) {
+                let index = chosen[first] as usize;
                 let m = Mask8::from_bitmask(same);
-                if let Light::Constant(constant) = &scene.lights[index as usize] {
+                if let Light::Constant(constant) = &scene.lights[index] {
                     if !constant.radiance.is_black() {
+                        let dir = uniform_sphere(u_x, u_y);
+                        let ray = RayLanes { o: offset_origin_lanes(sp, sn, dir), d: dir, tmax: Float8::splat(f32::INFINITY) };
                         li.store(V3::select(m, V3::splat(Vec3::from_array(constant.radiance.0)), li.lanes()));
-                        on_sky |= same;
-                        sky_pdf = constant.pdf_li(Vec3::Z);
+                        wi.store(V3::select(m, dir, wi.lanes()));
+                        light_pdf = Float8::select(m, Float8::splat(constant.pdf_li(Vec3::Z)), Float8::load(&light_pdf)).to_array();
+                        shadow.merge(m, &ray);
+                        sampled |= same;
                     }
                     rest &= !same;
                     continue;
                 }
-                let (Light::Area(area), Some(tris)) = (&scene.lights[index as usize], &scene.light_triangles[index as usize]) else {
+                let (Light::Area(area), Some(tris)) = (&scene.lights[index], &scene.light_triangles[index]) else {
                     continue;
                 };
                 let (vertices, n) = tris.sample(u_c);
@@ -396,17 +393,6 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
                 delta |= u32::from(ls.delta) << lane;
                 shadow.set(lane, &ls.shadow);
                 sampled |= 1 << lane;
-            }
-            let (sp, sn) = (hit.p.lanes(), hit.n.lanes());
-            if on_sky != 0 {
-                // `ConstantLight::sample_li` in lanes (the surfaces' normals are never zero).
-                let m = Mask8::from_bitmask(on_sky);
-                let dir = uniform_sphere(u_x, u_y);
-                let ray = RayLanes { o: offset_origin_lanes(sp, sn, dir), d: dir, tmax: Float8::splat(f32::INFINITY) };
-                wi.store(V3::select(m, dir, wi.lanes()));
-                light_pdf = Float8::select(m, Float8::splat(sky_pdf), Float8::load(&light_pdf)).to_array();
-                shadow.merge(m, &ray);
-                sampled |= on_sky;
             }
             if on_mesh != 0 {
                 // `AreaLight::sample_li` on a flat mesh, in lanes.
