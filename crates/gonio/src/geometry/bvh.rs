@@ -21,8 +21,9 @@
 //! distance); farther ones are culled when a closer hit has been found by the time they are popped.
 //!
 //! The path tracer traces its rays eight at a time ([`Bvh::closest_rays`], [`Bvh::any_rays`]): each child
-//! box is tested against the packet's rays in lanes, and the packet descends with the lanes that enter it;
-//! a subtree that at most `ALONE_BELOW` rays reach is finished by each ray alone (Benthin et al. 2012).
+//! box is tested against the packet's rays in lanes, and the packet descends with the lanes that enter it
+//! (a subtree waiting on the stack keeps each lane's entry distance, and a lane that has meanwhile found a
+//! nearer hit drops out of it); a subtree that at most `ALONE_BELOW` rays reach is finished by each ray alone (Benthin et al. 2012).
 //! The leaves are the caller's ([`PacketLeaves`]), for rays in lanes or one by one.
 //!
 //! # Against a crate (2026-11)
@@ -324,8 +325,8 @@ impl Bvh {
         }
         let pre = PacketPre::new(rays);
         let each = each_ray(rays);
-        // (node, lanes, the smallest entry distance among them).
-        let mut stack = [MaybeUninit::<(u32, u32, f32)>::uninit(); STACK];
+        // (node, lanes, each lane's entry distance).
+        let mut stack = [MaybeUninit::<(u32, u32, Float8)>::uninit(); STACK];
         let mut sp = 0usize;
         let (mut cur, mut active) = (0u32, lanes);
         'visit: loop {
@@ -347,7 +348,7 @@ impl Bvh {
             } else {
                 let node = &self.nodes[cur as usize];
                 // The children the rays enter, nearest (by the smallest entry distance of their rays) first.
-                let mut kids = [(0u32, 0u32, 0.0f32); LANES];
+                let mut kids = [(0u32, 0u32, 0.0f32, Float8::splat(0.0)); LANES];
                 let mut n = 0;
                 for c in 0..LANES {
                     let child = node.child[c];
@@ -365,27 +366,30 @@ impl Bvh {
                         kids[j] = kids[j - 1];
                         j -= 1;
                     }
-                    kids[j] = (child, m, dist);
+                    kids[j] = (child, m, dist, tnear);
                     n += 1;
                 }
                 if n > 0 {
-                    for &k in kids[1..n].iter().rev() {
-                        stack[sp].write(k);
+                    for &(child, m, _, tnear) in kids[1..n].iter().rev() {
+                        stack[sp].write((child, m, tnear));
                         sp += 1;
                     }
                     (cur, active) = (kids[0].0, kids[0].1);
                     continue 'visit;
                 }
             }
-            // Pop the next subtree, with the lanes that can still find a closer hit in it.
+            // Pop the next subtree, with the lanes that can still find a closer hit in it: those whose hit so
+            // far is not nearer than their own entry into its box. (2026-12: by each lane's entry rather than
+            // the packet's nearest, the Cornell box and the material spheres rendered 0.97–0.98× the time,
+            // same images.)
             loop {
                 if sp == 0 {
                     return hits;
                 }
                 sp -= 1;
                 // SAFETY: entries below `sp` were written by the pushes above.
-                let (node, m, dist) = unsafe { stack[sp].assume_init() };
-                let m = m & hits.t.ge(Float8::splat(dist)).bitmask();
+                let (node, m, tnear) = unsafe { stack[sp].assume_init() };
+                let m = m & hits.t.ge(tnear).bitmask();
                 if m != 0 {
                     (cur, active) = (node, m);
                     continue 'visit;
@@ -795,6 +799,7 @@ fn median_split(prims: &mut [BuildPrim], axis: usize) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::math::lanes::V3;
     use crate::sampling::Pcg32;
 
     fn random_boxes(rng: &mut Pcg32, n: usize) -> Vec<Bounds3> {
@@ -840,6 +845,86 @@ mod tests {
                 assert_eq!(brute.is_some(), any);
             }
         }
+    }
+
+    /// Boxes as a packet traversal's leaves: each ray tested against each box, lane by lane.
+    struct BoxLeaves<'a>(&'a Bvh, &'a [Bounds3]);
+
+    impl BoxLeaves<'_> {
+        /// The nearest box of slots `first..first + count` that `ray` enters before `tmax` (the first slot
+        /// among equals), and where.
+        fn nearest(&self, ray: &Ray, first: u32, count: u32, tmax: f32) -> Option<(f32, u32)> {
+            let mut best: Option<(f32, u32)> = None;
+            for slot in first..first + count {
+                let i = self.0.primitive(slot);
+                if i == EMPTY_SLOT {
+                    continue;
+                }
+                let limit = best.map_or(tmax, |b| b.0);
+                if let Some(t) = self.1[i as usize].hit(ray.o, ray.d.recip(), limit).filter(|&t| t > 0.0 && t < limit) {
+                    best = Some((t, slot));
+                }
+            }
+            best
+        }
+    }
+
+    impl PacketLeaves for BoxLeaves<'_> {
+        fn closest_rays(&self, _: &RayLanes<Float8>, each: &[Ray; PACKET], first: u32, count: u32, lanes: u32, hits: &mut Hits8) {
+            for lane in bits(lanes) {
+                if let Some((t, slot)) = self.nearest(&each[lane], first, count, hits.t.lane(lane)) {
+                    hits.t = hits.t.with_lane(lane, t);
+                    hits.slot[lane] = slot;
+                }
+            }
+        }
+        fn closest_ray(&self, ray: &Ray, first: u32, count: u32, tmax: f32) -> Option<(f32, u32)> {
+            self.nearest(ray, first, count, tmax)
+        }
+        fn any_rays(&self, _: &RayLanes<Float8>, each: &[Ray; PACKET], first: u32, count: u32, lanes: u32) -> u32 {
+            bits(lanes).filter(|&lane| self.any_ray(&each[lane], first, count)).fold(0, |m, lane| m | 1 << lane)
+        }
+        fn any_ray(&self, ray: &Ray, first: u32, count: u32) -> bool {
+            self.nearest(ray, first, count, ray.tmax).is_some()
+        }
+    }
+
+    /// Packets of eight incoherent rays (random origins, directions and lengths, some lanes off, as a path
+    /// tracer's bounces) find each ray's nearest box and its blocked rays as brute force does: the packet
+    /// traversal's culling of subtrees per lane never drops a lane's nearest hit.
+    #[test]
+    fn incoherent_packets_match_brute_force() {
+        let mut rng = Pcg32::new(5, 11);
+        let boxes = random_boxes(&mut rng, 3000);
+        let bvh = Bvh::build(&boxes);
+        let (mut hit, mut missed) = (0, 0);
+        for _ in 0..400 {
+            let rays: [Ray; PACKET] = std::array::from_fn(|_| {
+                let o = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 10.0;
+                Ray::new(o, crate::sampling::warp::sample_uniform_sphere(rng.next_vec2()), 0.5 + 8.0 * rng.next_f32())
+            });
+            let lanes = RayLanes {
+                o: V3::new(Float8::from_fn(|i| rays[i].o.x), Float8::from_fn(|i| rays[i].o.y), Float8::from_fn(|i| rays[i].o.z)),
+                d: V3::new(Float8::from_fn(|i| rays[i].d.x), Float8::from_fn(|i| rays[i].d.y), Float8::from_fn(|i| rays[i].d.z)),
+                tmax: Float8::from_fn(|i| rays[i].tmax),
+            };
+            let live = (rng.next_u32() & 0xff) | 0b1110_0001;
+            let leaves = BoxLeaves(&bvh, &boxes);
+            let hits = bvh.closest_rays(&lanes, live, &leaves);
+            let blocked = bvh.any_rays(&lanes, live, &leaves);
+            for (lane, ray) in rays.iter().enumerate() {
+                let on = live & 1 << lane != 0;
+                let brute = on.then(|| leaves.nearest(ray, 0, bvh.order().len() as u32, ray.tmax)).flatten();
+                let got = (hits.slot[lane] != EMPTY_SLOT).then(|| (hits.t.lane(lane), hits.slot[lane]));
+                assert_eq!(got.map(|g| bvh.primitive(g.1)), brute.map(|b| bvh.primitive(b.1)), "lane {lane}");
+                assert_eq!(got.map(|g| g.0), brute.map(|b| b.0), "lane {lane}");
+                assert_eq!(blocked & 1 << lane != 0, brute.is_some(), "lane {lane}");
+                if on {
+                    (hit, missed) = if brute.is_some() { (hit + 1, missed) } else { (hit, missed + 1) };
+                }
+            }
+        }
+        assert!(hit > 500 && missed > 200, "{hit} rays hit a box, {missed} missed all");
     }
 
     /// Eight well separated boxes: as packed primitives one leaf holds them all (a single test costs less
