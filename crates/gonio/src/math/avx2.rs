@@ -150,6 +150,19 @@ impl Avx8 {
         Avx8(avx!(_mm256_permutevar8x32_ps(self.0, _mm256_cvttps_epi32(idx.0))))
     }
 
+    /// The smallest lane: three shuffles and three `vminps` (as `min_or_second` across the lanes: a NaN
+    /// lane may or may not win). The renderer's; the batch kernels have no use for it.
+    #[cfg_attr(not(all(target_feature = "avx2", target_feature = "fma")), allow(dead_code))]
+    #[inline(always)]
+    #[must_use]
+    pub fn min_lane(self) -> f32 {
+        avx!({
+            let m = _mm256_min_ps(self.0, _mm256_permute2f128_ps::<1>(self.0, self.0));
+            let m = _mm256_min_ps(m, _mm256_permute_ps::<0b0100_1110>(m));
+            _mm256_cvtss_f32(_mm256_min_ps(m, _mm256_permute_ps::<0b1011_0001>(m)))
+        })
+    }
+
     /// Towards zero (`f32::trunc`).
     #[inline(always)]
     #[must_use]

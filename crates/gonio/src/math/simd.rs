@@ -408,6 +408,9 @@ impl Float8 {
     }
 }
 
+/// [`Float8::min_lane`] where `Float8` is two SSE registers or an array (AVX2's is shuffles, in
+/// `math::avx2`).
+#[cfg(not(all(target_arch = "x86_64", target_feature = "avx2", target_feature = "fma")))]
 impl Float8 {
     /// The smallest lane (as `min_or_second` across the lanes: a NaN lane may or may not win).
     #[inline(always)]
@@ -706,5 +709,18 @@ mod tests {
             [f32::INFINITY, f32::NAN, -f32::MIN_POSITIVE, 1e-40, -1e-40, 2.0, -3.5, f32::MAX],
         ];
         matches_across_magnitudes(&first, Float8::floor, f32::floor);
+    }
+
+    /// `min_lane` is the smallest lane wherever it sits, infinities and subnormals included.
+    #[test]
+    fn min_lane_is_the_smallest() {
+        let mut rng = crate::sampling::Pcg32::new(4, 4);
+        for k in 0..2000 {
+            let mut a: [f32; 8] = std::array::from_fn(|_| (rng.next_f32() - 0.5) * 1e3);
+            let specials = [f32::INFINITY, f32::NEG_INFINITY, 1e-40, -1e-40, f32::MAX, 0.0];
+            a[k % 8] = specials[k % specials.len()];
+            let want = a.iter().copied().fold(f32::INFINITY, f32::min);
+            assert_eq!(Float8::load(&a).min_lane(), want, "{a:?}");
+        }
     }
 }
