@@ -10,7 +10,9 @@ Run by `make bench` (never by `make test`): a benchmark, not a test. It prints t
    Mitsuba (`llvm_ad_rgb` if it runs here, else `scalar_rgb`) and cached in bench/.cache/. `llvm_ad_rgb`
    needs libLLVM 19: the script looks for it with `ldconfig -p` (or takes DRJIT_LIBLLVM_PATH as given)
    and skips the variant with a message when it is missing. Every render is repeated (`--repeats`) and
-   the fastest kept; Mitsuba's LLVM kernels are compiled in the first repeat.
+   the fastest kept; the repeats go in rounds of one render of each renderer (gonio, `--baseline` builds,
+   Mitsuba's variants), so that a change in the machine's load falls on all of them alike. Mitsuba's LLVM
+   kernels are compiled in the first repeat.
 2. **Cost against pixels × spp** for the Cornell box (should be linear: constant ns per sample).
 3. **Cost against triangle count**, 10³ … 10⁶ (a tessellated sphere written as binary PLY): BVH build
    time (should grow as n log n) and render time at fixed pixels × spp (should grow as log n).
@@ -153,6 +155,31 @@ def best_of(repeats: int, f):
     return best
 
 
+def interleaved(repeats: int, runners: list) -> list:
+    """Each of `runners` ((label, render) pairs; a render returns (times, image)) `repeats` times, in rounds
+    of one render of each, so that a change in the machine's load falls on all of them alike rather than
+    on whichever ran during it. Per runner: (label, (times, image), error), times with the fastest wall
+    time and the least CPU time of its renders; error is the message of a failed render (None if all ran)."""
+    runs: dict[str, list] = {label: [] for label, _ in runners}
+    errors: dict[str, str] = {}
+    for _ in range(repeats):
+        for label, render in runners:
+            if label in errors:
+                continue
+            try:
+                runs[label].append(render())
+            except RuntimeError as e:
+                errors[label] = str(e)
+    out = []
+    for label, _ in runners:
+        if label in errors:
+            out.append((label, (None, None), errors[label]))
+            continue
+        times, image = min(runs[label], key=lambda r: r[0]["wall"])
+        out.append((label, (dict(times, cpu=min(r[0]["cpu"] for r in runs[label])), image), None))
+    return out
+
+
 def mse(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.mean((a.astype(np.float64) - b.astype(np.float64)) ** 2))
 
@@ -195,28 +222,30 @@ def compare(spp: int, ref_spp: int, repeats: int, tmp: Path, baseline: list[Path
         print("llvm_ad_rgb skipped: libLLVM 19 not found by `ldconfig -p` (Debian: apt-get install libllvm19), "
               "and DRJIT_LIBLLVM_PATH is not set")
         variants.remove("llvm_ad_rgb")
-    print(f"\n== gonio vs Mitsuba 3, {spp} spp, best of {repeats} ({load_note()})")
+    print(f"\n== gonio vs Mitsuba 3, {spp} spp, best of {repeats} in alternation ({load_note()})")
     header = f"{'scene':<18} {'renderer':<20} {'wall s':>8} {'cpu s':>8} {'MSE':>11}   {'gonio/this wall':>15} {'cpu':>6} {'MSE':>6}"
     print(header)
     print("-" * len(header))
     for name in ["cornell-box", "material-spheres"]:
         scene = SCENES / f"{name}.xml"
         ref, label = reference(scene, ref_spp, llvm)
-        rows = []
-        g = best_of(repeats, lambda: run_gonio(scene, spp, {}, tmp / f"{name}.exr"))
-        rows.append(("gonio", g, mse(read_exr(tmp / f"{name}.exr"), ref)))
+
+        def gonio(binary: Path | None, out: Path):
+            return lambda: (run_gonio(scene, spp, {}, out, binary=binary), out)
+
+        # (label, render): gonio, other gonio builds (e.g. before a change), Mitsuba's variants.
+        runners = [("gonio", gonio(None, tmp / f"{name}.exr"))]
         for k, other in enumerate(baseline or []):
-            # Other gonio builds (e.g. before a change), timed in the same run as the others.
-            out = tmp / f"{name}-baseline{k}.exr"
-            b = best_of(repeats, lambda other=other, out=out: run_gonio(scene, spp, {}, out, binary=other))
-            rows.append((f"gonio baseline {k + 1}" if len(baseline) > 1 else "gonio baseline", b, mse(read_exr(out), ref)))
-        for v in variants:
-            try:
-                t, img = best_of(repeats, lambda v=v: run_mitsuba(v, scene, spp, {}, llvm))
-            except RuntimeError as e:
-                print(f"{name:<18} mitsuba {v:<12} failed: {str(e).splitlines()[-1]}")
+            runners.append((f"gonio baseline {k + 1}" if len(baseline) > 1 else "gonio baseline", gonio(other, tmp / f"{name}-baseline{k}.exr")))
+        runners += [(f"mitsuba {v}", lambda v=v: run_mitsuba(v, scene, spp, {}, llvm)) for v in variants]
+        rows = []
+        for label_r, (t, img), error in interleaved(repeats, runners):
+            if error is not None and label_r == "gonio":
+                raise RuntimeError(error)
+            if error is not None:
+                print(f"{name:<18} {label_r:<20} failed: {error.splitlines()[-1]}")
                 continue
-            rows.append((f"mitsuba {v}", t, mse(img, ref)))
+            rows.append((label_r, t, mse(read_exr(img) if isinstance(img, Path) else img, ref)))
         gt, ge = rows[0][1], rows[0][2]
         for label_r, t, e in rows:
             ratio = f"{gt['wall'] / t['wall']:>15.2f} {gt['cpu'] / t['cpu']:>6.2f} {ge / e:>6.2f}" if label_r != "gonio" else ""
