@@ -23,7 +23,8 @@
 //! The path tracer traces its rays eight at a time ([`Bvh::closest_rays`], [`Bvh::any_rays`]): each child
 //! box is tested against the packet's rays in lanes, and the packet descends with the lanes that enter it
 //! (a subtree waiting on the stack keeps each lane's entry distance, and a lane that has meanwhile found a
-//! nearer hit drops out of it); a subtree that at most `ALONE_BELOW` rays reach is finished by each ray alone (Benthin et al. 2012).
+//! nearer hit drops out of it); a subtree that at most `ALONE_BELOW` rays reach is finished by each ray
+//! alone (Benthin et al. 2012).
 //! The leaves are the caller's ([`PacketLeaves`]), for rays in lanes or one by one.
 //!
 //! # Against a crate (2026-11)
@@ -380,8 +381,8 @@ impl Bvh {
             }
             // Pop the next subtree, with the lanes that can still find a closer hit in it: those whose hit so
             // far is not nearer than their own entry into its box. (2026-12: by each lane's entry rather than
-            // the packet's nearest, the Cornell box and the material spheres rendered 0.97–0.98× the time,
-            // same images.)
+            // the packet's nearest, the Cornell box and the material spheres rendered 0.97–0.98× the time in
+            // five of seven alternations, 1.03–1.05× in two; same images. `docs/performance.md`.)
             loop {
                 if sp == 0 {
                     return hits;
