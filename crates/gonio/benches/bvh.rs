@@ -4,7 +4,6 @@
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use gonio::geometry::ray::{spawn_ray, RayLanes};
 use gonio::geometry::{Bounds3, Bvh, Ray};
-use gonio::math::lanes::V3;
 use gonio::math::simd::Float8;
 use gonio::math::{Frame, Vec2, Vec3};
 use gonio::sampling::warp::{sample_cosine_hemisphere, sample_uniform_sphere};
@@ -53,16 +52,6 @@ fn bench_traversal(c: &mut Criterion) {
     group.finish();
 }
 
-/// Eight rays in lanes.
-fn packet(rays: &[Ray; 8]) -> RayLanes<Float8> {
-    let row = |f: fn(&Ray) -> f32| Float8::load(&rays.each_ref().map(f));
-    RayLanes {
-        o: V3::new(row(|r| r.o.x), row(|r| r.o.y), row(|r| r.o.z)),
-        d: V3::new(row(|r| r.d.x), row(|r| r.d.y), row(|r| r.d.z)),
-        tmax: row(|r| r.tmax),
-    }
-}
-
 /// Shadow rays in lanes, and the lanes that hold one.
 type ShadowPacket = (RayLanes<Float8>, u32);
 
@@ -86,7 +75,7 @@ fn path_packets(scene: &Scene, packets: usize) -> (Vec<RayLanes<Float8>>, Vec<Sh
     let mut lanes: [(Ray, u32); 8] = std::array::from_fn(|_| camera(&mut rng));
     let (mut closest, mut shadow) = (Vec::with_capacity(packets), Vec::with_capacity(packets));
     while closest.len() < packets {
-        closest.push(packet(&lanes.map(|(r, _)| r)));
+        closest.push(RayLanes::from_rays(&lanes.map(|(r, _)| r)));
         let (mut shadows, mut tested) = ([Ray::new(Vec3::ZERO, Vec3::Z, 0.0); 8], 0u32);
         for (lane, (ray, depth)) in lanes.iter_mut().enumerate() {
             let Some(si) = scene.intersect(ray).filter(|_| *depth < MAX_BOUNCES) else {
@@ -102,7 +91,7 @@ fn path_packets(scene: &Scene, packets: usize) -> (Vec<RayLanes<Float8>>, Vec<Sh
             (*ray, *depth) = (spawn_ray(si.p, n, wi), *depth + 1);
         }
         if tested != 0 {
-            shadow.push((packet(&shadows), tested));
+            shadow.push((RayLanes::from_rays(&shadows), tested));
         }
     }
     (closest, shadow)

@@ -800,7 +800,6 @@ fn median_split(prims: &mut [BuildPrim], axis: usize) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::math::lanes::V3;
     use crate::sampling::Pcg32;
 
     fn random_boxes(rng: &mut Pcg32, n: usize) -> Vec<Bounds3> {
@@ -904,11 +903,7 @@ mod tests {
                 let o = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 10.0;
                 Ray::new(o, crate::sampling::warp::sample_uniform_sphere(rng.next_vec2()), 0.5 + 8.0 * rng.next_f32())
             });
-            let lanes = RayLanes {
-                o: V3::new(Float8::from_fn(|i| rays[i].o.x), Float8::from_fn(|i| rays[i].o.y), Float8::from_fn(|i| rays[i].o.z)),
-                d: V3::new(Float8::from_fn(|i| rays[i].d.x), Float8::from_fn(|i| rays[i].d.y), Float8::from_fn(|i| rays[i].d.z)),
-                tmax: Float8::from_fn(|i| rays[i].tmax),
-            };
+            let lanes = RayLanes::from_rays(&rays);
             let live = (rng.next_u32() & 0xff) | 0b1110_0001;
             let leaves = BoxLeaves(&bvh, &boxes);
             let hits = bvh.closest_rays(&lanes, live, &leaves);

@@ -9,6 +9,7 @@
 //! offset is simpler and, like Mitsuba's ray epsilon, relative to the scene's scale.
 
 use crate::math::lanes::{Real, V3};
+use crate::math::simd::Float8;
 use glam::Vec3;
 
 /// Relative offset of spawned ray origins (see the module docs).
@@ -75,6 +76,19 @@ pub struct RayLanes<R> {
     pub o: V3<R>,
     pub d: V3<R>,
     pub tmax: R,
+}
+
+impl RayLanes<Float8> {
+    /// Eight rays in lanes (lane `i` is `rays[i]`; `bvh::each_ray` takes them apart again).
+    #[must_use]
+    pub fn from_rays(rays: &[Ray; 8]) -> Self {
+        let row = |f: fn(&Ray) -> f32| Float8::load(&rays.each_ref().map(f));
+        RayLanes {
+            o: V3::new(row(|r| r.o.x), row(|r| r.o.y), row(|r| r.o.z)),
+            d: V3::new(row(|r| r.d.x), row(|r| r.d.y), row(|r| r.d.z)),
+            tmax: row(|r| r.tmax),
+        }
+    }
 }
 
 /// [`spawn_ray_to`] in lanes.

@@ -252,11 +252,7 @@ mod tests {
                 let target = Vec3::new(rng.next_f32() * 4.0 - 2.0, rng.next_f32() * 2.0 - 1.0, rng.next_f32() * 2.0 - 1.5);
                 *r = Ray::new(o, (target - o).normalize(), f32::INFINITY);
             }
-            let lanes = RayLanes {
-                o: V3::new(Float8::load(&rays.map(|r| r.o.x)), Float8::load(&rays.map(|r| r.o.y)), Float8::load(&rays.map(|r| r.o.z))),
-                d: V3::new(Float8::load(&rays.map(|r| r.d.x)), Float8::load(&rays.map(|r| r.d.y)), Float8::load(&rays.map(|r| r.d.z))),
-                tmax: Float8::splat(f32::INFINITY),
-            };
+            let lanes = RayLanes::from_rays(&rays);
             let live = 0b1011_1111;
             let hits = scene.intersect_rays(&lanes, live);
             let s = scene.surfaces(&lanes, &hits, live);
