@@ -146,7 +146,12 @@ def run_gonio(scene: Path, spp: int, defines: dict[str, str], out: Path, extra: 
 
 
 def best_of(repeats: int, f):
-    runs = [f() for _ in range(repeats)]
+    return fastest([f() for _ in range(repeats)])
+
+
+def fastest(runs: list):
+    """The run with the fastest wall time, given the least CPU time of all the runs (a run is a dict of
+    times, or a tuple whose first item is one)."""
     best = min(runs, key=lambda r: r[0]["wall"] if isinstance(r, tuple) else r["wall"])
     if isinstance(best, tuple):
         best[0]["cpu"] = min(r[0]["cpu"] for r in runs)
@@ -175,8 +180,7 @@ def interleaved(repeats: int, runners: list) -> list:
         if label in errors:
             out.append((label, (None, None), errors[label]))
             continue
-        times, image = min(runs[label], key=lambda r: r[0]["wall"])
-        out.append((label, (dict(times, cpu=min(r[0]["cpu"] for r in runs[label])), image), None))
+        out.append((label, fastest(runs[label]), None))
     return out
 
 
