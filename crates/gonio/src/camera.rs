@@ -14,7 +14,9 @@
 //! top-left corner, maps to the direction ((1 − 2 sx) tan(fov_x/2), (1 − 2 sy) tan(fov_y/2), 1).
 
 use crate::error::{Error, Result};
+use crate::geometry::ray::RayLanes;
 use crate::geometry::Ray;
+use crate::math::lanes::{Real, V3};
 use crate::math::Transform;
 use crate::props::Props;
 use glam::{Vec2, Vec3};
@@ -94,11 +96,20 @@ impl PerspectiveCamera {
     #[inline]
     #[must_use]
     pub fn ray(&self, s: Vec2) -> Ray {
-        let local = Vec3::new((1.0 - 2.0 * s.x) * self.tan_half_x, (1.0 - 2.0 * s.y) * self.tan_half_y, 1.0);
-        let d = self.to_world.vector(local);
+        let r = self.rays(s.x, s.y);
+        Ray::new(r.o.into(), r.d.into(), r.tmax)
+    }
+
+    /// [`Self::ray`] for film positions (`x`, `y`) in lanes ([`Real`]: one `f32` or eight).
+    #[inline(always)]
+    #[must_use]
+    pub fn rays<R: Real>(&self, x: R, y: R) -> RayLanes<R> {
+        let (one, two) = (R::splat(1.0), R::splat(2.0));
+        let local = V3::new((one - two * x) * R::splat(self.tan_half_x), (one - two * y) * R::splat(self.tan_half_y), one);
+        let d = self.to_world.vector_lanes(local);
         let len = d.length();
-        let o = self.to_world.point(Vec3::ZERO) + d * self.near;
-        Ray::new(o, d / len, (self.far - self.near) * len)
+        let o = V3::splat(self.to_world.point(Vec3::ZERO)).add(d.scale(R::splat(self.near)));
+        RayLanes { o, d: d.div(len), tmax: R::splat(self.far - self.near) * len }
     }
 }
 
@@ -119,6 +130,34 @@ mod tests {
     }
 
     /// Horizontal fields of view Mitsuba 3.9.1 reports (`x_fov`) for these sensors.
+    /// `rays`, on one `f32` (`ray`) and in eight lanes, gives bit for bit the ray that glam's `Vec3` and
+    /// `Mat4` operations give: direction (1 − 2s) · tan(fov/2) in camera space taken to world space and
+    /// normalised by division, origin at the near plane, `tmax` the far plane.
+    #[test]
+    fn rays_in_lanes_match() {
+        use crate::math::simd::Float8;
+        let look = Transform::look_at(Vec3::new(0.3, 2.0, 5.0), Vec3::new(0.0, 0.5, 0.0), Vec3::Y).unwrap();
+        let cam = PerspectiveCamera::new(look, 39.3, "x", 400, 160, 0.1, 1e3, "t").unwrap();
+        let mut rng = crate::sampling::Pcg32::new(4, 1);
+        let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+        for _ in 0..100 {
+            let s: [Vec2; 8] = std::array::from_fn(|_| rng.next_vec2());
+            let lanes = cam.rays(Float8::from_fn(|i| s[i].x), Float8::from_fn(|i| s[i].y));
+            for (i, s) in s.iter().enumerate() {
+                let local = Vec3::new((1.0 - 2.0 * s.x) * cam.tan_half_x, (1.0 - 2.0 * s.y) * cam.tan_half_y, 1.0);
+                let d = look.vector(local);
+                let want = Ray::new(look.point(Vec3::ZERO) + d * cam.near, d / d.length(), (cam.far - cam.near) * d.length());
+                let one = cam.ray(*s);
+                assert_eq!((bits(one.o), bits(one.d), one.tmax.to_bits()), (bits(want.o), bits(want.d), want.tmax.to_bits()));
+                let lane = |v: &V3<Float8>| Vec3::new(v.x.lane(i), v.y.lane(i), v.z.lane(i));
+                assert_eq!(
+                    (bits(lane(&lanes.o)), bits(lane(&lanes.d)), lanes.tmax.lane(i).to_bits()),
+                    (bits(want.o), bits(want.d), want.tmax.to_bits())
+                );
+            }
+        }
+    }
+
     #[test]
     fn fields_of_view_match_mitsuba() {
         let x_fov = |xml: &str, w: u32, h: u32| {

@@ -11,7 +11,10 @@ pub mod path;
 use crate::bsdf::{Bsdf, BsdfModel};
 use crate::geometry::{Ray, SurfaceInteraction};
 use crate::sampling::mis::power_heuristic;
-use crate::sampling::Pcg32;
+use crate::geometry::ray::RayLanes;
+use crate::math::lanes::Real;
+use crate::math::simd::Float8;
+use crate::sampling::{Pcg32, Pcg32x8};
 use crate::scene::{IntegratorKind, Scene};
 use crate::spectrum::Rgb;
 use glam::Vec3;
@@ -37,11 +40,34 @@ fn mix(seed: u64, sample: u64) -> u64 {
 #[inline]
 #[must_use]
 pub fn start(scene: &Scene, seed: u64, s: CameraSample) -> (Ray, Pcg32) {
-    let (w, h) = (scene.film.width, scene.film.height);
-    let pixel = u64::from(s.y) * u64::from(w) + u64::from(s.x);
-    let mut rng = Pcg32::new(mix(seed, u64::from(s.k)), pixel);
-    let p = glam::Vec2::new((s.x as f32 + rng.next_f32()) / w as f32, (s.y as f32 + rng.next_f32()) / h as f32);
-    (scene.camera.ray(p), rng)
+    let mut rng = Pcg32::new(mix(seed, u64::from(s.k)), pixel_index(scene, s));
+    let (ux, uy) = (rng.next_f32(), rng.next_f32());
+    let (x, y) = film_point(scene, s.x as f32, s.y as f32, ux, uy);
+    (scene.camera.ray(glam::Vec2::new(x, y)), rng)
+}
+
+/// The stream of a camera sample's generator: its pixel's row-major index.
+#[inline(always)]
+fn pixel_index(scene: &Scene, s: CameraSample) -> u64 {
+    u64::from(s.y) * u64::from(scene.film.width) + u64::from(s.x)
+}
+
+/// The point of pixel (`x`, `y`) offset by (`ux`, `uy`), in film coordinates [0, 1]².
+#[inline(always)]
+fn film_point<R: Real>(scene: &Scene, x: R, y: R, ux: R, uy: R) -> (R, R) {
+    ((x + ux) / R::splat(scene.film.width as f32), (y + uy) / R::splat(scene.film.height as f32))
+}
+
+/// [`start`] for eight camera samples at once, in the lanes of `lanes` (lane `i` for `samples[i]`): each
+/// lane's generator in `rng` is started as `start` starts it and its ray is the one `start` returns, by the
+/// same operations in lanes. The other lanes of `rng` are left as they were; their rays mean nothing.
+#[inline(always)]
+pub fn start_lanes(scene: &Scene, seed: u64, samples: &[CameraSample; 8], lanes: u32, rng: &mut Pcg32x8) -> RayLanes<Float8> {
+    rng.seed(lanes, &samples.map(|s| mix(seed, u64::from(s.k))), &samples.map(|s| pixel_index(scene, s)));
+    let (ux, uy) = (rng.next_f32(lanes), rng.next_f32(lanes));
+    let (x, y) = (Float8::from_fn(|i| samples[i].x as f32), Float8::from_fn(|i| samples[i].y as f32));
+    let (x, y) = film_point(scene, x, y, ux, uy);
+    scene.camera.rays(x, y)
 }
 
 /// The radiance of each camera sample (`out[i]` for `samples[i]`), by the scene's integrator.

@@ -19,7 +19,7 @@
 //! draws from its own random stream in the order a path traced alone would, so the packet changes nothing
 //! but the speed.
 
-use super::{emitter_hit, start, BsdfSampled, CameraSample};
+use super::{emitter_hit, start_lanes, BsdfSampled, CameraSample};
 use crate::bsdf::diffuse::{diffuse_f, diffuse_pdf, diffuse_sample};
 use crate::bsdf::lanes::{LaneKernel, LaneModel};
 use crate::bsdf::{Bsdf, BsdfFlags, BsdfModel};
@@ -34,7 +34,7 @@ use crate::math::lanes::{Real, V3};
 use crate::math::simd::{Float8, Mask8};
 use crate::math::{Vec2, Vec3};
 use crate::sampling::warp::uniform_sphere;
-use crate::sampling::{Pcg32, Pcg32x8};
+use crate::sampling::Pcg32x8;
 use crate::scene::surfaces::Rows3;
 use crate::scene::Scene;
 use crate::spectrum::Rgb;
@@ -126,18 +126,20 @@ impl Packet {
         Ray::new(self.o.get(lane), self.d.get(lane), self.tmax[lane])
     }
 
-    /// Lane `lane` starts camera sample `index`.
-    fn start(&mut self, lane: usize, index: usize, ray: Ray, rng: Pcg32) {
-        self.live |= 1 << lane;
-        self.sample[lane] = index;
-        self.rng.set(lane, &rng);
-        self.depth[lane] = 0;
-        self.o.set(lane, ray.o);
-        self.d.set(lane, ray.d);
-        self.tmax[lane] = ray.tmax;
-        self.beta.set_rgb(lane, Rgb::ONE);
-        self.l.set_rgb(lane, Rgb::ZERO);
-        self.eta[lane] = 1.0;
+    /// Lanes `lanes` start paths along `rays` (their camera samples and generators already set).
+    #[inline(always)]
+    fn start(&mut self, lanes: u32, rays: &RayLanes<Float8>) {
+        self.live |= lanes;
+        let m = Mask8::from_bitmask(lanes);
+        self.o.store(V3::select(m, rays.o, self.o.lanes()));
+        self.d.store(V3::select(m, rays.d, self.d.lanes()));
+        self.tmax = Float8::select(m, rays.tmax, Float8::load(&self.tmax)).to_array();
+        self.beta.store(V3::select(m, V3::splat(Vec3::ONE), self.beta.lanes()));
+        self.l.store(V3::select(m, V3::splat(Vec3::ZERO), self.l.lanes()));
+        self.eta = Float8::select(m, Float8::splat(1.0), Float8::load(&self.eta)).to_array();
+        for (i, depth) in self.depth.iter_mut().enumerate() {
+            *depth = if lanes >> i & 1 == 1 { 0 } else { *depth };
+        }
     }
 
     /// Lane `lane`'s path ends: its radiance goes to `out`.
@@ -171,6 +173,13 @@ fn to_world(s: V3<Float8>, t: V3<Float8>, n: V3<Float8>, v: V3<Float8>) -> V3<Fl
     s.scale(v.x).add(t.scale(v.y)).add(n.scale(v.z))
 }
 
+/// The mask of the lanes `i` (all [`W`] of them, live or not) where `f(i)` holds: a fixed loop, which
+/// compiles to comparisons without branches, where a loop over a mask's set lanes mispredicts its exit.
+#[inline(always)]
+fn lanes_where(f: impl Fn(usize) -> bool) -> u32 {
+    (0..W).fold(0, |m, i| m | u32::from(f(i)) << i)
+}
+
 /// [`power_heuristic`] with one sample of each technique, in lanes.
 #[inline(always)]
 fn power_heuristic_1(f: Float8, g: Float8) -> Float8 {
@@ -191,14 +200,19 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
     let mut p = Packet::new();
     let mut next = 0;
     loop {
-        // Lanes without a path take the next camera sample.
+        // Lanes without a path take the next camera samples, started together.
+        let (mut fill, mut chosen) = (0u32, [CameraSample { x: 0, y: 0, k: 0 }; W]);
         for lane in bits(!p.live & ((1 << W) - 1)) {
             if next == samples.len() {
                 break;
             }
-            let (ray, rng) = start(scene, seed, samples[next]);
-            p.start(lane, next, ray, rng);
+            (chosen[lane], p.sample[lane]) = (samples[next], next);
+            fill |= 1 << lane;
             next += 1;
+        }
+        if fill != 0 {
+            let rays = start_lanes(scene, seed, &chosen, fill, &mut p.rng);
+            p.start(fill, &rays);
         }
         if p.live == 0 {
             return;
@@ -214,7 +228,7 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
         // sample either way); paths that escaped or reached the longest length end.
         let mut le = Rows3::default();
         let t = found.t.to_array();
-        let first = bits(p.live).fold(0u32, |m, lane| m | u32::from(p.depth[lane] == 0) << lane);
+        let first = p.live & lanes_where(|i| p.depth[i] == 0);
         let shown = p.live & !(if hide_emitters { first } else { 0 });
         // A constant environment seen, in lanes: `emitter_hit`'s Le · w, with w the power heuristic
         // against light sampling, one sample of each (1 after a delta lobe and for camera rays).
@@ -246,11 +260,10 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
             l[c] = l[c] + beta[c] * le[c];
         }
         store_rgb(&mut p.l, l);
-        for lane in bits(p.live) {
-            // A vertex at `depth` can extend the path only if the next one is within max_depth.
-            if hit.found & (1 << lane) == 0 || (max_depth >= 0 && p.depth[lane] + 1 >= max_depth) {
-                p.finish(lane, out);
-            }
+        // A vertex at `depth` can extend the path only if the next one is within max_depth.
+        let longest = if max_depth >= 0 { lanes_where(|i| p.depth[i] >= max_depth - 1) } else { 0 };
+        for lane in bits(p.live & (!hit.found | longest)) {
+            p.finish(lane, out);
         }
         if p.live == 0 {
             continue;
@@ -525,16 +538,14 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
         // Russian roulette.
         let beta_max = beta[0].max(beta[1]).max(beta[2]);
         let q = (beta_max * eta * eta).min(Float8::splat(0.95));
-        let dead = (!beta_max.gt(Float8::splat(0.0))).bitmask();
-        let mut roulette = 0u32;
-        for lane in bits(p.live) {
-            p.depth[lane] += 1;
-            if dead & (1 << lane) != 0 {
-                p.finish(lane, out);
-                continue;
-            }
-            roulette |= u32::from(p.depth[lane] >= rr_depth) << lane;
+        let dead = p.live & (!beta_max.gt(Float8::splat(0.0))).bitmask();
+        for (i, depth) in p.depth.iter_mut().enumerate() {
+            *depth += (p.live >> i & 1) as i32;
         }
+        for lane in bits(dead) {
+            p.finish(lane, out);
+        }
+        let roulette = p.live & lanes_where(|i| p.depth[i] >= rr_depth);
         let survive_scale = roulette & !p.rng.next_f32(roulette).ge(q).bitmask();
         for lane in bits(roulette & !survive_scale) {
             p.finish(lane, out);

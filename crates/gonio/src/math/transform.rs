@@ -101,13 +101,24 @@ impl Transform {
     #[inline(always)]
     #[must_use]
     pub fn point_lanes<R: Real>(&self, p: V3<R>) -> V3<R> {
-        let m = &self.matrix;
-        let row = |i: usize| {
-            let c = |axis: Vec4| R::splat(axis[i]);
-            c(m.x_axis) * p.x + c(m.y_axis) * p.y + c(m.z_axis) * p.z + c(m.w_axis) * R::splat(1.0)
-        };
+        let row = |i: usize| self.row_lanes(i, p, 1.0);
         let (q, w) = (V3::new(row(0), row(1), row(2)), row(3));
         V3::select(w.eq(R::splat(1.0)), q, q.div(w))
+    }
+
+    /// [`Self::vector`] in lanes, by the same operations: ((c₀x + c₁y) + c₂z) + c₃·0 per coordinate.
+    #[inline(always)]
+    #[must_use]
+    pub fn vector_lanes<R: Real>(&self, v: V3<R>) -> V3<R> {
+        V3::new(self.row_lanes(0, v, 0.0), self.row_lanes(1, v, 0.0), self.row_lanes(2, v, 0.0))
+    }
+
+    /// Row `i` of the matrix times (v, w), in glam's column order.
+    #[inline(always)]
+    fn row_lanes<R: Real>(&self, i: usize, v: V3<R>, w: f32) -> R {
+        let m = &self.matrix;
+        let c = |axis: Vec4| R::splat(axis[i]);
+        c(m.x_axis) * v.x + c(m.y_axis) * v.y + c(m.z_axis) * v.z + c(m.w_axis) * R::splat(w)
     }
 
     #[inline]
@@ -135,8 +146,8 @@ mod tests {
     use super::*;
     use crate::math::simd::Float8;
 
-    /// `point_lanes` computes `point`'s numbers bit for bit, on one `f32` and in eight lanes, for random
-    /// affine and projective matrices and points.
+    /// `point_lanes` and `vector_lanes` compute `point`'s and `vector`'s numbers bit for bit, on one `f32`
+    /// and in eight lanes, for random affine and projective matrices and points.
     #[test]
     fn points_in_lanes_match() {
         let mut rng = crate::sampling::Pcg32::new(11, 2);
@@ -149,13 +160,17 @@ mod tests {
             let Some(t) = Transform::from_rows(&rows) else { continue };
             let points: [Vec3; 8] = std::array::from_fn(|_| Vec3::new(r(), r(), r()));
             let lanes = V3::new(Float8::from_fn(|i| points[i].x), Float8::from_fn(|i| points[i].y), Float8::from_fn(|i| points[i].z));
-            let got = t.point_lanes(lanes);
+            let (got, got_v) = (t.point_lanes(lanes), t.vector_lanes(lanes));
             for (i, p) in points.iter().enumerate() {
-                let want = t.point(*p);
+                let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+                let lane = |v: &V3<Float8>| Vec3::new(v.x.lane(i), v.y.lane(i), v.z.lane(i));
+                let (want, want_v) = (t.point(*p), t.vector(*p));
                 let one: Vec3 = t.point_lanes(V3::<f32>::from(*p)).into();
-                let lane = Vec3::new(got.x.lane(i), got.y.lane(i), got.z.lane(i));
-                assert_eq!(one.to_array().map(f32::to_bits), want.to_array().map(f32::to_bits), "{p} by {t:?}");
-                assert_eq!(lane.to_array().map(f32::to_bits), want.to_array().map(f32::to_bits), "{p} by {t:?}");
+                assert_eq!(bits(one), bits(want), "{p} by {t:?}");
+                assert_eq!(bits(lane(&got)), bits(want), "{p} by {t:?}");
+                let one_v: Vec3 = t.vector_lanes(V3::<f32>::from(*p)).into();
+                assert_eq!(bits(one_v), bits(want_v), "vector {p} by {t:?}");
+                assert_eq!(bits(lane(&got_v)), bits(want_v), "vector {p} by {t:?}");
             }
         }
     }

@@ -105,6 +105,20 @@ impl Pcg32x8 {
         (self.state[lane], self.inc[lane]) = (rng.state, rng.inc);
     }
 
+    /// Lanes `lanes` start [`Pcg32::new`]`(seed[i], stream[i])`, by the same steps (in lanes).
+    #[inline(always)]
+    pub fn seed(&mut self, lanes: u32, seed: &[u64; 8], stream: &[u64; 8]) {
+        #[allow(clippy::needless_range_loop)] // lane i of four arrays and bit i of `lanes`
+        for i in 0..8 {
+            let inc = (stream[i] << 1) | 1;
+            // `new`'s first step from state 0 leaves `inc`; then the seed is added and the state stepped.
+            let state = inc.wrapping_add(seed[i]).wrapping_mul(MULT).wrapping_add(inc);
+            let keep = 0u64.wrapping_sub(u64::from(lanes >> i & 1));
+            self.state[i] = (state & keep) | (self.state[i] & !keep);
+            self.inc[i] = (inc & keep) | (self.inc[i] & !keep);
+        }
+    }
+
     /// The generator of lane `lane`.
     #[inline]
     #[must_use]
@@ -178,6 +192,23 @@ mod tests {
                 }
                 assert_eq!(&lanes.get(i), r);
             }
+        }
+    }
+
+    /// `seed` starts the lanes it names as `Pcg32::new` would, and leaves the others.
+    #[test]
+    fn seeded_lanes_are_new_generators() {
+        let mut lanes = Pcg32x8::default();
+        let before: Vec<Pcg32> = (0..8).map(|i| Pcg32::new(100 + i, i)).collect();
+        for (i, r) in before.iter().enumerate() {
+            lanes.set(i, r);
+        }
+        let seeds: [u64; 8] = std::array::from_fn(|i| 0x9e37_79b9_7f4a_7c15u64.wrapping_mul(i as u64 + 1));
+        let streams: [u64; 8] = std::array::from_fn(|i| u64::MAX - 3 * i as u64);
+        lanes.seed(0b1010_0110, &seeds, &streams);
+        for i in 0..8 {
+            let want = if 0b1010_0110 >> i & 1 == 1 { Pcg32::new(seeds[i], streams[i]) } else { before[i].clone() };
+            assert_eq!(lanes.get(i), want, "lane {i}");
         }
     }
 
