@@ -9,11 +9,11 @@ pub mod direct;
 pub mod path;
 
 use crate::bsdf::{Bsdf, BsdfModel};
-use crate::geometry::{Ray, SurfaceInteraction};
-use crate::sampling::mis::power_heuristic;
 use crate::geometry::ray::RayLanes;
+use crate::geometry::{Ray, SurfaceInteraction};
 use crate::math::lanes::Real;
 use crate::math::simd::Float8;
+use crate::sampling::mis::power_heuristic;
 use crate::sampling::{Pcg32, Pcg32x8};
 use crate::scene::{IntegratorKind, Scene};
 use crate::spectrum::Rgb;
