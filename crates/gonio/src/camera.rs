@@ -129,7 +129,6 @@ mod tests {
         assert!(PerspectiveCamera::new(look, 90.0, "z", 2, 1, 1e-2, 1e4, "t").is_err());
     }
 
-    /// Horizontal fields of view Mitsuba 3.9.1 reports (`x_fov`) for these sensors.
     /// `rays`, on one `f32` (`ray`) and in eight lanes, gives bit for bit the ray that glam's `Vec3` and
     /// `Mat4` operations give: direction (1 − 2s) · tan(fov/2) in camera space taken to world space and
     /// normalised by division, origin at the near plane, `tmax` the far plane.
@@ -158,6 +157,7 @@ mod tests {
         }
     }
 
+    /// Horizontal fields of view Mitsuba 3.9.1 reports (`x_fov`) for these sensors.
     #[test]
     fn fields_of_view_match_mitsuba() {
         let x_fov = |xml: &str, w: u32, h: u32| {
