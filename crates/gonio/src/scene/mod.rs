@@ -207,7 +207,7 @@ impl Primitives {
 
 /// Rays per packet tested triangle by triangle (each triangle against all rays) rather than ray by ray
 /// (each ray against the packet's eight triangles): below this many rays per triangle in the packet, ray by
-/// ray. 2026-12 (Zen 3), with the triangle-by-triangle test branch-free ([`Triangle8::intersect_rays_t`],
+/// ray. 2026-12 (Zen 3), with the triangle-by-triangle test branch-free ([`Triangle8::intersect_rays`],
 /// slots taken by selects): 1 took 0.90–0.95 × the Cornell box's render time of 2 (sequential
 /// alternations, 40 renders each), the same instructions and 16 % fewer simulated branch mispredictions;
 /// 0 about the same time with 12 % more instructions. (2026-11, with the branching test and a loop over
