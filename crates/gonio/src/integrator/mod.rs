@@ -28,7 +28,8 @@ pub struct CameraSample {
 }
 
 /// Mix a seed and a sample index into a PCG32 seed (the SplitMix64 finaliser, Steele et al. 2014).
-fn mix(seed: u64, sample: u64) -> u64 {
+#[inline]
+pub(crate) fn mix(seed: u64, sample: u64) -> u64 {
     let mut z = seed.wrapping_add(sample.wrapping_mul(0x9e37_79b9_7f4a_7c15));
     z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
@@ -58,12 +59,13 @@ fn film_point<R: Real>(scene: &Scene, x: R, y: R, ux: R, uy: R) -> (R, R) {
     ((x + ux) / R::splat(scene.film.width as f32), (y + uy) / R::splat(scene.film.height as f32))
 }
 
-/// [`start`] for eight camera samples at once, in the lanes of `lanes` (lane `i` for `samples[i]`): each
-/// lane's generator in `rng` is started as `start` starts it and its ray is the one `start` returns, by the
-/// same operations in lanes. The other lanes of `rng` are left as they were; their rays mean nothing.
+/// [`start`] for eight camera samples at once, in the lanes of `lanes` (lane `i` for `samples[i]`, whose
+/// seed `mixed[i]` is [`mix`]`(seed, k)`, computed by the caller for the starting lanes alone): each lane's
+/// generator in `rng` is started as `start` starts it and its ray is the one `start` returns, by the same
+/// operations in lanes. The other lanes of `rng` are left as they were; their rays mean nothing.
 #[inline(always)]
-pub fn start_lanes(scene: &Scene, seed: u64, samples: &[CameraSample; 8], lanes: u32, rng: &mut Pcg32x8) -> RayLanes<Float8> {
-    rng.seed(lanes, &samples.map(|s| mix(seed, u64::from(s.k))), &samples.map(|s| pixel_index(scene, s)));
+pub fn start_lanes(scene: &Scene, mixed: &[u64; 8], samples: &[CameraSample; 8], lanes: u32, rng: &mut Pcg32x8) -> RayLanes<Float8> {
+    rng.seed(lanes, mixed, &samples.map(|s| pixel_index(scene, s)));
     let (ux, uy) = (rng.next_f32(lanes), rng.next_f32(lanes));
     let (x, y) = (Float8::from_fn(|i| samples[i].x as f32), Float8::from_fn(|i| samples[i].y as f32));
     let (x, y) = film_point(scene, x, y, ux, uy);

@@ -19,7 +19,7 @@
 //! draws from its own random stream in the order a path traced alone would, so the packet changes nothing
 //! but the speed.
 
-use super::{emitter_hit, start_lanes, BsdfSampled, CameraSample};
+use super::{emitter_hit, mix, start_lanes, BsdfSampled, CameraSample};
 use crate::bsdf::diffuse::{diffuse_f, diffuse_pdf, diffuse_sample};
 use crate::bsdf::lanes::{LaneKernel, LaneModel};
 use crate::bsdf::{Bsdf, BsdfFlags, BsdfModel};
@@ -201,17 +201,17 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
     let mut next = 0;
     loop {
         // Lanes without a path take the next camera samples, started together.
-        let (mut fill, mut chosen) = (0u32, [CameraSample { x: 0, y: 0, k: 0 }; W]);
+        let (mut fill, mut chosen, mut mixed) = (0u32, [CameraSample { x: 0, y: 0, k: 0 }; W], [0u64; W]);
         for lane in bits(!p.live & ((1 << W) - 1)) {
             if next == samples.len() {
                 break;
             }
-            (chosen[lane], p.sample[lane]) = (samples[next], next);
+            (chosen[lane], p.sample[lane], mixed[lane]) = (samples[next], next, mix(seed, u64::from(samples[next].k)));
             fill |= 1 << lane;
             next += 1;
         }
         if fill != 0 {
-            let rays = start_lanes(scene, seed, &chosen, fill, &mut p.rng);
+            let rays = start_lanes(scene, &mixed, &chosen, fill, &mut p.rng);
             p.start(fill, &rays);
         }
         if p.live == 0 {

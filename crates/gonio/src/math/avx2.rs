@@ -101,6 +101,14 @@ impl Avx8 {
         Avx8(avx!(_mm256_setr_ps(a[0], a[1], a[2], a[3], a[4], a[5], a[6], a[7])))
     }
 
+    /// The lanes of an AVX register.
+    #[cfg_attr(not(all(target_feature = "avx2", target_feature = "fma")), allow(dead_code))]
+    #[inline(always)]
+    #[must_use]
+    pub(crate) fn from_m256(v: __m256) -> Self {
+        Avx8(v)
+    }
+
     /// Lanes from an array.
     #[inline(always)]
     #[must_use]

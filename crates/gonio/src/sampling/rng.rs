@@ -128,6 +128,7 @@ impl Pcg32x8 {
 
     /// The next uniform `f32` in [0, 1) of each lane whose bit is set in `draw` (the others are not
     /// stepped; their lanes hold a number that was not drawn).
+    #[cfg(not(all(target_arch = "x86_64", target_feature = "avx2", target_feature = "fma")))]
     #[inline(always)]
     pub fn next_f32(&mut self, draw: u32) -> crate::math::simd::Float8 {
         let mut out = [0.0f32; 8];
@@ -141,6 +142,48 @@ impl Pcg32x8 {
             out[i] = unit_f32(xsh_rr(old));
         }
         crate::math::simd::Float8::new(out)
+    }
+
+    /// [`Pcg32x8::next_f32`] with AVX2 integer instructions, in builds that enable AVX2: the state's
+    /// lanes 0–3 and 4–7 in two registers, the 64-bit multiply from three 32 × 32 → 64-bit ones
+    /// (`vpmuludq`), XSH-RR by variable shifts. The same numbers as the plain loop, in about half its
+    /// instructions (LLVM vectorised the loop, but moved the lanes through memory).
+    #[cfg(all(target_arch = "x86_64", target_feature = "avx2", target_feature = "fma"))]
+    #[inline(always)]
+    pub fn next_f32(&mut self, draw: u32) -> crate::math::simd::Float8 {
+        use std::arch::x86_64::*;
+        // SAFETY: this build enables AVX2, so every CPU it runs on has it; the loads and stores are of the
+        // two arrays' eight u64s, four at a time.
+        unsafe {
+            let (state, inc) = (self.state.as_mut_ptr().cast::<__m256i>(), self.inc.as_ptr().cast::<__m256i>());
+            let (mul_lo, mul_hi) = (_mm256_set1_epi64x((MULT & 0xffff_ffff) as i64), _mm256_set1_epi64x((MULT >> 32) as i64));
+            let draws = _mm256_set1_epi64x(i64::from(draw));
+            let step = |half: usize, lane_bits: __m256i| {
+                let old = _mm256_loadu_si256(state.add(half));
+                // old · MULT mod 2⁶⁴: lo·lo + ((hi·lo + lo·hi) << 32).
+                let cross = _mm256_add_epi64(_mm256_mul_epu32(_mm256_srli_epi64::<32>(old), mul_lo), _mm256_mul_epu32(old, mul_hi));
+                let product = _mm256_add_epi64(_mm256_mul_epu32(old, mul_lo), _mm256_slli_epi64::<32>(cross));
+                let stepped = _mm256_add_epi64(product, _mm256_loadu_si256(inc.add(half)));
+                let keep = _mm256_cmpeq_epi64(_mm256_and_si256(draws, lane_bits), lane_bits);
+                _mm256_storeu_si256(state.add(half), _mm256_blendv_epi8(old, stepped, keep));
+                // XSH-RR's inputs: the xorshift (its low 32 bits) and the rotation (the top five bits).
+                let xorshifted = _mm256_srli_epi64::<27>(_mm256_xor_si256(_mm256_srli_epi64::<18>(old), old));
+                (xorshifted, _mm256_srli_epi64::<59>(old))
+            };
+            let (x0, r0) = step(0, _mm256_setr_epi64x(1, 2, 4, 8));
+            let (x1, r1) = step(1, _mm256_setr_epi64x(16, 32, 64, 128));
+            // The low 32 bits of the eight u64 lanes, in order: even dwords of both halves, then the
+            // 64-bit pieces put back in lane order.
+            let low = |a: __m256i, b: __m256i| {
+                let even = _mm256_shuffle_ps::<0b10_00_10_00>(_mm256_castsi256_ps(a), _mm256_castsi256_ps(b));
+                _mm256_permute4x64_epi64::<0b11_01_10_00>(_mm256_castps_si256(even))
+            };
+            let (x, rot) = (low(x0, x1), low(r0, r1));
+            // Rotate right by rot; a shift by 32 (rot = 0) gives 0, as `vpsllvd` defines it.
+            let rotated = _mm256_or_si256(_mm256_srlv_epi32(x, rot), _mm256_sllv_epi32(x, _mm256_sub_epi32(_mm256_set1_epi32(32), rot)));
+            let unit = _mm256_mul_ps(_mm256_cvtepi32_ps(_mm256_srli_epi32::<8>(rotated)), _mm256_set1_ps(1.0 / 16_777_216.0));
+            crate::math::simd::Float8::from_m256(unit)
+        }
     }
 }
 
