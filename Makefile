@@ -1,6 +1,6 @@
 # gonio — the only entry points a newcomer needs.
 #   make demo   build, render scenes/demo.xml to out/demo.png, then prove every model's physics with `gonio check --all`
-#   make test   build, then run the Rust tests and the Python tests (incl. the Mitsuba 3 cross-checks)
+#   make test   build, then run the Rust tests, the Python tests (incl. the Mitsuba 3 cross-checks) and the lane code's tests built for this CPU
 #   make bench  criterion benchmarks, and gonio vs Mitsuba 3 timings, errors and scaling tables
 #   make gallery  regenerate docs/gallery/*.png and docs/gallery/README.md (the lecture's figures, < 10 min on 2 cores)
 #   make fuzz   run one loader's fuzz target (TARGET=ply FUZZ_SECONDS=600; docs/fuzzing.md)
@@ -11,7 +11,7 @@ VENV   := .venv
 VPY    := $(VENV)/bin/python
 CARGO  ?= cargo
 
-.PHONY: all build cli venv python demo test test-rust test-python bench gallery fit-table fuzz fmt lint clean
+.PHONY: all build cli venv python demo test test-native test-rust test-python bench gallery fit-table fuzz fmt lint clean
 
 all: build
 
@@ -46,6 +46,14 @@ demo: build
 test: build
 	$(CARGO) test --release -p gonio -p gonio-cli
 	$(VPY) -m pytest -q -rxX crates/gonio-py/tests
+	$(MAKE) test-native
+
+# The renderer's lane code built for this machine's CPU, as `make bench` times it: with AVX2 (where the CPU
+# has it) `Float8` is one AVX register and `Pcg32x8` steps in AVX2 integer instructions, code the portable
+# build does not compile. Its tests (lanes against scalar code, bit for bit) in their own target directory.
+test-native:
+	RUSTFLAGS="-C target-cpu=native" CARGO_TARGET_DIR=target/native $(CARGO) test --release -p gonio --lib -- \
+		math:: sampling:: geometry:: scene:: integrator:: render
 
 test-rust:
 	$(CARGO) test --release -p gonio -p gonio-cli
