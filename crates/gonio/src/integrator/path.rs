@@ -275,9 +275,16 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
         let (mut rho, mut rho_rows, mut diffuse, mut diffuse_rows) = ([Float8::splat(0.0); 3], Rows3::default(), 0u32, 0u32);
         let mut models: [Option<Cow<'_, Bsdf>>; W] = Default::default();
         let (u, v) = (Float8::load(&hit.uv[0]), Float8::load(&hit.uv[1]));
-        let class: [u32; W] =
-            std::array::from_fn(|l| if p.live & (1 << l) != 0 { scene.material_class[hit.shape[l] as usize] } else { u32::MAX });
-        for (first, same) in groups(p.live, |l| bits(p.live).filter(|&k| class[k] == class[l]).fold(0, |m, k| m | 1 << k)) {
+        // Without a branch per lane (a lane without a hit has shape 0, a valid index where any lane is live).
+        let class: [u32; W] = std::array::from_fn(|l| {
+            let c = scene.material_class.get(hit.shape[l] as usize).copied().unwrap_or(u32::MAX);
+            if p.live & (1 << l) != 0 {
+                c
+            } else {
+                u32::MAX
+            }
+        });
+        for (first, same) in groups(p.live, |l| p.live & lanes_where(|k| class[k] == class[l])) {
             let material = &scene.materials[hit.shape[first] as usize];
             if let Some(r) = material.diffuse_reflectance_lanes(u, v) {
                 let m = Mask8::from_bitmask(same);
@@ -318,7 +325,8 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
                 grouped |= same;
             }
         }
-        let kernels = || kernels.iter().filter_map(|&(m, k)| k.map(|k| (m, k)));
+        // (Skipped where no lanes are grouped: a loop over the eight entries whose exit the predictor misses.)
+        let kernels = || kernels[..if grouped == 0 { 0 } else { W }].iter().filter_map(|&(m, k)| k.map(|k| (m, k)));
         let (fs, ft, fn_) = (hit.s.lanes(), hit.t.lanes(), hit.ns.lanes());
         let wo = to_local(fs, ft, fn_, p.d.lanes().neg());
         let wo_rows = Rows3::from_lanes(wo);

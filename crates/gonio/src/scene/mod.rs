@@ -224,6 +224,20 @@ fn take_hits(hit: Mask8, t: Float8, slot: usize, hits_t: &mut Float8, slots: &mu
     *slots = Float8::select(hit, Float8::splat(f32::from_bits(slot as u32)), *slots);
 }
 
+/// `f(l)` for each lane `l` of `tris` (a packet's triangles): for a full packet by a fixed loop, whose
+/// exit the branch predictor does not miss as it does a loop's over the set lanes (2026-12, Cornell box:
+/// a fifth fewer simulated mispredictions). Partial packets loop over their lanes: all eight lanes, the
+/// empty ones masked off, made the material spheres' two-triangle packets 4 % more instructions and
+/// about as much slower.
+#[inline(always)]
+fn for_each_triangle(tris: u32, f: impl FnMut(usize)) {
+    if tris == (1 << LANES) - 1 {
+        (0..LANES).for_each(f);
+    } else {
+        bits(tris).for_each(f);
+    }
+}
+
 /// The scene's primitives as the BVH's packet traversal sees them.
 struct Leaves<'a> {
     prims: &'a Primitives,
@@ -256,10 +270,10 @@ impl PacketLeaves for Leaves<'_> {
                     }
                 } else {
                     let mut slots = Float8::new(hits.slot.map(f32::from_bits));
-                    for l in bits(tris) {
+                    for_each_triangle(tris, |l| {
                         let (hit, t) = tri.intersect_rays(l, rays.o, rays.d, hits.t);
                         take_hits(hit & live, t, packet * LANES + l, &mut hits.t, &mut slots);
-                    }
+                    });
                     hits.slot = slots.to_array().map(f32::to_bits);
                 }
             }
@@ -315,9 +329,7 @@ impl PacketLeaves for Leaves<'_> {
                         }
                     }
                 } else {
-                    for l in bits(tris) {
-                        blocked |= tri.intersect_rays(l, rays.o, rays.d, rays.tmax).0.bitmask() & open;
-                    }
+                    for_each_triangle(tris, |l| blocked |= tri.intersect_rays(l, rays.o, rays.d, rays.tmax).0.bitmask() & open);
                 }
             }
             if !self.prims.has_others {
