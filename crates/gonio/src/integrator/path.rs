@@ -137,9 +137,10 @@ impl Packet {
         self.beta.store(V3::select(m, V3::splat(Vec3::ONE), self.beta.lanes()));
         self.l.store(V3::select(m, V3::splat(Vec3::ZERO), self.l.lanes()));
         self.eta = Float8::select(m, Float8::splat(1.0), Float8::load(&self.eta)).to_array();
-        for (i, depth) in self.depth.iter_mut().enumerate() {
-            *depth = if lanes >> i & 1 == 1 { 0 } else { *depth };
-        }
+        // As bit patterns in float lanes, stored by `to_array`: a loop here became a masked store (slow on
+        // AMD's cores: see `Avx8::to_array`).
+        let depth = Float8::load(&self.depth.map(|d| f32::from_bits(d as u32)));
+        self.depth = Float8::select(m, Float8::splat(0.0), depth).to_array().map(|d| d.to_bits() as i32);
     }
 
     /// Lane `lane`'s path ends: its radiance goes to `out`.
