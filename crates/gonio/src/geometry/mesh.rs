@@ -430,14 +430,18 @@ struct Numerators<R: Real> {
 /// The division-free part of [`intersect_triangle_lanes`] (see there).
 #[inline(always)]
 fn triangle_numerators<R: Real>(o: V3<R>, d: V3<R>, p0: V3<R>, e2: V3<R>, ne1: V3<R>, m: V3<R>) -> Numerators<R> {
-    let det = d.dot(m);
+    // Dot and cross products by `Real::mad`: fused where the build has FMA (2026-12: about a fifth fewer
+    // instructions in this test, which is most of a Cornell box render's traversal).
+    let dot = |a: V3<R>, b: V3<R>| a.z.mad(b.z, a.y.mad(b.y, a.x * b.x));
+    let cross = |a: V3<R>, b: V3<R>| V3::new(a.y.mad(b.z, -(b.y * a.z)), a.z.mad(b.x, -(b.z * a.x)), a.x.mad(b.y, -(b.x * a.y)));
+    let det = dot(d, m);
     let tp = p0.sub(o);
-    let r = d.cross(tp);
+    let r = cross(d, tp);
     let zero = R::splat(0.0);
     // The numerators with det's sign moved onto them (a negation is exact).
     let flip = det.lt(zero);
     let flipped = |x: R| R::select(flip, -x, x);
-    let (u, v, tt, abs_det) = (flipped(e2.dot(r)), flipped(ne1.dot(r)), flipped(tp.dot(m)), det.abs());
+    let (u, v, tt, abs_det) = (flipped(dot(e2, r)), flipped(dot(ne1, r)), flipped(dot(tp, m)), det.abs());
     // Comparisons with NaN are false: degenerate lanes drop out.
     let inside = det.ne(zero) & u.ge(zero) & v.ge(zero) & (u + v).le(abs_det) & tt.gt(zero);
     Numerators { inside, u, v, tt, abs_det }

@@ -52,6 +52,19 @@ pub trait Real:
     fn clamp(self, lo: f32, hi: f32) -> Self;
     /// `f32::mul_add`: self · a + b with one rounding.
     fn mul_add(self, a: Self, b: Self) -> Self;
+    /// self · a + b for speed: fused ([`Self::mul_add`], one instruction) where the build enables FMA,
+    /// else a product and a sum (two roundings; the exact fused operation would be a library call per lane).
+    /// The choice is the build's, the same for every lane type, so that lanes still equal single calls bit
+    /// for bit within one build.
+    #[inline(always)]
+    #[must_use]
+    fn mad(self, a: Self, b: Self) -> Self {
+        if cfg!(target_feature = "fma") {
+            self.mul_add(a, b)
+        } else {
+            self * a + b
+        }
+    }
     /// `f32::round`: to the nearest integer, halves away from zero.
     fn round(self) -> Self;
     /// `f(lane)` in every lane: for scalar code (not vectorised, same results).
