@@ -417,8 +417,9 @@ pub fn intersect_triangle_lanes<R: Real>(o: V3<R>, d: V3<R>, p0: V3<R>, e2: V3<R
     (n.inside & t.gt(R::splat(0.0)) & t.lt(tmax), t, n.u / n.abs_det, n.v / n.abs_det)
 }
 
-/// The division-free part of [`intersect_triangle_lanes`]: whether the ray passes inside each triangle in
-/// front of its origin, and the numerators of b₁, b₂ and t with det's sign moved onto them, and |det|.
+/// The division-free part of [`intersect_triangle_lanes`]: whether the ray's line passes inside each
+/// triangle (the callers test t's sign), and the numerators of b₁, b₂ and t with det's sign moved onto
+/// them, and |det|.
 struct Numerators<R: Real> {
     inside: R::Mask,
     u: R,
@@ -438,12 +439,13 @@ fn triangle_numerators<R: Real>(o: V3<R>, d: V3<R>, p0: V3<R>, e2: V3<R>, ne1: V
     let tp = p0.sub(o);
     let r = cross(d, tp);
     let zero = R::splat(0.0);
-    // The numerators with det's sign moved onto them (a negation is exact).
-    let flip = det.lt(zero);
-    let flipped = |x: R| R::select(flip, -x, x);
-    let (u, v, tt, abs_det) = (flipped(dot(e2, r)), flipped(dot(ne1, r)), flipped(dot(tp, m)), det.abs());
-    // Comparisons with NaN are false: degenerate lanes drop out.
-    let inside = det.ne(zero) & u.ge(zero) & v.ge(zero) & (u + v).le(abs_det) & tt.gt(zero);
+    // The numerators with det's sign moved onto them (a negation is exact; by its sign bit, so det = −0
+    // flips them too, which changes no hit: see below).
+    let (u, v, tt, abs_det) = (dot(e2, r).xor_sign(det), dot(ne1, r).xor_sign(det), dot(tp, m).xor_sign(det), det.abs());
+    // Comparisons with NaN are false: degenerate lanes drop out. det = 0 and t ≤ 0 need no test of their
+    // own: where |det| = 0 the conditions leave only u = v = 0, and then t = tt / 0 is ±∞ or NaN, which the
+    // callers' 0 < t < tmax rejects (as it does t ≤ 0, tt ≤ 0's).
+    let inside = u.ge(zero) & v.ge(zero) & (u + v).le(abs_det);
     Numerators { inside, u, v, tt, abs_det }
 }
 

@@ -338,6 +338,10 @@ impl Real for Avx8 {
     fn abs(self) -> Self {
         Avx8::abs(self)
     }
+    #[inline(always)]
+    fn xor_sign(self, o: Self) -> Self {
+        Avx8::xor_sign(self, o)
+    }
     /// `minps(self, o)` is self < o ? self : o, the `f32` form's result but where `o` is NaN.
     #[inline(always)]
     fn min(self, o: Self) -> Self {

@@ -196,6 +196,12 @@ impl Real for Avx16 {
     fn abs(self) -> Self {
         Avx16(avx!(_mm512_abs_ps(self.0)))
     }
+    #[inline(always)]
+    fn xor_sign(self, o: Self) -> Self {
+        let (a, b) = (avx!(_mm512_castps_si512(self.0)), avx!(_mm512_castps_si512(o.0)));
+        let sign = avx!(_mm512_and_si512(b, _mm512_set1_epi32(i32::MIN)));
+        Avx16(avx!(_mm512_castsi512_ps(_mm512_xor_si512(a, sign))))
+    }
     /// `vminps(self, o)` is self < o ? self : o, the `f32` form's result but where `o` is NaN.
     #[inline(always)]
     fn min(self, o: Self) -> Self {

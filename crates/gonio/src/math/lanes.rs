@@ -67,6 +67,9 @@ pub trait Real:
     }
     /// `f32::round`: to the nearest integer, halves away from zero.
     fn round(self) -> Self;
+    /// `self` with its sign flipped where `o`'s sign bit is set (−0 and NaNs included): the bits
+    /// `self ^ (o & sign)`.
+    fn xor_sign(self, o: Self) -> Self;
     /// `f(lane)` in every lane: for scalar code (not vectorised, same results).
     fn map(self, f: impl Fn(f32) -> f32) -> Self;
     /// The piecewise-linear function through `table[k]` at k/(N − 1), on [0, 1] (arguments are clamped to
@@ -129,6 +132,10 @@ impl Real for f32 {
     #[inline(always)]
     fn round(self) -> Self {
         f32::round(self)
+    }
+    #[inline(always)]
+    fn xor_sign(self, o: Self) -> Self {
+        f32::from_bits(self.to_bits() ^ (o.to_bits() & 0x8000_0000))
     }
     #[inline(always)]
     fn map(self, f: impl Fn(f32) -> f32) -> Self {
@@ -307,6 +314,10 @@ impl Real for F32x8 {
     #[inline(always)]
     fn round(self) -> Self {
         lanes!(F32x8, |i| self.0[i].round())
+    }
+    #[inline(always)]
+    fn xor_sign(self, o: Self) -> Self {
+        lanes!(F32x8, |i| Real::xor_sign(self.0[i], o.0[i]))
     }
     #[inline(always)]
     fn map(self, f: impl Fn(f32) -> f32) -> Self {
@@ -615,6 +626,8 @@ pub(crate) fn check_lane_type<R: Rows>() {
         same(x.clamp(0.0, 1.0), &|p, _| p.clamp(0.0, 1.0), "clamp");
         same(x.mul_add(y, x), &|p, q| p.mul_add(q, p), "mul_add");
         same(x.round(), &|p, _| p.round(), "round");
+        same(x.mad(y, x), &|p, q| p.mad(q, p), "mad");
+        same(x.xor_sign(y), &|p, q| f32::from_bits(p.to_bits() ^ (q.to_bits() & 0x8000_0000)), "xor_sign");
         same(x.map(|v| v * 2.0 + 1.0), &|p, _| p * 2.0 + 1.0, "map");
         same(R::select(x.lt(y), x, y), &|p, q| if p < q { p } else { q }, "select");
         let mask = |m: R::Mask, f: &dyn Fn(f32, f32) -> bool, what: &str| {

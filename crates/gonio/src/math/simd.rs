@@ -503,6 +503,10 @@ mod common {
         fn abs(self) -> Self {
             Float8::abs(self)
         }
+        #[inline(always)]
+        fn xor_sign(self, o: Self) -> Self {
+            Float8::xor_sign(self, o)
+        }
         /// `f32::min`: `o` where `o < self`, and `o` where `self` is NaN — what `f32::min(self, o)` compiles to.
         #[inline(always)]
         fn min(self, o: Self) -> Self {

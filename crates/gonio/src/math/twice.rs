@@ -104,6 +104,10 @@ impl<R: Real> Real for Twice<R> {
     }
     unary!(sqrt, abs, round);
     #[inline(always)]
+    fn xor_sign(self, o: Self) -> Self {
+        Twice(self.0.xor_sign(o.0), self.1.xor_sign(o.1))
+    }
+    #[inline(always)]
     fn min(self, o: Self) -> Self {
         Twice(self.0.min(o.0), self.1.min(o.1))
     }
