@@ -35,7 +35,7 @@ use crate::math::simd::{Float8, Mask8};
 use crate::math::{Vec2, Vec3};
 use crate::sampling::warp::uniform_sphere;
 use crate::sampling::Pcg32x8;
-use crate::scene::surfaces::Rows3;
+use crate::scene::surfaces::{Rows3, Surfaces8};
 use crate::scene::Scene;
 use crate::spectrum::Rgb;
 use std::borrow::Cow;
@@ -199,6 +199,7 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
     }
     let n_lights = scene.lights.len();
     let mut p = Packet::new();
+    let mut hit = Surfaces8::default();
     let mut next = 0;
     loop {
         // Lanes without a path take the next camera samples, started together.
@@ -222,7 +223,7 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
         // Trace.
         let rays = RayLanes { o: p.o.lanes(), d: p.d.lanes(), tmax: Float8::load(&p.tmax) };
         let found = scene.intersect_rays(&rays, p.live);
-        let hit = scene.surfaces(&rays, &found, p.live);
+        scene.surfaces_into(&rays, &found, p.live, &mut hit);
 
         // Emission found by the ray (looked up only where the surface emits or an environment is seen), in
         // lanes L += β Le, Le zero elsewhere (as a path traced alone adds it: a non-finite β spoils the
