@@ -277,7 +277,8 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
         let (mut rho, mut rho_rows, mut diffuse, mut diffuse_rows) = ([Float8::splat(0.0); 3], Rows3::default(), 0u32, 0u32);
         let mut models: [Option<Cow<'_, Bsdf>>; W] = Default::default();
         let (u, v) = (Float8::load(&hit.uv[0]), Float8::load(&hit.uv[1]));
-        // Without a branch per lane (a lane without a hit has shape 0, a valid index where any lane is live).
+        // Without a branch per lane (a lane without a hit holds shape 0 or the shape of an earlier hit in it
+        // (`Scene::surfaces_into`): a valid index either way, and an out-of-range one would read as no class).
         let class: [u32; W] = std::array::from_fn(|l| {
             let c = scene.material_class.get(hit.shape[l] as usize).copied().unwrap_or(u32::MAX);
             if p.live & (1 << l) != 0 {
