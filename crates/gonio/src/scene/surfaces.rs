@@ -123,13 +123,17 @@ impl Scene {
         out
     }
 
-    /// [`Self::surfaces`] into `out`, a record the caller keeps from packet to packet: the lanes without a
-    /// hit keep their earlier points, normals, frames, shapes and primitives (all valid numbers and
-    /// indices), and `found`, `emits` and the texture coordinates start again from zero. (2026-12: returned
-    /// by value, the record's 616 bytes were zeroed and copied every bounce, 2 % of a material spheres
-    /// render.)
+    /// [`Self::surfaces`] of the lanes `lanes` into `out`, a record the caller keeps from packet to packet:
+    /// in those lanes `found`, `emits` and the texture coordinates start again from zero, and the lanes
+    /// without a hit keep their earlier points, normals, frames, shapes and primitives (all valid numbers
+    /// and indices); the other lanes keep all they hold (the path tracer traces some lanes again before it
+    /// shades the packet). (2026-12: returned by value, the record's 616 bytes were zeroed and copied every
+    /// bounce, 2 % of a material spheres render.)
     pub fn surfaces_into(&self, rays: &RayLanes<Float8>, hits: &Hits8, lanes: u32, out: &mut Surfaces8) {
-        (out.found, out.emits, out.uv) = (0, 0, [[0.0; LANES]; 2]);
+        (out.found, out.emits) = (out.found & !lanes, out.emits & !lanes);
+        for lane in bits(lanes) {
+            (out.uv[0][lane], out.uv[1][lane]) = (0.0, 0.0);
+        }
         let mut tris = Triangle8::default();
         // Lanes on flat triangles, and those of them whose material reads texture coordinates.
         let (mut flat, mut flat_uv) = (0u32, 0u32);
@@ -246,6 +250,45 @@ mod tests {
         </scene>"#;
         let scene = Scene::build(mitsuba_xml::load_str(CLASSES, "t.xml", Path::new("."), &[]).unwrap()).unwrap();
         assert_eq!(scene.material_class, [0, 1, 0, 0, 4, 5, 6]);
+    }
+
+    /// `surfaces_into` on some lanes fills those as `surfaces` would and leaves the other lanes as they were
+    /// (the path tracer traces the lanes that freed again before it shades).
+    #[test]
+    fn surfaces_into_keeps_other_lanes() {
+        let scene = Scene::build(mitsuba_xml::load_str(SCENE, "t.xml", Path::new("."), &[]).unwrap()).unwrap();
+        let mut rng = Pcg32::new(5, 2);
+        let random_rays = |rng: &mut Pcg32| {
+            let rays: [Ray; LANES] = std::array::from_fn(|_| {
+                let o = Vec3::new(rng.next_f32() * 4.0 - 2.0, rng.next_f32() * 2.0, 3.0);
+                let target = Vec3::new(rng.next_f32() * 4.0 - 2.0, rng.next_f32() * 2.0 - 1.0, rng.next_f32() * 2.0 - 1.5);
+                Ray::new(o, (target - o).normalize(), f32::INFINITY)
+            });
+            RayLanes::from_rays(&rays)
+        };
+        let (mut kept, mut refilled) = (0, 0);
+        for _ in 0..100 {
+            let (first, second) = (random_rays(&mut rng), random_rays(&mut rng));
+            let mut record = scene.surfaces(&first, &scene.intersect_rays(&first, 0xff), 0xff);
+            let before = record;
+            let again = rng.next_u32() & 0xff;
+            scene.surfaces_into(&second, &scene.intersect_rays(&second, again), again, &mut record);
+            let want = scene.surfaces(&second, &scene.intersect_rays(&second, again), again);
+            for lane in 0..LANES {
+                let (from, bit) = (if again & (1 << lane) != 0 { &want } else { &before }, 1 << lane);
+                assert_eq!(record.found & bit, from.found & bit, "lane {lane}");
+                assert_eq!(record.emits & bit, from.emits & bit, "lane {lane}");
+                if from.found & bit != 0 {
+                    assert_eq!(record.interaction(lane, 1.0), from.interaction(lane, 1.0), "lane {lane}");
+                    if again & bit != 0 {
+                        refilled += 1;
+                    } else {
+                        kept += 1;
+                    }
+                }
+            }
+        }
+        assert!(kept > 100 && refilled > 100, "{kept} lanes kept, {refilled} traced again");
     }
 
     /// Each lane of [`Scene::surfaces`] is the interaction [`Scene::intersect`] finds for its ray alone: the
