@@ -273,12 +273,13 @@ impl Mesh {
         }
         let mut t = FlatTriangles8 {
             thresholds: [f32::INFINITY; LANES],
+            threshold_count: 0,
             vertices: [[[0.0; LANES]; 3]; 3],
             normals: [[0.0; LANES]; 3],
             density: 1.0 / self.area,
         };
         for (k, th) in self.areas.index_thresholds().into_iter().enumerate() {
-            t.thresholds[k] = th;
+            (t.thresholds[k], t.threshold_count) = (th, k + 1);
         }
         for tri in 0..n {
             for (rows, v) in t.vertices.iter_mut().zip(self.vertices(tri as u32)) {
@@ -322,8 +323,9 @@ const LANES: usize = 8;
 /// same choice and vertices as [`Mesh::sample_flat_triangle`] per lane.
 #[derive(Clone, Debug)]
 pub struct FlatTriangles8 {
-    /// The area CDF's [`Distribution1D::index_thresholds`], +∞ after them.
+    /// The area CDF's [`Distribution1D::index_thresholds`], +∞ after them, and how many there are.
     thresholds: [f32; LANES],
+    threshold_count: usize,
     /// `vertices[v][axis][triangle]`.
     vertices: [[[f32; LANES]; 3]; 3],
     /// `normals[axis][triangle]`: the unit geometric normals.
@@ -338,8 +340,11 @@ impl FlatTriangles8 {
     #[must_use]
     pub fn sample(&self, uc: Float8) -> ([V3<Float8>; 3], V3<Float8>) {
         let (zero, one) = (Float8::splat(0.0), Float8::splat(1.0));
-        // The index: how many thresholds lie at or below uc (at most seven; +∞ never does).
-        let index = self.thresholds[..LANES - 1].iter().fold(zero, |k, &t| k + Float8::select(uc.ge(Float8::splat(t)), one, zero));
+        // The index: how many thresholds lie at or below uc (at most seven; the +∞ after them never do, and
+        // are not compared: a rectangle has one threshold).
+        let index = self.thresholds[..self.threshold_count.min(LANES - 1)]
+            .iter()
+            .fold(zero, |k, &t| k + Float8::select(uc.ge(Float8::splat(t)), one, zero));
         let row = |r: &[[f32; LANES]; 3]| {
             let v = lane_rows(r);
             V3::new(v.x.permute(index), v.y.permute(index), v.z.permute(index))

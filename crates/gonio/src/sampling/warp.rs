@@ -30,7 +30,8 @@ pub fn concentric_disk<R: Real>(ux: R, uy: R) -> (R, R) {
     // or π/2 − π/4 · (x/y) about the y axis, whose cosine and sine are the sine and cosine of π/4 · (x/y).
     // Either way the angle to evaluate is in [−π/4, π/4], where a short polynomial is exact to f32.
     let x_major = ox.abs().gt(oy.abs());
-    let (r, t) = (R::select(x_major, ox, oy), R::select(x_major, oy / ox, ox / oy));
+    // (One division of the selected operands: the same quotient in each lane as selecting between two.)
+    let (r, t) = (R::select(x_major, ox, oy), R::select(x_major, oy, ox) / R::select(x_major, ox, oy));
     let (s, c) = sin_cos_quarter(t * FRAC_PI_4);
     let (x, y) = (r * R::select(x_major, c, s), r * R::select(x_major, s, c));
     // The centre (where t is 0/0).
