@@ -30,8 +30,13 @@ impl Scene {
         for p in &desc.shapes {
             shapes.push(shape_from_props(p)?);
             let nested = p.nested_of("bsdf");
+            // Without a <bsdf>, Mitsuba 3 gives a shape a `diffuse` of reflectance 0.5, and an emitting shape
+            // one of reflectance 0 (its `Shape` constructor): a light that reflects nothing. (Until
+            // 2026-12-03 gonio gave lights 0.5 too: the material spheres' light reflected the floor's light
+            // back onto it: 0.4 % of the image's mean, 1 % of the near floor's brightness, against Mitsuba's.)
+            let default_reflectance = if p.nested_of("emitter").is_empty() { 0.5 } else { 0.0 };
             materials.push(match nested.as_slice() {
-                [] => Material::Fixed(Bsdf::Diffuse(Diffuse::new(Rgb::splat(0.5)))),
+                [] => Material::Fixed(Bsdf::Diffuse(Diffuse::new(Rgb::splat(default_reflectance)))),
                 [one] => Material::from_props(one)?,
                 [_, second, ..] => return Err(Error::spec(second.at(), "a shape takes one <bsdf>")),
             });
@@ -187,4 +192,27 @@ fn integrator_from_props(p: &Props) -> Result<IntegratorKind> {
     };
     p.finish()?;
     Ok(kind)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::mitsuba_xml;
+    use std::path::Path;
+
+    /// A shape without a `<bsdf>` is a `diffuse` of reflectance 0.5, or 0 where it emits (as in Mitsuba 3);
+    /// a `<bsdf>` given to an emitting shape is kept.
+    #[test]
+    fn default_bsdf_is_black_on_emitters() {
+        const SCENE: &str = r#"<scene version="3.0.0">
+            <sensor type="perspective"><film type="hdrfilm"><integer name="width" value="4"/><integer name="height" value="4"/></film></sensor>
+            <shape type="rectangle"/>
+            <shape type="rectangle"><emitter type="area"><rgb name="radiance" value="1"/></emitter></shape>
+            <shape type="rectangle"><bsdf type="diffuse"><rgb name="reflectance" value="0.3"/></bsdf>
+                <emitter type="area"><rgb name="radiance" value="1"/></emitter></shape>
+        </scene>"#;
+        let scene = Scene::build(mitsuba_xml::load_str(SCENE, "t.xml", Path::new("."), &[]).unwrap()).unwrap();
+        let reflectance: Vec<Option<Rgb>> = scene.materials.iter().map(|m| m.diffuse_reflectance(glam::Vec2::ZERO)).collect();
+        assert_eq!(reflectance, [Some(Rgb::splat(0.5)), Some(Rgb::splat(0.0)), Some(Rgb::splat(0.3))]);
+    }
 }
