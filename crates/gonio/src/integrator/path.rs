@@ -197,8 +197,8 @@ fn power_heuristic_1(f: Float8, g: Float8) -> Float8 {
 /// shading phases cost about the same for a few lanes as for eight, a trace of a few rays less than one of
 /// eight (a lone ray traverses alone). 2026-12: on the material spheres 45 % of the rays traced escape to
 /// the sky (a floor bounce, mostly), and with shading at once the packets shaded 4.4 lanes on average;
-/// with 6 here the render took 14.2 % fewer instructions and 0.74–0.79 × the time (alternated with the
-/// build before), with 5, 7 and 8 within a percent of that in instructions (8 the most); the Cornell box
+/// with 6 here the render took 14.2 % fewer instructions and 0.79–0.82 × the time (two alternations
+/// with the build before), with 5, 7 and 8 within a percent of that in instructions (8 the most); the Cornell box
 /// (16 % escape) the same within 0.3 %. Images are the same: each path draws from its own stream.
 const MIN_READY: u32 = 6;
 
