@@ -29,18 +29,17 @@ impl Scene {
         let mut lights = Vec::new();
         for p in &desc.shapes {
             shapes.push(shape_from_props(p)?);
-            let nested = p.nested_of("bsdf");
+            let (nested, emitters) = (p.nested_of("bsdf"), p.nested_of("emitter"));
             // Without a <bsdf>, Mitsuba 3 gives a shape a `diffuse` of reflectance 0.5, and an emitting shape
             // one of reflectance 0 (its `Shape` constructor): a light that reflects nothing. (Until
             // 2026-12-03 gonio gave lights 0.5 too: the material spheres' light reflected the floor's light
             // back onto it: 0.4 % of the image's mean, 1 % of the near floor's brightness, against Mitsuba's.)
-            let default_reflectance = if p.nested_of("emitter").is_empty() { 0.5 } else { 0.0 };
+            let default_reflectance = if emitters.is_empty() { 0.5 } else { 0.0 };
             materials.push(match nested.as_slice() {
                 [] => Material::Fixed(Bsdf::Diffuse(Diffuse::new(Rgb::splat(default_reflectance)))),
                 [one] => Material::from_props(one)?,
                 [_, second, ..] => return Err(Error::spec(second.at(), "a shape takes one <bsdf>")),
             });
-            let emitters = p.nested_of("emitter");
             shape_lights.push(match emitters.as_slice() {
                 [] => None,
                 [e] => {

@@ -233,6 +233,15 @@ mod tests {
         <shape type="disk"><transform name="to_world"><translate z="-1.5"/></transform></shape>
     </scene>"#;
 
+    /// Eight rays from above the scene of [`SCENE`] towards its shapes.
+    fn random_rays(rng: &mut Pcg32) -> [Ray; LANES] {
+        std::array::from_fn(|_| {
+            let o = Vec3::new(rng.next_f32() * 4.0 - 2.0, rng.next_f32() * 2.0, 3.0);
+            let target = Vec3::new(rng.next_f32() * 4.0 - 2.0, rng.next_f32() * 2.0 - 1.0, rng.next_f32() * 2.0 - 1.5);
+            Ray::new(o, (target - o).normalize(), f32::INFINITY)
+        })
+    }
+
     /// Shapes with the same constant `diffuse` reflectance (through a `<ref>` or equal values) share a
     /// material class; textured, other and differently coloured materials have their own.
     #[test]
@@ -258,17 +267,9 @@ mod tests {
     fn surfaces_into_keeps_other_lanes() {
         let scene = Scene::build(mitsuba_xml::load_str(SCENE, "t.xml", Path::new("."), &[]).unwrap()).unwrap();
         let mut rng = Pcg32::new(5, 2);
-        let random_rays = |rng: &mut Pcg32| {
-            let rays: [Ray; LANES] = std::array::from_fn(|_| {
-                let o = Vec3::new(rng.next_f32() * 4.0 - 2.0, rng.next_f32() * 2.0, 3.0);
-                let target = Vec3::new(rng.next_f32() * 4.0 - 2.0, rng.next_f32() * 2.0 - 1.0, rng.next_f32() * 2.0 - 1.5);
-                Ray::new(o, (target - o).normalize(), f32::INFINITY)
-            });
-            RayLanes::from_rays(&rays)
-        };
         let (mut kept, mut refilled) = (0, 0);
         for _ in 0..100 {
-            let (first, second) = (random_rays(&mut rng), random_rays(&mut rng));
+            let (first, second) = (RayLanes::from_rays(&random_rays(&mut rng)), RayLanes::from_rays(&random_rays(&mut rng)));
             let mut record = scene.surfaces(&first, &scene.intersect_rays(&first, 0xff), 0xff);
             let before = record;
             let again = rng.next_u32() & 0xff;
@@ -299,12 +300,7 @@ mod tests {
         let mut rng = Pcg32::new(3, 9);
         let (mut flat, mut other, mut emitting) = (0, 0, 0);
         for _ in 0..200 {
-            let mut rays = [Ray::new(Vec3::ZERO, Vec3::Z, f32::INFINITY); LANES];
-            for r in &mut rays {
-                let o = Vec3::new(rng.next_f32() * 4.0 - 2.0, rng.next_f32() * 2.0, 3.0);
-                let target = Vec3::new(rng.next_f32() * 4.0 - 2.0, rng.next_f32() * 2.0 - 1.0, rng.next_f32() * 2.0 - 1.5);
-                *r = Ray::new(o, (target - o).normalize(), f32::INFINITY);
-            }
+            let rays = random_rays(&mut rng);
             let lanes = RayLanes::from_rays(&rays);
             let live = 0b1011_1111;
             let hits = scene.intersect_rays(&lanes, live);
