@@ -170,6 +170,62 @@ impl Mesh {
         [p0, p1 - p0, p2 - p0]
     }
 
+    /// Whether triangles `tri` and `tri + 1` form a flat parallelogram that can be intersected as one
+    /// primitive (a `rectangle`, a `cube`'s face, a quad of a mesh file split along a diagonal), and if so
+    /// the corner k of triangle `tri` opposite the shared diagonal: the parallelogram is
+    /// [`Self::corner_edges`]`(tri, k)` with b₁, b₂ in [0, 1], and its points have the barycentrics
+    /// [`parallelogram_barycentrics`] in triangle `tri`. Only where nothing on it changes: the mesh is
+    /// flat-shaded, the two triangles share two vertices, the fourth vertex is where the parallelogram's
+    /// is and the shading frames are the same (to 10⁻⁵ of the edges and of unit length), and, when
+    /// `uv_matters`, the texture coordinates are affine over it (the fourth vertex's as extrapolated from
+    /// triangle `tri`; without any, uv would be each triangle's own barycentrics).
+    #[must_use]
+    pub fn parallelogram(&self, tri: u32, uv_matters: bool) -> Option<u8> {
+        const TOLERANCE: f32 = 1e-5;
+        let (a, b) = (tri as usize, tri as usize + 1);
+        if b >= self.indices.len() || self.flat_frames.is_empty() || (uv_matters && self.uvs.is_none()) {
+            return None;
+        }
+        let (ia, ib) = (self.indices[a], self.indices[b]);
+        // The corner of `a` not in `b`, and the vertex of `b` not in `a`: exactly one each.
+        let mut corners = (0..3).filter(|&k| !ib.contains(&ia[k]));
+        let (Some(k), None) = (corners.next(), corners.next()) else { return None };
+        let mut fourth = ib.iter().filter(|&i| !ia.contains(i));
+        let (Some(&d), None) = (fourth.next(), fourth.next()) else { return None };
+        let (c, v1, v2) = (ia[k], ia[(k + 1) % 3], ia[(k + 2) % 3]);
+        if ia[(k + 1) % 3] == ia[(k + 2) % 3] || self.tri_normals[a] == Vec3::ZERO || self.tri_normals[b] == Vec3::ZERO {
+            return None;
+        }
+        let p = |i: u32| self.positions[i as usize];
+        let size = (p(v1) - p(c)).length().max((p(v2) - p(c)).length());
+        if (p(v1) + p(v2) - p(c) - p(d)).length() > TOLERANCE * size {
+            return None;
+        }
+        let (fa, fb) = (&self.flat_frames[a], &self.flat_frames[b]);
+        if [(fa.s, fb.s), (fa.t, fb.t), (fa.n, fb.n)].iter().any(|(x, y)| (*x - *y).length() > TOLERANCE) {
+            return None;
+        }
+        if let (true, Some(uvs)) = (uv_matters, &self.uvs) {
+            let uv = |i: u32| uvs[i as usize];
+            let scale = (uv(v1) - uv(c)).length().max((uv(v2) - uv(c)).length());
+            if (uv(v1) + uv(v2) - uv(c) - uv(d)).length() > TOLERANCE * scale {
+                return None;
+            }
+        }
+        Some(k as u8)
+    }
+
+    /// Triangle `tri` as (p_k, p_{k+1} − p_k, p_{k+2} − p_k), from its corner `k` (indices mod 3): for
+    /// k = 0, [`Self::triangle_edges`].
+    #[inline]
+    #[must_use]
+    pub fn corner_edges(&self, tri: u32, k: u8) -> [Vec3; 3] {
+        let v = self.vertices(tri);
+        let k = usize::from(k);
+        let c = v[k];
+        [c, v[(k + 1) % 3] - c, v[(k + 2) % 3] - c]
+    }
+
     /// `uv` of the hit holds the barycentrics (b₁, b₂).
     #[inline]
     #[must_use]
@@ -353,6 +409,21 @@ impl FlatTriangles8 {
     }
 }
 
+/// The barycentrics (b₁, b₂) in a triangle of the point at (s, t) along the edges from its corner `k`
+/// ([`Mesh::corner_edges`]): the weights of corners k, k + 1, k + 2 are 1 − s − t, s, t. For the
+/// parallelogram of [`Mesh::parallelogram`] they extrapolate beyond the triangle (a weight below zero),
+/// which is exact for what is affine over it.
+#[inline]
+#[must_use]
+pub fn parallelogram_barycentrics(k: u8, st: Vec2) -> Vec2 {
+    let rest = 1.0 - st.x - st.y;
+    match k {
+        0 => st,
+        1 => Vec2::new(rest, st.x),
+        _ => Vec2::new(st.y, rest),
+    }
+}
+
 /// The point p₀ + b₁ e₁ + b₂ e₂ of the triangle with corner p₀ and edges e₁, e₂, in lanes. From the
 /// barycentrics rather than as o + t d, which is less accurate (pbrt-v4 §6.8.6).
 #[inline(always)]
@@ -403,17 +474,29 @@ fn angle_weighted_normals(positions: &[Vec3], indices: &[[u32; 3]]) -> Vec<Vec3>
 pub fn intersect_triangle(p0: Vec3, e1: Vec3, e2: Vec3, ray: &Ray) -> Option<PrimHit> {
     let (ne1, m) = (-e1, e2.cross(e1));
     let (hit, t, b1, b2) =
-        intersect_triangle_lanes::<f32>(ray.o.into(), ray.d.into(), p0.into(), e2.into(), ne1.into(), m.into(), ray.tmax);
+        intersect_triangle_lanes::<f32>(ray.o.into(), ray.d.into(), p0.into(), e2.into(), ne1.into(), m.into(), 1.0, ray.tmax);
     hit.then_some(PrimHit { t, uv: Vec2::new(b1, b2) })
 }
 
 /// [`intersect_triangle`] in lanes — of triangles for one ray ([`Triangle8`]) or of rays for one triangle —
 /// with the per-triangle terms precomputed (−e₁ and m = e₂ × e₁), the same operations in every lane: the
-/// lanes hit within (0, tmax), and their t, b₁, b₂ (meaningful in those lanes only).
+/// lanes hit within (0, tmax), and their t, b₁, b₂ (meaningful in those lanes only). `diagonal` is 1 for
+/// the triangle, and 0 for the parallelogram p₀ + b₁ e₁ + b₂ e₂ with b₁, b₂ in [0, 1] (two triangles of a
+/// mesh tested as one: [`Mesh::parallelogram`]); see [`triangle_numerators`].
 #[inline(always)]
 #[must_use]
-pub fn intersect_triangle_lanes<R: Real>(o: V3<R>, d: V3<R>, p0: V3<R>, e2: V3<R>, ne1: V3<R>, m: V3<R>, tmax: R) -> (R::Mask, R, R, R) {
-    let n = triangle_numerators(o, d, p0, e2, ne1, m);
+#[allow(clippy::too_many_arguments)] // the ray and the precomputed terms of the test
+pub fn intersect_triangle_lanes<R: Real>(
+    o: V3<R>,
+    d: V3<R>,
+    p0: V3<R>,
+    e2: V3<R>,
+    ne1: V3<R>,
+    m: V3<R>,
+    diagonal: R,
+    tmax: R,
+) -> (R::Mask, R, R, R) {
+    let n = triangle_numerators(o, d, p0, e2, ne1, m, diagonal);
     if !R::any(n.inside) {
         let zero = R::splat(0.0);
         return (n.inside, zero, zero, zero);
@@ -433,9 +516,12 @@ struct Numerators<R: Real> {
     abs_det: R,
 }
 
-/// The division-free part of [`intersect_triangle_lanes`] (see there).
+/// The division-free part of [`intersect_triangle_lanes`] (see there). The far side is b₁ + b₂ ≤ 1 for a
+/// triangle and b₁ ≤ 1, b₂ ≤ 1 for a parallelogram, tested for both as b₁ + `diagonal` · b₂ ≤ 1 and
+/// b₂ ≤ 1 (which b₁ ≥ 0 and b₁ + b₂ ≤ 1 imply for a triangle; its sum is the same bits as before,
+/// 1 · b₂ + b₁ being b₁ + b₂ rounded once).
 #[inline(always)]
-fn triangle_numerators<R: Real>(o: V3<R>, d: V3<R>, p0: V3<R>, e2: V3<R>, ne1: V3<R>, m: V3<R>) -> Numerators<R> {
+fn triangle_numerators<R: Real>(o: V3<R>, d: V3<R>, p0: V3<R>, e2: V3<R>, ne1: V3<R>, m: V3<R>, diagonal: R) -> Numerators<R> {
     // Dot and cross products by `Real::mad`: fused where the build has FMA (2026-12: about a fifth fewer
     // instructions in this test, which is most of a Cornell box render's traversal).
     let dot = |a: V3<R>, b: V3<R>| a.z.mad(b.z, a.y.mad(b.y, a.x * b.x));
@@ -450,7 +536,7 @@ fn triangle_numerators<R: Real>(o: V3<R>, d: V3<R>, p0: V3<R>, e2: V3<R>, ne1: V
     // Comparisons with NaN are false: degenerate lanes drop out. det = 0 and t ≤ 0 need no test of their
     // own: where |det| = 0 the conditions leave only u = v = 0, and then t = tt / 0 is ±∞ or NaN, which the
     // callers' 0 < t < tmax rejects (as it does t ≤ 0, tt ≤ 0's).
-    let inside = u.ge(zero) & v.ge(zero) & (u + v).le(abs_det);
+    let inside = u.ge(zero) & v.ge(zero) & diagonal.mad(v, u).le(abs_det) & v.le(abs_det);
     Numerators { inside, u, v, tt, abs_det }
 }
 
@@ -462,8 +548,18 @@ fn triangle_numerators<R: Real>(o: V3<R>, d: V3<R>, p0: V3<R>, e2: V3<R>, ne1: V
 /// [`Triangle8::any`] on this than on the branching test; and a packet's rays against one triangle,
 /// [`Triangle8::intersect_rays`], the same way: see `RAYS_PER_TRIANGLE` in `scene`).
 #[inline(always)]
-fn intersect_triangle_lanes_t<R: Real>(o: V3<R>, d: V3<R>, p0: V3<R>, e2: V3<R>, ne1: V3<R>, m: V3<R>, tmax: R) -> (R::Mask, R) {
-    let n = triangle_numerators(o, d, p0, e2, ne1, m);
+#[allow(clippy::too_many_arguments)] // the ray and the precomputed terms of the test
+fn intersect_triangle_lanes_t<R: Real>(
+    o: V3<R>,
+    d: V3<R>,
+    p0: V3<R>,
+    e2: V3<R>,
+    ne1: V3<R>,
+    m: V3<R>,
+    diagonal: R,
+    tmax: R,
+) -> (R::Mask, R) {
+    let n = triangle_numerators(o, d, p0, e2, ne1, m, diagonal);
     let t = n.tt / n.abs_det;
     (n.inside & t.gt(R::splat(0.0)) & t.lt(tmax), t)
 }
@@ -477,7 +573,8 @@ fn lane_rows(r: &[[f32; 8]; 3]) -> V3<Float8> {
 /// Eight triangles in structure-of-arrays form, for [`intersect_triangle`] on eight at once (see
 /// [`Float8`] for the registers that takes), with its per-triangle terms precomputed: p₀, e₂, −e₁ and
 /// m = e₂ × e₁, each as rows x, y, z of eight lanes. Lanes without a triangle are zero, which the test
-/// rejects (determinant 0).
+/// rejects (determinant 0). A lane may hold a parallelogram instead (two triangles of a mesh:
+/// [`Mesh::parallelogram`]), its `diagonal` 0 rather than 1 ([`intersect_triangle_lanes`]).
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(32))]
 pub struct Triangle8 {
@@ -485,12 +582,13 @@ pub struct Triangle8 {
     e2: [[f32; 8]; 3],
     neg_e1: [[f32; 8]; 3],
     m: [[f32; 8]; 3],
+    diagonal: [f32; 8],
 }
 
 impl Default for Triangle8 {
     fn default() -> Self {
         let zero = [[0.0; 8]; 3];
-        Triangle8 { p0: zero, e2: zero, neg_e1: zero, m: zero }
+        Triangle8 { p0: zero, e2: zero, neg_e1: zero, m: zero, diagonal: [1.0; 8] }
     }
 }
 
@@ -504,8 +602,9 @@ pub struct Hit8 {
 }
 
 impl Triangle8 {
-    /// Put the triangle (p₀, e₁ = p₁ − p₀, e₂ = p₂ − p₀) in lane `lane`.
-    pub fn set(&mut self, lane: usize, [p0, e1, e2]: [Vec3; 3]) {
+    /// Put the triangle (p₀, e₁ = p₁ − p₀, e₂ = p₂ − p₀) in lane `lane`, or with `parallelogram` the
+    /// parallelogram p₀ + b₁ e₁ + b₂ e₂, b₁, b₂ in [0, 1].
+    pub fn set(&mut self, lane: usize, [p0, e1, e2]: [Vec3; 3], parallelogram: bool) {
         // The same f32 operations as in `intersect_triangle`, so that lanes agree with it bit for bit.
         let (ne1, m) = (-e1, e2.cross(e1));
         for axis in 0..3 {
@@ -514,6 +613,7 @@ impl Triangle8 {
             self.neg_e1[axis][lane] = ne1[axis];
             self.m[axis][lane] = m[axis];
         }
+        self.diagonal[lane] = if parallelogram { 0.0 } else { 1.0 };
     }
 
     /// The triangle in lane `lane` as (p₀, e₁, e₂), the arguments of [`intersect_triangle`] it was set from.
@@ -524,12 +624,39 @@ impl Triangle8 {
         [row(&self.p0), -row(&self.neg_e1), row(&self.e2)]
     }
 
+    /// Lane `lane`'s triangle or parallelogram against one ray, by the scalar test: the hit within
+    /// (0, ray.tmax), its `uv` the coordinates (b₁, b₂) along e₁ and e₂.
+    #[inline]
+    #[must_use]
+    pub fn intersect_lane(&self, lane: usize, ray: &Ray) -> Option<PrimHit> {
+        let row = |r: &[[f32; 8]; 3]| V3::new(r[0][lane], r[1][lane], r[2][lane]);
+        let (hit, t, b1, b2) = intersect_triangle_lanes::<f32>(
+            ray.o.into(),
+            ray.d.into(),
+            row(&self.p0),
+            row(&self.e2),
+            row(&self.neg_e1),
+            row(&self.m),
+            self.diagonal[lane],
+            ray.tmax,
+        );
+        hit.then_some(PrimHit { t, uv: Vec2::new(b1, b2) })
+    }
+
+    /// The point p₀ + b₁ e₁ + b₂ e₂ of lane `lane`, as [`Self::points_hit`] computes it.
+    #[inline]
+    #[must_use]
+    pub fn point_at(&self, lane: usize, b: Vec2) -> Vec3 {
+        let [p0, e1, e2] = self.edges(lane);
+        barycentric_point::<f32>(p0.into(), e1.into(), e2.into(), b.x, b.y).into()
+    }
+
     /// [`intersect_triangle`] on all eight lanes, operation for operation, up to the comparisons: the
     /// lanes hit within (0, tmax) and their t, b₁, b₂ (as the scalar test computes them).
     #[inline(always)]
     fn lanes(&self, ray: &Ray, tmax: f32) -> (Mask8, Float8, Float8, Float8) {
         let (p0, e2, ne1, m) = (lane_rows(&self.p0), lane_rows(&self.e2), lane_rows(&self.neg_e1), lane_rows(&self.m));
-        intersect_triangle_lanes(V3::splat(ray.o), V3::splat(ray.d), p0, e2, ne1, m, Float8::splat(tmax))
+        intersect_triangle_lanes(V3::splat(ray.o), V3::splat(ray.d), p0, e2, ne1, m, Float8::load(&self.diagonal), Float8::splat(tmax))
     }
 
     /// Put lane `from` of `src` in lane `lane`.
@@ -541,6 +668,7 @@ impl Triangle8 {
             self.neg_e1[axis][lane] = src.neg_e1[axis][from];
             self.m[axis][lane] = src.m[axis][from];
         }
+        self.diagonal[lane] = src.diagonal[from];
     }
 
     /// Each lane's triangle against the same lane's ray, for rays known to hit them (a packet's closest
@@ -550,7 +678,8 @@ impl Triangle8 {
     #[must_use]
     pub fn points_hit(&self, o: V3<Float8>, d: V3<Float8>) -> (V3<Float8>, Float8, Float8) {
         let (p0, e2, ne1) = (lane_rows(&self.p0), lane_rows(&self.e2), lane_rows(&self.neg_e1));
-        let (_, _, b1, b2) = intersect_triangle_lanes(o, d, p0, e2, ne1, lane_rows(&self.m), Float8::splat(f32::INFINITY));
+        let (_, _, b1, b2) =
+            intersect_triangle_lanes(o, d, p0, e2, ne1, lane_rows(&self.m), Float8::load(&self.diagonal), Float8::splat(f32::INFINITY));
         (barycentric_point(p0, ne1.neg(), e2, b1, b2), b1, b2)
     }
 
@@ -558,7 +687,7 @@ impl Triangle8 {
     #[inline(always)]
     fn lanes_t(&self, ray: &Ray, tmax: f32) -> (Mask8, Float8) {
         let (p0, e2, ne1, m) = (lane_rows(&self.p0), lane_rows(&self.e2), lane_rows(&self.neg_e1), lane_rows(&self.m));
-        intersect_triangle_lanes_t(V3::splat(ray.o), V3::splat(ray.d), p0, e2, ne1, m, Float8::splat(tmax))
+        intersect_triangle_lanes_t(V3::splat(ray.o), V3::splat(ray.d), p0, e2, ne1, m, Float8::load(&self.diagonal), Float8::splat(tmax))
     }
 
     /// Whether lane `lane` holds a triangle (padding and other shapes are zero).
@@ -575,7 +704,16 @@ impl Triangle8 {
     #[must_use]
     pub fn intersect_rays(&self, lane: usize, o: V3<Float8>, d: V3<Float8>, tmax: Float8) -> (Mask8, Float8) {
         let row = |r: &[[f32; 8]; 3]| V3::new(Float8::splat(r[0][lane]), Float8::splat(r[1][lane]), Float8::splat(r[2][lane]));
-        intersect_triangle_lanes_t(o, d, row(&self.p0), row(&self.e2), row(&self.neg_e1), row(&self.m), tmax)
+        intersect_triangle_lanes_t(
+            o,
+            d,
+            row(&self.p0),
+            row(&self.e2),
+            row(&self.neg_e1),
+            row(&self.m),
+            Float8::splat(self.diagonal[lane]),
+            tmax,
+        )
     }
 
     /// The lanes hit within (0, tmax), with their distances and barycentrics.
@@ -738,14 +876,15 @@ mod tests {
             let tris: Vec<[Vec3; 3]> = (0..7).map(|_| [v(), v() * 0.7, v() * 0.7]).collect();
             let mut packet = Triangle8::default();
             for (lane, t) in tris.iter().enumerate() {
-                packet.set(lane, *t);
+                packet.set(lane, *t, lane % 3 == 1);
             }
             let ray =
                 Ray::new(v() * 3.0, crate::sampling::warp::sample_uniform_sphere(Vec2::new(v().x * 0.5 + 0.5, v().y * 0.5 + 0.5)), 4.0);
             let h = packet.intersect(&ray, ray.tmax);
             assert_eq!(h.mask & 128, 0, "the empty lane is never hit");
             for (lane, t) in tris.iter().enumerate() {
-                let scalar = intersect_triangle(t[0], t[1], t[2], &ray);
+                // Parallelograms (every third lane) against the scalar test of their lane.
+                let scalar = if lane % 3 == 1 { packet.intersect_lane(lane, &ray) } else { intersect_triangle(t[0], t[1], t[2], &ray) };
                 assert_eq!(scalar.is_some(), h.mask & (1 << lane) != 0);
                 if let Some(s) = scalar {
                     assert_eq!((s.t, s.uv.x, s.uv.y), (h.t[lane], h.b1[lane], h.b2[lane]));
@@ -765,7 +904,7 @@ mod tests {
             let tris: Vec<[Vec3; 3]> = (0..7).map(|_| [v(), v() * 0.7, v() * 0.7]).collect();
             let mut packet = Triangle8::default();
             for (lane, t) in tris.iter().enumerate() {
-                packet.set(lane, *t);
+                packet.set(lane, *t, lane % 3 == 1);
             }
             // Each ray aimed near a point of one of the triangles (barycentrics in [-0.2, 1.2]: some
             // miss), with a length that sometimes ends before it.
@@ -783,7 +922,11 @@ mod tests {
                 let (hit, t) = packet.intersect_rays(lane, o, d, tmax);
                 let (hit, t) = (hit.bitmask(), t.to_array());
                 for (i, ray) in rays.iter().enumerate() {
-                    let scalar = tris.get(lane).and_then(|tri| intersect_triangle(tri[0], tri[1], tri[2], ray));
+                    let scalar = match tris.get(lane) {
+                        Some(_) if lane % 3 == 1 => packet.intersect_lane(lane, ray),
+                        Some(tri) => intersect_triangle(tri[0], tri[1], tri[2], ray),
+                        None => None,
+                    };
                     assert_eq!(scalar.is_some(), hit & (1 << i) != 0, "triangle {lane}, ray {i}");
                     if let Some(s) = scalar {
                         assert_eq!(s.t.to_bits(), t[i].to_bits());
@@ -793,5 +936,87 @@ mod tests {
             }
         }
         assert!(hits > 1000, "only {hits} hits: the test would not show a wrong distance");
+    }
+
+    /// A parallelogram lane is hit where one of its two triangles is: rays are classified by where they
+    /// cross its plane (in f64), those within 10⁻⁴ of its border skipped, and the hit's distance and
+    /// coordinates agree with that crossing.
+    #[test]
+    fn parallelogram_is_its_two_triangles() {
+        let mut rng = crate::sampling::Pcg32::new(5, 11);
+        let mut v = || Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 2.0 - Vec3::ONE;
+        let (mut inside, mut outside) = (0, 0);
+        for _ in 0..4000 {
+            let (p0, e1, e2) = (v(), v(), v());
+            let mut packet = Triangle8::default();
+            packet.set(3, [p0, e1, e2], true);
+            // Aimed at coordinates in [-0.3, 1.3]².
+            let (o, st) = (v() * 4.0, Vec2::new(v().x, v().y) * 0.8 + Vec2::splat(0.5));
+            let target = p0 + e1 * st.x + e2 * st.y;
+            let ray = Ray::new(o, (target - o).normalize(), 100.0);
+            // The crossing in f64: o + t d = p0 + s e1 + u e2.
+            let f = |a: Vec3| a.as_dvec3();
+            let (d, e1d, e2d) = (f(ray.d), f(e1), f(e2));
+            let n = e1d.cross(e2d);
+            let t = n.dot(f(p0) - f(ray.o)) / n.dot(d);
+            let q = f(ray.o) + d * t - f(p0);
+            let (s_, u_) = (q.cross(e2d).dot(n) / n.length_squared(), e1d.cross(q).dot(n) / n.length_squared());
+            let margin = [s_, u_, 1.0 - s_, 1.0 - u_].into_iter().fold(f64::INFINITY, f64::min);
+            if margin.abs() < 1e-4 || n.length() < 1e-3 || t < 1e-3 {
+                continue;
+            }
+            let hit = packet.intersect_lane(3, &ray);
+            assert_eq!(hit.is_some(), margin > 0.0, "crossing at ({s_}, {u_})");
+            let Some(hit) = hit else {
+                outside += 1;
+                continue;
+            };
+            inside += 1;
+            assert!((f64::from(hit.t) - t).abs() < 1e-3 * t, "t {} against {t}", hit.t);
+            assert!((f64::from(hit.uv.x) - s_).abs() < 1e-3 && (f64::from(hit.uv.y) - u_).abs() < 1e-3);
+            // The triangle half holding the point agrees with the parallelogram.
+            let half = if s_ + u_ < 1.0 { intersect_triangle(p0, e1, e2, &ray) } else { intersect_triangle(p0 + e1 + e2, -e1, -e2, &ray) };
+            if (s_ + u_ - 1.0).abs() > 1e-4 {
+                assert!(half.is_some_and(|h| (h.t - hit.t).abs() <= 1e-3 * hit.t), "{half:?} against {hit:?}");
+            }
+        }
+        assert!(inside > 500 && outside > 500, "{inside} rays inside, {outside} outside");
+    }
+
+    /// Which neighbouring triangles are taken as a parallelogram: a rectangle's two (its corner 1, or 2
+    /// when a mirroring transform reversed the winding), each of a cube's faces, and not a folded pair, a
+    /// smooth-shaded one, a trapezoid, nor texture coordinates that are not affine over it.
+    #[test]
+    fn parallelograms_are_found_where_nothing_changes() {
+        use crate::geometry::builtin_meshes::{cube, rectangle};
+        let rect = rectangle(&Transform::IDENTITY, false, "t").unwrap();
+        assert_eq!(rect.parallelogram(0, true), Some(1));
+        assert_eq!(rect.parallelogram(1, true), None, "no third triangle");
+        let mirrored = rectangle(&Transform::scale(Vec3::new(-1.0, 1.0, 1.0)).unwrap(), false, "t").unwrap();
+        assert_eq!(mirrored.parallelogram(0, true), Some(2));
+        let tilted =
+            Transform::rotate(Vec3::new(1.0, 2.0, 3.0), 37.0).unwrap().then_after(Transform::scale(Vec3::new(0.3, 2.0, 1.0)).unwrap());
+        let box_ = cube(&tilted, false, "t").unwrap();
+        for face in 0..6 {
+            assert!(box_.parallelogram(2 * face, true).is_some(), "face {face}");
+            assert!(box_.parallelogram(2 * face + 1, true).is_none(), "across faces {face}, {}", face + 1);
+        }
+        let quad = |p3: Vec3, uv3: Vec2, normals: Option<Vec<Vec3>>| {
+            let positions = vec![Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), p3];
+            let uvs = vec![Vec2::ZERO, Vec2::X, Vec2::ONE, uv3];
+            Mesh::new(positions, normals, Some(uvs), vec![[0, 1, 2], [0, 2, 3]], &Transform::IDENTITY, false, false, "t").unwrap()
+        };
+        assert_eq!(quad(Vec3::Y, Vec2::Y, None).parallelogram(0, true), Some(1));
+        assert_eq!(quad(Vec3::new(0.0, 1.0, 0.5), Vec2::Y, None).parallelogram(0, true), None, "folded");
+        assert_eq!(quad(Vec3::new(0.2, 1.0, 0.0), Vec2::Y, None).parallelogram(0, true), None, "a trapezoid");
+        assert_eq!(quad(Vec3::Y, Vec2::new(0.3, 1.0), None).parallelogram(0, true), None, "uv not affine");
+        assert_eq!(quad(Vec3::Y, Vec2::new(0.3, 1.0), None).parallelogram(0, false), Some(1), "uv unused");
+        assert_eq!(quad(Vec3::Y, Vec2::Y, Some(vec![Vec3::Z; 4])).parallelogram(0, true), None, "smooth-shaded");
+        // Texture coordinates over a parallelogram's far half, extrapolated from the first triangle.
+        let q = quad(Vec3::Y, Vec2::Y, None);
+        // Corner 1 of the first triangle is (1, 0), its edges go to (1, 1) and (0, 0): (0.75, 0.75) along
+        // them is the point (0.25, 0.75), in the second triangle, where uv = (x, y).
+        let b = parallelogram_barycentrics(1, Vec2::new(0.75, 0.75));
+        assert!((q.uv_at(0, b) - Vec2::new(0.25, 0.75)).length() < 1e-6, "{}", q.uv_at(0, b));
     }
 }

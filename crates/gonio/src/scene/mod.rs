@@ -17,12 +17,13 @@ use crate::error::Result;
 use crate::film::FilmSpec;
 use crate::geometry::bvh::{bits, PacketLeaves, LANES, PACKET};
 pub use crate::geometry::bvh::{Hits8, EMPTY_SLOT};
-use crate::geometry::mesh::{intersect_triangle, FlatTriangles8, Triangle8};
+use crate::geometry::mesh::{parallelogram_barycentrics, FlatTriangles8, Triangle8};
 use crate::geometry::ray::RayLanes;
 use crate::geometry::sphere::Sphere8;
-use crate::geometry::{Bvh, Ray, Shape, SurfaceInteraction};
+use crate::geometry::{Bvh, PrimHit, Ray, Shape, SurfaceInteraction};
 use crate::light::Light;
 use crate::math::simd::{Float8, Mask8};
+use crate::math::Vec2;
 use std::path::Path;
 
 /// Which integrator renders the scene.
@@ -82,6 +83,21 @@ pub struct Scene {
 struct SlotRef {
     shape: u32,
     prim: u32,
+    /// For the parallelogram of a mesh's triangles `prim` and `prim + 1` ([`Mesh::parallelogram`]): the
+    /// corner of triangle `prim` its edges start from. `None` for a triangle and other shapes.
+    corner: Option<u8>,
+}
+
+impl SlotRef {
+    /// The barycentrics in triangle `prim` of a hit at (b₁, b₂) of the slot's test (the coordinates along
+    /// the parallelogram's edges for a parallelogram).
+    #[inline]
+    fn barycentrics(&self, b: Vec2) -> Vec2 {
+        match self.corner {
+            Some(k) => parallelogram_barycentrics(k, b),
+            None => b,
+        }
+    }
 }
 
 /// The primitives in BVH leaf order, in packets of eight slots: triangles inline as a [`Triangle8`] (no
@@ -120,12 +136,12 @@ impl Primitives {
         for (slot, &i) in order.iter().enumerate() {
             let (packet, lane) = (slot / LANES, slot % LANES);
             if i == EMPTY_SLOT {
-                p.slots.push(SlotRef { shape: EMPTY_SLOT, prim: 0 });
+                p.slots.push(SlotRef { shape: EMPTY_SLOT, prim: 0, corner: None });
                 continue;
             }
             let r = refs[i as usize];
             match &shapes[r.shape as usize] {
-                Shape::Mesh(m) => p.triangles[packet].set(lane, m.triangle_edges(r.prim)),
+                Shape::Mesh(m) => p.triangles[packet].set(lane, m.corner_edges(r.prim, r.corner.unwrap_or(0)), r.corner.is_some()),
                 Shape::Sphere(s) => {
                     if p.sphere_packet[packet] == NO_SPHERES {
                         p.sphere_packet[packet] = p.spheres.len() as u32;
@@ -381,21 +397,33 @@ impl Scene {
         integrator: IntegratorKind,
         warnings: Vec<String>,
     ) -> Scene {
+        let textured: Vec<bool> = (0..shapes.len()).map(|s| materials.get(s).is_some_and(Material::is_textured)).collect();
+        let start = std::time::Instant::now();
         let (mut refs, mut bounds, mut alone) = (Vec::new(), Vec::new(), Vec::new());
         for (s, shape) in shapes.iter().enumerate() {
-            for p in 0..shape.primitive_count() as u32 {
-                refs.push(SlotRef { shape: s as u32, prim: p });
-                bounds.push(shape.primitive_bounds(p));
+            let mut p = 0;
+            while p < shape.primitive_count() as u32 {
+                // Two triangles that form a parallelogram are one primitive (its test costs as much as a
+                // triangle's): a `rectangle` is one, a `cube` six.
+                let corner = match shape {
+                    Shape::Mesh(m) => m.parallelogram(p, textured[s]),
+                    _ => None,
+                };
+                refs.push(SlotRef { shape: s as u32, prim: p, corner });
+                let mut b = shape.primitive_bounds(p);
+                if corner.is_some() {
+                    b = b.union(shape.primitive_bounds(p + 1));
+                }
+                bounds.push(b);
                 // Triangles are tested eight at a time; a leaf's spheres and disks each by its own test.
                 alone.push(!matches!(shape, Shape::Mesh(_)));
+                p += if corner.is_some() { 2 } else { 1 };
             }
         }
-        let start = std::time::Instant::now();
         let bvh = Bvh::build_costed(&bounds, &alone);
         let prims = Primitives::new(&shapes, &refs, bvh.order());
         let bvh_seconds = start.elapsed().as_secs_f64();
         let environment = lights.iter().position(Light::is_environment).map(|i| i as u32);
-        let textured = (0..shapes.len()).map(|s| materials.get(s).is_some_and(Material::is_textured)).collect();
         let mut first_with = std::collections::HashMap::new();
         let material_class = (0..shapes.len() as u32)
             .map(|s| match materials.get(s as usize) {
@@ -479,15 +507,22 @@ impl Scene {
         let shape = &self.shapes[r.shape as usize];
         // The traversal kept only the distance: the primitive's own test gives the hit again, bit for bit
         // (the packet tests run the scalar test's operations), now with its coordinates.
-        let hit = match shape {
-            Shape::Mesh(_) => {
-                let [p0, e1, e2] = self.prims.triangles[slot as usize / LANES].edges(slot as usize % LANES);
-                intersect_triangle(p0, e1, e2, ray)
-            }
-            _ => shape.intersect(r.prim, ray),
-        };
+        let textured = self.textured[r.shape as usize];
+        if let Shape::Mesh(_) = shape {
+            let (tris, lane) = (&self.prims.triangles[slot as usize / LANES], slot as usize % LANES);
+            let hit = tris.intersect_lane(lane, ray);
+            debug_assert!(hit.is_some(), "the closest hit is found again");
+            return hit.map(|hit| {
+                let mut si = shape.interaction(r.shape, r.prim, ray, &PrimHit { uv: r.barycentrics(hit.uv), ..hit }, textured);
+                // The point from the slot's own corner and edges, as `surfaces` computes it (for a triangle,
+                // the same operations as the mesh's).
+                si.p = tris.point_at(lane, hit.uv);
+                si
+            });
+        }
+        let hit = shape.intersect(r.prim, ray);
         debug_assert!(hit.is_some(), "the closest hit is found again");
-        hit.map(|hit| shape.interaction(r.shape, r.prim, ray, &hit, self.textured[r.shape as usize]))
+        hit.map(|hit| shape.interaction(r.shape, r.prim, ray, &hit, textured))
     }
 
     /// Whether anything blocks `ray` before its `tmax`.

@@ -186,7 +186,7 @@ impl Scene {
                 for lane in bits(flat_uv) {
                     let r = self.prims.slots[hits.slot[lane] as usize];
                     if let Shape::Mesh(mesh) = &self.shapes[r.shape as usize] {
-                        let uv = mesh.uv_at(r.prim, Vec2::new(b1[lane], b2[lane]));
+                        let uv = mesh.uv_at(r.prim, r.barycentrics(Vec2::new(b1[lane], b2[lane])));
                         (out.uv[0][lane], out.uv[1][lane]) = (uv.x, uv.y);
                     }
                 }
