@@ -79,7 +79,7 @@ pub struct RayLanes<R> {
 }
 
 impl RayLanes<Float8> {
-    /// Eight rays in lanes (lane `i` is `rays[i]`; `bvh::each_ray` takes them apart again).
+    /// Eight rays in lanes (lane `i` is `rays[i]`; `bvh::PacketRays` takes them apart again).
     #[must_use]
     pub fn from_rays(rays: &[Ray; 8]) -> Self {
         let row = |f: fn(&Ray) -> f32| Float8::load(&rays.each_ref().map(f));

@@ -15,7 +15,7 @@ pub use material::Material;
 use crate::camera::PerspectiveCamera;
 use crate::error::Result;
 use crate::film::FilmSpec;
-use crate::geometry::bvh::{bits, PacketLeaves, LANES, PACKET};
+use crate::geometry::bvh::{bits, PacketLeaves, PacketRays, LANES};
 pub use crate::geometry::bvh::{Hits8, EMPTY_SLOT};
 use crate::geometry::mesh::{parallelogram_barycentrics, FlatTriangles8, Triangle8};
 use crate::geometry::ray::RayLanes;
@@ -270,7 +270,7 @@ impl Leaves<'_> {
 
 impl PacketLeaves for Leaves<'_> {
     #[inline(always)]
-    fn closest_rays(&self, rays: &RayLanes<Float8>, each: &[Ray; PACKET], first: u32, count: u32, lanes: u32, hits: &mut Hits8) {
+    fn closest_rays(&self, rays: &RayLanes<Float8>, each: &PacketRays, first: u32, count: u32, lanes: u32, hits: &mut Hits8) {
         let live = Mask8::from_bitmask(lanes);
         for packet in Self::packets(first, count) {
             let tri = &self.prims.triangles[packet];
@@ -279,7 +279,7 @@ impl PacketLeaves for Leaves<'_> {
                 if lanes.count_ones() < RAYS_PER_TRIANGLE * tris.count_ones() {
                     let t = hits.t.to_array();
                     for lane in bits(lanes) {
-                        if let Some((tl, l)) = tri.nearest(&each[lane], t[lane]) {
+                        if let Some((tl, l)) = tri.nearest(&each.ray(lane), t[lane]) {
                             hits.t = hits.t.with_lane(lane, tl);
                             hits.slot[lane] = (packet * LANES) as u32 + l;
                         }
@@ -310,7 +310,7 @@ impl PacketLeaves for Leaves<'_> {
                 for lane in bits(lanes) {
                     for l in bits(others) {
                         let r = self.prims.slots[packet * LANES + l];
-                        let ray = Ray { tmax: t[lane], ..each[lane] };
+                        let ray = Ray { tmax: t[lane], ..each.ray(lane) };
                         if let Some(hit) = self.shapes[r.shape as usize].intersect(r.prim, &ray) {
                             t[lane] = hit.t;
                             hits.slot[lane] = (packet * LANES + l) as u32;
@@ -328,7 +328,7 @@ impl PacketLeaves for Leaves<'_> {
     }
 
     #[inline(always)]
-    fn any_rays(&self, rays: &RayLanes<Float8>, each: &[Ray; PACKET], first: u32, count: u32, lanes: u32) -> u32 {
+    fn any_rays(&self, rays: &RayLanes<Float8>, each: &PacketRays, first: u32, count: u32, lanes: u32) -> u32 {
         let mut blocked = 0u32;
         for packet in Self::packets(first, count) {
             let open = lanes & !blocked;
@@ -340,7 +340,8 @@ impl PacketLeaves for Leaves<'_> {
             if tris != 0 {
                 if open.count_ones() < RAYS_PER_TRIANGLE * tris.count_ones() {
                     for lane in bits(open) {
-                        if tri.any(&each[lane], each[lane].tmax) {
+                        let ray = each.ray(lane);
+                        if tri.any(&ray, ray.tmax) {
                             blocked |= 1 << lane;
                         }
                     }
@@ -361,7 +362,7 @@ impl PacketLeaves for Leaves<'_> {
                 for lane in bits(lanes & !blocked) {
                     if bits(others).any(|l| {
                         let r = self.prims.slots[packet * LANES + l];
-                        self.shapes[r.shape as usize].intersect(r.prim, &each[lane]).is_some()
+                        self.shapes[r.shape as usize].intersect(r.prim, &each.ray(lane)).is_some()
                     }) {
                         blocked |= 1 << lane;
                     }
