@@ -643,14 +643,6 @@ impl Triangle8 {
         hit.then_some(PrimHit { t, uv: Vec2::new(b1, b2) })
     }
 
-    /// The point p₀ + b₁ e₁ + b₂ e₂ of lane `lane`, as [`Self::points_hit`] computes it.
-    #[inline]
-    #[must_use]
-    pub fn point_at(&self, lane: usize, b: Vec2) -> Vec3 {
-        let [p0, e1, e2] = self.edges(lane);
-        barycentric_point::<f32>(p0.into(), e1.into(), e2.into(), b.x, b.y).into()
-    }
-
     /// [`intersect_triangle`] on all eight lanes, operation for operation, up to the comparisons: the
     /// lanes hit within (0, tmax) and their t, b₁, b₂ (as the scalar test computes them).
     #[inline(always)]
@@ -672,15 +664,14 @@ impl Triangle8 {
     }
 
     /// Each lane's triangle against the same lane's ray, for rays known to hit them (a packet's closest
-    /// hits, gathered by [`Self::copy_lane`]): the points hit and their barycentrics (b₁, b₂), as
-    /// [`intersect_triangle`] computes them.
+    /// hits, gathered by [`Self::copy_lane`]): their barycentrics (b₁, b₂), as [`intersect_triangle`]
+    /// computes them (the coordinates along the edges for a parallelogram).
     #[inline(always)]
     #[must_use]
-    pub fn points_hit(&self, o: V3<Float8>, d: V3<Float8>) -> (V3<Float8>, Float8, Float8) {
-        let (p0, e2, ne1) = (lane_rows(&self.p0), lane_rows(&self.e2), lane_rows(&self.neg_e1));
-        let (_, _, b1, b2) =
-            intersect_triangle_lanes(o, d, p0, e2, ne1, lane_rows(&self.m), Float8::load(&self.diagonal), Float8::splat(f32::INFINITY));
-        (barycentric_point(p0, ne1.neg(), e2, b1, b2), b1, b2)
+    pub fn barycentrics_hit(&self, o: V3<Float8>, d: V3<Float8>) -> (Float8, Float8) {
+        let (p0, e2, ne1, m) = (lane_rows(&self.p0), lane_rows(&self.e2), lane_rows(&self.neg_e1), lane_rows(&self.m));
+        let (_, _, b1, b2) = intersect_triangle_lanes(o, d, p0, e2, ne1, m, Float8::load(&self.diagonal), Float8::splat(f32::INFINITY));
+        (b1, b2)
     }
 
     /// The lanes hit within (0, tmax) and their t, by [`intersect_triangle_lanes_t`] (no branch).
@@ -725,9 +716,9 @@ impl Triangle8 {
     }
 
     /// The nearest lane hit within (0, tmax), and its distance: what closest-hit traversal needs (the
-    /// barycentrics of the triangles finally hit are recomputed, by [`Self::points_hit`] for a packet or
-    /// [`intersect_triangle`] for one ray, which give the same numbers, rather than kept for every packet
-    /// on the way).
+    /// barycentrics of the triangles finally hit, where they are needed, are recomputed, by
+    /// [`Self::barycentrics_hit`] for a packet or [`Self::intersect_lane`] for one ray, which give the same
+    /// numbers, rather than kept for every packet on the way).
     #[inline(always)]
     #[must_use]
     pub fn nearest(&self, ray: &Ray, tmax: f32) -> Option<(f32, u32)> {

@@ -38,6 +38,13 @@ impl Ray {
     }
 }
 
+/// The point o + t d of rays in lanes (or of one ray: the same operations as [`Ray::at`]).
+#[inline(always)]
+#[must_use]
+pub fn ray_point<R: Real>(o: V3<R>, d: V3<R>, t: R) -> V3<R> {
+    o.add(d.scale(t))
+}
+
 /// `p` moved off its surface (geometric normal `n`) towards the side of direction `w`.
 #[inline]
 #[must_use]

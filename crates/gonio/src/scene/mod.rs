@@ -18,7 +18,7 @@ use crate::film::FilmSpec;
 use crate::geometry::bvh::{bits, PacketLeaves, PacketRays, LANES};
 pub use crate::geometry::bvh::{Hits8, EMPTY_SLOT};
 use crate::geometry::mesh::{parallelogram_barycentrics, FlatTriangles8, Triangle8};
-use crate::geometry::ray::RayLanes;
+use crate::geometry::ray::{ray_point, RayLanes};
 use crate::geometry::sphere::Sphere8;
 use crate::geometry::{Bvh, PrimHit, Ray, Shape, SurfaceInteraction};
 use crate::light::Light;
@@ -509,15 +509,17 @@ impl Scene {
         // The traversal kept only the distance: the primitive's own test gives the hit again, bit for bit
         // (the packet tests run the scalar test's operations), now with its coordinates.
         let textured = self.textured[r.shape as usize];
-        if let Shape::Mesh(_) = shape {
+        if let Shape::Mesh(mesh) = shape {
             let (tris, lane) = (&self.prims.triangles[slot as usize / LANES], slot as usize % LANES);
             let hit = tris.intersect_lane(lane, ray);
             debug_assert!(hit.is_some(), "the closest hit is found again");
             return hit.map(|hit| {
-                let mut si = shape.interaction(r.shape, r.prim, ray, &PrimHit { uv: r.barycentrics(hit.uv), ..hit }, textured);
-                // The point from the slot's own corner and edges, as `surfaces` computes it (for a triangle,
-                // the same operations as the mesh's).
-                si.p = tris.point_at(lane, hit.uv);
+                let mut si = mesh.interaction(r.prim, ray, &PrimHit { uv: r.barycentrics(hit.uv), ..hit }, textured);
+                (si.shape, si.prim) = (r.shape, r.prim);
+                // On a flat-shaded mesh the point is o + t d, as `surfaces` computes it (see there).
+                if mesh.flat_frame(r.prim).is_some() {
+                    si.p = ray_point::<f32>(ray.o.into(), ray.d.into(), hit.t).into();
+                }
                 si
             });
         }

@@ -1,9 +1,14 @@
 //! The surfaces a packet of rays found, in lanes: what the path tracer's phases read at each vertex.
 //!
-//! Packet traversal keeps only each ray's distance and slot. Where the slot holds a triangle of a
-//! flat-shaded mesh (the common case: every built-in `rectangle`, `cube` and face-normal mesh), the
-//! triangles hit are gathered into one [`Triangle8`] and the eight rays' barycentrics and points come from
-//! one lane test ([`Triangle8::points_hit`]); the shading frame, constant over such a triangle, is copied.
+//! Packet traversal keeps only each ray's distance and slot. Where the slot holds a triangle (or a
+//! parallelogram) of a flat-shaded mesh (the common case: every built-in `rectangle`, `cube` and
+//! face-normal mesh), the point is o + t d, computed in lanes, and the shading frame, constant over the
+//! triangle, is copied; where the material reads texture coordinates, the triangles hit are gathered into
+//! one [`Triangle8`] and the rays' barycentrics come from one lane test ([`Triangle8::barycentrics_hit`]).
+//! (2026-12: the point from the barycentrics, for every flat lane, had the triangles gathered for all of
+//! them: 5.7 % of a Cornell box render. o + t d is off the plane by about t · 10⁻⁷, far below the ray
+//! offset; at grazing incidence it can lie beyond the triangle's edge by a few 10⁻⁵ of t, within the ray
+//! offset too. Mitsuba's `rectangle` takes o + t d in its own space.)
 //! Spheres need only the distance, which the packet test computed as the scalar test does: their points,
 //! normals and frames are computed in lanes too. Other shapes (disks, smooth-shaded meshes) build their
 //! interaction one lane at a time, as [`Scene::interaction_at`] does for a single ray. 2026-12: building interactions one lane at a time
@@ -12,7 +17,7 @@
 use super::{Scene, EMPTY_SLOT};
 use crate::geometry::bvh::{bits, Hits8, LANES};
 use crate::geometry::mesh::Triangle8;
-use crate::geometry::ray::RayLanes;
+use crate::geometry::ray::{ray_point, RayLanes};
 use crate::geometry::sphere::sphere_surface;
 use crate::geometry::{Ray, Shape, SurfaceInteraction};
 use crate::math::frame::tangents;
@@ -153,11 +158,12 @@ impl Scene {
             let shape = &self.shapes[r.shape as usize];
             if let Shape::Mesh(mesh) = shape {
                 if let Some(frame) = mesh.flat_frame(r.prim) {
-                    tris.copy_lane(lane, &self.prims.triangles[slot as usize / LANES], slot as usize % LANES);
+                    if textured {
+                        tris.copy_lane(lane, &self.prims.triangles[slot as usize / LANES], slot as usize % LANES);
+                        flat_uv |= 1 << lane;
+                    }
                     out.set_frame(lane, frame);
-                    out.n.set(lane, frame.n);
                     flat |= 1 << lane;
-                    flat_uv |= u32::from(textured) << lane;
                     continue;
                 }
             }
@@ -179,9 +185,12 @@ impl Scene {
             (out.uv[0][lane], out.uv[1][lane]) = (si.uv.x, si.uv.y);
         }
         if flat != 0 {
-            let (p, b1, b2) = tris.points_hit(rays.o, rays.d);
-            out.p.store(V3::select(Mask8::from_bitmask(flat), p, out.p.lanes()));
+            // The point, and the geometric normal: the frame's (flat-shaded).
+            let m = Mask8::from_bitmask(flat);
+            out.p.store(V3::select(m, ray_point(rays.o, rays.d, hits.t), out.p.lanes()));
+            out.n.store(V3::select(m, out.ns.lanes(), out.n.lanes()));
             if flat_uv != 0 {
+                let (b1, b2) = tris.barycentrics_hit(rays.o, rays.d);
                 let (b1, b2) = (b1.to_array(), b2.to_array());
                 for lane in bits(flat_uv) {
                     let r = self.prims.slots[hits.slot[lane] as usize];
