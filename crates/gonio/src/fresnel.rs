@@ -64,7 +64,7 @@ pub fn refract_about(wi: Vec3, n: Vec3, eta: f32) -> Option<Refraction> {
 /// and θᵢ is grazing (2026-11: the first form rounded to total internal reflection at η = 1 for
 /// |cos θᵢ| < 1.7e-4, found by the Mitsuba cross-check). ≤ 0 means total internal reflection.
 #[inline(always)]
-fn cos2_transmitted<R: Real>(cos_i: R, eta: R) -> R {
+pub(crate) fn cos2_transmitted<R: Real>(cos_i: R, eta: R) -> R {
     cos_i.mul_add(cos_i, eta.mul_add(eta, R::splat(-1.0))) / (eta * eta)
 }
 

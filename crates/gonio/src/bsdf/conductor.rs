@@ -20,9 +20,11 @@
 //! assert_eq!(s.weight, gonio::Rgb::ONE);
 //! ```
 
+use super::lanes::{flag_lanes, sample_one, LaneModel, LaneSample};
 use super::{BsdfFlags, BsdfModel, BsdfSample};
 use crate::error::{Error, Result};
-use crate::fresnel::{fresnel_conductor_rgb, reflect};
+use crate::fresnel::{fresnel_conductor_rgb, fresnel_conductor_rgb_lanes};
+use crate::math::lanes::{channels, Real, V3};
 use crate::math::{Vec2, Vec3};
 use crate::props::Props;
 use crate::spectrum::{named, Rgb};
@@ -105,14 +107,40 @@ impl BsdfModel for Conductor {
         Rgb::ZERO
     }
 
-    fn sample(&self, wo: Vec3, _uc: f32, _u: Vec2) -> Option<BsdfSample> {
-        if wo.z <= 0.0 {
-            return None;
-        }
-        BsdfSample::delta(reflect(wo, Vec3::Z), self.reflectance(wo.z), 1.0, BsdfFlags::DELTA_REFLECTION, 1.0)
+    fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
+        sample_one(self, wo, uc, u)
     }
 
     fn pdf(&self, _wo: Vec3, _wi: Vec3) -> f32 {
         0.0
+    }
+}
+
+/// The model in lanes ([`LaneModel`]), which its `sample` runs for one direction: the path tracer's packets
+/// run it for the lanes on one conductor.
+impl LaneModel for Conductor {
+    #[inline(always)]
+    fn f_lanes<R: Real>(&self, _wo: V3<R>, _wi: V3<R>) -> [R; 3] {
+        [R::splat(0.0); 3]
+    }
+
+    #[inline(always)]
+    fn pdf_lanes<R: Real>(&self, _wo: V3<R>, _wi: V3<R>) -> R {
+        R::splat(0.0)
+    }
+
+    /// The mirror direction (−x, −y, z) = 2 (ωo·n) n − ωo for n = +z, with probability 1 and weight
+    /// F(cos θo) · `specular_reflectance`; none from below the surface.
+    #[inline(always)]
+    fn sample_lanes<R: Real>(&self, wo: V3<R>, _uc: R, _ux: R, _uy: R) -> LaneSample<R> {
+        let above = !wo.z.le(R::splat(0.0));
+        let fresnel = match self.eta_k {
+            Some((eta, k)) => fresnel_conductor_rgb_lanes(wo.z, eta, k),
+            None => [R::splat(1.0); 3],
+        };
+        let s = self.specular_reflectance.0;
+        let value = channels!(|c| fresnel[c] * s[c]);
+        let wi = V3::new(-wo.x, -wo.y, wo.z);
+        LaneSample::delta(wi, value, R::splat(1.0), flag_lanes(BsdfFlags::DELTA_REFLECTION | BsdfFlags::DELTA), R::splat(1.0), above)
     }
 }

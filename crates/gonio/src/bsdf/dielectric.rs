@@ -27,9 +27,11 @@
 //! assert!((s.weight.r() - 1.0 / 2.25).abs() < 1e-6); // (1/1.5)² entering glass
 //! ```
 
+use super::lanes::{flag_lanes, sample_one, LaneModel, LaneSample};
 use super::{BsdfFlags, BsdfModel, BsdfSample};
 use crate::error::{Error, Result};
-use crate::fresnel::{fresnel_dielectric, reflect, refract};
+use crate::fresnel::{cos2_transmitted, fresnel_dielectric, fresnel_dielectric_lanes, reflect};
+use crate::math::lanes::{channels, Real, V3};
 use crate::math::{Vec2, Vec3};
 use crate::props::{NumberOrName, Props};
 use crate::spectrum::{named, Rgb};
@@ -166,17 +168,56 @@ impl BsdfModel for Dielectric {
         Rgb::ZERO
     }
 
-    fn sample(&self, wo: Vec3, uc: f32, _u: Vec2) -> Option<BsdfSample> {
-        if wo.z == 0.0 {
-            return None;
-        }
-        let r = self.reflected_fraction(wo.z);
-        let transmitted = || refract(wo, self.eta).map(|refr| (refr.wt, refr.eta));
-        sample_reflect_or_transmit(wo, uc, r, self.specular_reflectance, self.specular_transmittance, transmitted)
+    fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
+        sample_one(self, wo, uc, u)
     }
 
     fn pdf(&self, _wo: Vec3, _wi: Vec3) -> f32 {
         0.0
+    }
+}
+
+/// The model in lanes ([`LaneModel`]), which its `sample` runs for one direction: the path tracer's packets
+/// run it for the lanes on one dielectric.
+impl LaneModel for Dielectric {
+    #[inline(always)]
+    fn f_lanes<R: Real>(&self, _wo: V3<R>, _wi: V3<R>) -> [R; 3] {
+        [R::splat(0.0); 3]
+    }
+
+    #[inline(always)]
+    fn pdf_lanes<R: Real>(&self, _wo: V3<R>, _wi: V3<R>) -> R {
+        R::splat(0.0)
+    }
+
+    /// [`sample_reflect_or_transmit`] with r = [`Dielectric::reflected_fraction`]: the mirror direction
+    /// (−x, −y, z) where uc < r, else the refracted one ([`refract`](crate::fresnel::refract) about ±z, on the side of ωo), none
+    /// under total internal reflection there and for ωo in the plane.
+    #[inline(always)]
+    fn sample_lanes<R: Real>(&self, wo: V3<R>, uc: R, _ux: R, _uy: R) -> LaneSample<R> {
+        let (zero, one) = (R::splat(0.0), R::splat(1.0));
+        let f = fresnel_dielectric_lanes(wo.z, self.eta);
+        let r = if self.fresnel { f } else { R::select(f.ge(one), f, R::splat(fresnel_dielectric(1.0, self.eta))) };
+        // Refraction from the side of ωo: η' = ηₜ/ηᵢ, n = ±z towards ωo.
+        let inside = wo.z.lt(zero);
+        let (eta, cos_i, nz) =
+            (R::select(inside, R::splat(1.0 / self.eta), R::splat(self.eta)), R::select(inside, -wo.z, wo.z), R::select(inside, -one, one));
+        let cos2_t = cos2_transmitted(cos_i, eta);
+        let cos_t = cos2_t.sqrt();
+        let wt = V3::new(-wo.x / eta, -wo.y / eta, -wo.z / eta + (cos_i / eta - cos_t) * nz);
+        let reflected = uc.lt(r);
+        let t = one - r;
+        let (refl, trans) = (self.specular_reflectance.0, self.specular_transmittance.0);
+        let scale = t / (eta * eta);
+        let value = channels!(|c| R::select(reflected, r * refl[c], scale * trans[c]));
+        let wi = V3::select(reflected, V3::new(-wo.x, -wo.y, wo.z), wt);
+        let flags = R::select(
+            reflected,
+            flag_lanes(BsdfFlags::DELTA_REFLECTION | BsdfFlags::DELTA),
+            flag_lanes(BsdfFlags::DELTA_TRANSMISSION | BsdfFlags::DELTA),
+        );
+        let valid = !wo.z.eq(zero) & (reflected | !cos2_t.le(zero));
+        LaneSample::delta(wi, value, R::select(reflected, r, t), flags, R::select(reflected, one, eta), valid)
     }
 }
 

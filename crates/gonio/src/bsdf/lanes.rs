@@ -12,6 +12,8 @@
 //! lanes already loaded, so that checking a batch's inputs costs no pass of its own. Measured with callgrind
 //! (instructions per row): see the table in the `batch_rows` example's doc.
 
+use super::conductor::Conductor;
+use super::dielectric::Dielectric;
 use super::rough_conductor::GgxConductor;
 use super::rough_plastic::GgxPlastic;
 use super::{Bsdf, BsdfFlags, BsdfSample, SampleColumns};
@@ -46,6 +48,20 @@ impl<R: Real> LaneSample<R> {
         LaneSample { wi, f, pdf, weight, flags, eta: R::splat(1.0), valid }
     }
 
+    /// A sample of a delta lobe, as [`BsdfSample::delta`] (valid only where `prob` > 0): `value` the
+    /// multiplier, chosen with probability `prob`, and f = value / |cos θi| where that is finite (else 0).
+    #[inline(always)]
+    pub fn delta(wi: V3<R>, value: [R; 3], prob: R, flags: R, eta: R, valid: R::Mask) -> Self {
+        let zero = R::splat(0.0);
+        let cos = wi.z.abs();
+        let f = channels!(|c| {
+            let q = value[c] / cos;
+            R::select(cos.gt(zero) & q.is_finite(), q, zero)
+        });
+        let weight = channels!(|c| value[c] / prob);
+        LaneSample { wi, f, pdf: prob, weight, flags, eta, valid: valid & prob.gt(zero) }
+    }
+
     /// No sample in any lane.
     #[inline(always)]
     pub fn none(valid: R::Mask) -> Self {
@@ -78,6 +94,8 @@ pub trait LaneModel {
 pub enum LaneKernel<'a> {
     Conductor(GgxConductor),
     Plastic(GgxPlastic<'a>),
+    SmoothConductor(&'a Conductor),
+    Dielectric(&'a Dielectric),
 }
 
 impl Bsdf {
@@ -89,6 +107,8 @@ impl Bsdf {
         match self {
             Bsdf::RoughConductor(m) => m.0.lanes().map(LaneKernel::Conductor),
             Bsdf::RoughPlastic(m) => m.lanes().map(LaneKernel::Plastic),
+            Bsdf::Conductor(m) => Some(LaneKernel::SmoothConductor(m)),
+            Bsdf::Dielectric(m) => Some(LaneKernel::Dielectric(m)),
             _ => None,
         }
     }
@@ -100,6 +120,8 @@ impl LaneModel for LaneKernel<'_> {
         match self {
             LaneKernel::Conductor(k) => k.f_lanes(wo, wi),
             LaneKernel::Plastic(k) => k.f_lanes(wo, wi),
+            LaneKernel::SmoothConductor(k) => k.f_lanes(wo, wi),
+            LaneKernel::Dielectric(k) => k.f_lanes(wo, wi),
         }
     }
 
@@ -108,6 +130,8 @@ impl LaneModel for LaneKernel<'_> {
         match self {
             LaneKernel::Conductor(k) => k.pdf_lanes(wo, wi),
             LaneKernel::Plastic(k) => k.pdf_lanes(wo, wi),
+            LaneKernel::SmoothConductor(k) => k.pdf_lanes(wo, wi),
+            LaneKernel::Dielectric(k) => k.pdf_lanes(wo, wi),
         }
     }
 
@@ -116,6 +140,8 @@ impl LaneModel for LaneKernel<'_> {
         match self {
             LaneKernel::Conductor(k) => k.sample_lanes(wo, uc, ux, uy),
             LaneKernel::Plastic(k) => k.sample_lanes(wo, uc, ux, uy),
+            LaneKernel::SmoothConductor(k) => k.sample_lanes(wo, uc, ux, uy),
+            LaneKernel::Dielectric(k) => k.sample_lanes(wo, uc, ux, uy),
         }
     }
 }
@@ -404,15 +430,21 @@ mod tests {
     use crate::sampling::Pcg32;
 
     /// A model's [`LaneKernel`] on the renderer's eight lanes gives in every lane what the model's single
-    /// calls give, bit for bit; models without a kernel in their configuration have none.
+    /// calls give, bit for bit (GGX conductors and plastics, smooth conductors and dielectrics, from both
+    /// sides: the directions cover the sphere); models without a kernel in their configuration have none.
     #[test]
     fn lane_kernels_equal_single_calls() {
         let with = [
             r#"{"type": "roughconductor", "distribution": "ggx", "alpha": 0.2, "material": "Au"}"#,
             r#"{"type": "roughconductor", "distribution": "ggx", "alpha_u": 0.05, "alpha_v": 0.4}"#,
             r#"{"type": "roughplastic", "distribution": "ggx", "alpha": 0.1, "diffuse_reflectance": [0.7, 0.1, 0.1]}"#,
+            r#"{"type": "conductor", "material": "Al"}"#,
+            r#"{"type": "conductor", "specular_reflectance": [0.2, 0.5, 1.0]}"#,
+            r#"{"type": "dielectric"}"#,
+            r#"{"type": "dielectric", "int_ior": 1.0, "ext_ior": 1.5, "specular_transmittance": [0.2, 0.7, 0.9]}"#,
+            r#"{"type": "dielectric", "int_ior": 1.5, "fresnel": false}"#,
         ];
-        let without = [r#"{"type": "roughconductor", "alpha": 0.2}"#, r#"{"type": "diffuse"}"#, r#"{"type": "dielectric"}"#];
+        let without = [r#"{"type": "roughconductor", "alpha": 0.2}"#, r#"{"type": "diffuse"}"#, r#"{"type": "thindielectric"}"#];
         for spec in without {
             assert!(Bsdf::from_json(spec).unwrap().lane_kernel().is_none(), "{spec}");
         }
@@ -420,7 +452,7 @@ mod tests {
         let dir = |rng: &mut Pcg32| crate::sampling::warp::sample_uniform_sphere(rng.next_vec2());
         for spec in with {
             let b = Bsdf::from_json(spec).unwrap();
-            let k = b.lane_kernel().expect("a GGX kernel");
+            let k = b.lane_kernel().expect("a kernel");
             for _ in 0..64 {
                 let (wo, wi): (Vec<Vec3>, Vec<Vec3>) = (0..8).map(|_| (dir(&mut rng), dir(&mut rng))).unzip();
                 let (uc, ux, uy) =
