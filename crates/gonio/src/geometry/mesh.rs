@@ -226,6 +226,36 @@ impl Mesh {
         [c, v[(k + 1) % 3] - c, v[(k + 2) % 3] - c]
     }
 
+    /// The texture coordinates of triangle `tri` (or of its parallelogram from corner `k`, where they are
+    /// affine over it: [`Self::parallelogram`]) as a function of the point ([`UvMap`]); without texture
+    /// coordinates in the mesh, the barycentrics (b₁, b₂) of the triangle (k = 0). Computed in f64.
+    #[must_use]
+    pub fn uv_map(&self, tri: u32, k: u8) -> UvMap {
+        let idx = self.indices[tri as usize];
+        let k = usize::from(k);
+        let corners = [k, (k + 1) % 3, (k + 2) % 3];
+        let uv = |j: usize| match &self.uvs {
+            Some(uvs) => uvs[idx[j] as usize].as_dvec2(),
+            None => [glam::DVec2::ZERO, glam::DVec2::X, glam::DVec2::Y][j],
+        };
+        let p = |j: usize| self.positions[idx[j] as usize].as_dvec3();
+        let (p0, e1, e2) = (p(corners[0]), p(corners[1]) - p(corners[0]), p(corners[2]) - p(corners[0]));
+        let n = e1.cross(e2);
+        let nn = n.length_squared();
+        if !(nn > 0.0) {
+            return UvMap { p0: p0.as_vec3(), gu: Vec3::ZERO, gv: Vec3::ZERO, uv0: uv(corners[0]).as_vec2() };
+        }
+        // The dual vectors: (p − p₀)·d₁ = b₁ and (p − p₀)·d₂ = b₂ for p = p₀ + b₁ e₁ + b₂ e₂.
+        let (d1, d2) = (e2.cross(n) / nn, n.cross(e1) / nn);
+        let (du1, du2) = (uv(corners[1]) - uv(corners[0]), uv(corners[2]) - uv(corners[0]));
+        UvMap {
+            p0: p0.as_vec3(),
+            gu: (d1 * du1.x + d2 * du2.x).as_vec3(),
+            gv: (d1 * du1.y + d2 * du2.y).as_vec3(),
+            uv0: uv(corners[0]).as_vec2(),
+        }
+    }
+
     /// `uv` of the hit holds the barycentrics (b₁, b₂).
     #[inline]
     #[must_use]
@@ -406,6 +436,26 @@ impl FlatTriangles8 {
             V3::new(v.x.permute(index), v.y.permute(index), v.z.permute(index))
         };
         ([row(&self.vertices[0]), row(&self.vertices[1]), row(&self.vertices[2])], row(&self.normals))
+    }
+}
+
+/// Texture coordinates over a flat triangle or parallelogram as an affine function of the point
+/// ([`Mesh::uv_map`]): uv = uv₀ + ((p − p₀)·g_u, (p − p₀)·g_v), p₀ a corner and uv₀ its coordinates.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct UvMap {
+    pub p0: Vec3,
+    pub gu: Vec3,
+    pub gv: Vec3,
+    pub uv0: Vec2,
+}
+
+impl UvMap {
+    /// The texture coordinates at `p` (a point of the plane).
+    #[inline(always)]
+    #[must_use]
+    pub fn at(&self, p: Vec3) -> Vec2 {
+        let q = p - self.p0;
+        self.uv0 + Vec2::new(q.dot(self.gu), q.dot(self.gv))
     }
 }
 
@@ -651,29 +701,6 @@ impl Triangle8 {
         intersect_triangle_lanes(V3::splat(ray.o), V3::splat(ray.d), p0, e2, ne1, m, Float8::load(&self.diagonal), Float8::splat(tmax))
     }
 
-    /// Put lane `from` of `src` in lane `lane`.
-    #[inline(always)]
-    pub fn copy_lane(&mut self, lane: usize, src: &Triangle8, from: usize) {
-        for axis in 0..3 {
-            self.p0[axis][lane] = src.p0[axis][from];
-            self.e2[axis][lane] = src.e2[axis][from];
-            self.neg_e1[axis][lane] = src.neg_e1[axis][from];
-            self.m[axis][lane] = src.m[axis][from];
-        }
-        self.diagonal[lane] = src.diagonal[from];
-    }
-
-    /// Each lane's triangle against the same lane's ray, for rays known to hit them (a packet's closest
-    /// hits, gathered by [`Self::copy_lane`]): their barycentrics (b₁, b₂), as [`intersect_triangle`]
-    /// computes them (the coordinates along the edges for a parallelogram).
-    #[inline(always)]
-    #[must_use]
-    pub fn barycentrics_hit(&self, o: V3<Float8>, d: V3<Float8>) -> (Float8, Float8) {
-        let (p0, e2, ne1, m) = (lane_rows(&self.p0), lane_rows(&self.e2), lane_rows(&self.neg_e1), lane_rows(&self.m));
-        let (_, _, b1, b2) = intersect_triangle_lanes(o, d, p0, e2, ne1, m, Float8::load(&self.diagonal), Float8::splat(f32::INFINITY));
-        (b1, b2)
-    }
-
     /// The lanes hit within (0, tmax) and their t, by [`intersect_triangle_lanes_t`] (no branch).
     #[inline(always)]
     fn lanes_t(&self, ray: &Ray, tmax: f32) -> (Mask8, Float8) {
@@ -716,9 +743,8 @@ impl Triangle8 {
     }
 
     /// The nearest lane hit within (0, tmax), and its distance: what closest-hit traversal needs (the
-    /// barycentrics of the triangles finally hit, where they are needed, are recomputed, by
-    /// [`Self::barycentrics_hit`] for a packet or [`Self::intersect_lane`] for one ray, which give the same
-    /// numbers, rather than kept for every packet on the way).
+    /// barycentrics of the triangle finally hit, where they are needed, are recomputed by
+    /// [`Self::intersect_lane`], rather than kept for every packet on the way).
     #[inline(always)]
     #[must_use]
     pub fn nearest(&self, ray: &Ray, tmax: f32) -> Option<(f32, u32)> {
@@ -929,6 +955,28 @@ mod tests {
         assert!(hits > 1000, "only {hits} hits: the test would not show a wrong distance");
     }
 
+    /// [`Mesh::uv_map`] gives at a triangle's points what [`Mesh::uv_at`] gives at their barycentrics, from
+    /// each corner, with texture coordinates and without (where uv are the barycentrics).
+    #[test]
+    fn uv_map_matches_the_barycentric_uv() {
+        let mut rng = crate::sampling::Pcg32::new(8, 3);
+        let mut v = || Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 2.0 - Vec3::ONE;
+        for round in 0..200 {
+            let positions = vec![v() * 5.0 + Vec3::splat(20.0), v(), v()];
+            let uvs = (round % 2 == 0).then(|| vec![Vec2::new(0.1, 0.2), Vec2::new(3.0, -1.0), Vec2::new(0.5, 2.5)]);
+            let Ok(mesh) = Mesh::new(positions, None, uvs, vec![[0, 1, 2]], &Transform::IDENTITY, true, false, "t") else { continue };
+            let (b1, b2) = (v().x * 0.5 + 0.5, v().y * 0.5 + 0.5);
+            let b = Vec2::new(b1, b2 * (1.0 - b1));
+            let [p0, e1, e2] = mesh.triangle_edges(0);
+            let p = p0 + e1 * b.x + e2 * b.y;
+            let want = mesh.uv_at(0, b);
+            for k in 0..3 {
+                let got = mesh.uv_map(0, k).at(p);
+                assert!((got - want).length() < 1e-4 * (1.0 + want.length()), "corner {k}: {got} against {want}");
+            }
+        }
+    }
+
     /// A parallelogram lane is hit where one of its two triangles is: rays are classified by where they
     /// cross its plane (in f64), those within 10⁻⁴ of its border skipped, and the hit's distance and
     /// coordinates agree with that crossing.
@@ -1005,6 +1053,11 @@ mod tests {
         assert_eq!(quad(Vec3::Y, Vec2::Y, Some(vec![Vec3::Z; 4])).parallelogram(0, true), None, "smooth-shaded");
         // Texture coordinates over a parallelogram's far half, extrapolated from the first triangle.
         let q = quad(Vec3::Y, Vec2::Y, None);
+        // The texture coordinates as a function of the point agree, on both halves and outside them.
+        for (x, y) in [(0.25, 0.75), (0.9, 0.1), (0.5, 0.5), (1.5, -0.2)] {
+            let uv = q.uv_map(0, 1).at(Vec3::new(x, y, 0.0));
+            assert!((uv - Vec2::new(x, y)).length() < 1e-6, "({x}, {y}): {uv}");
+        }
         // Corner 1 of the first triangle is (1, 0), its edges go to (1, 1) and (0, 0): (0.75, 0.75) along
         // them is the point (0.25, 0.75), in the second triangle, where uv = (x, y).
         let b = parallelogram_barycentrics(1, Vec2::new(0.75, 0.75));

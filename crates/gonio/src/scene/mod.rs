@@ -17,7 +17,7 @@ use crate::error::Result;
 use crate::film::FilmSpec;
 use crate::geometry::bvh::{bits, PacketLeaves, PacketRays, LANES};
 pub use crate::geometry::bvh::{Hits8, EMPTY_SLOT};
-use crate::geometry::mesh::{parallelogram_barycentrics, FlatTriangles8, Triangle8};
+use crate::geometry::mesh::{parallelogram_barycentrics, FlatTriangles8, Triangle8, UvMap};
 use crate::geometry::ray::{ray_point, RayLanes};
 use crate::geometry::sphere::Sphere8;
 use crate::geometry::{Bvh, PrimHit, Ray, Shape, SurfaceInteraction};
@@ -86,7 +86,13 @@ struct SlotRef {
     /// For the parallelogram of a mesh's triangles `prim` and `prim + 1` ([`Mesh::parallelogram`]): the
     /// corner of triangle `prim` its edges start from. `None` for a triangle and other shapes.
     corner: Option<u8>,
+    /// For a flat mesh's slot whose material reads texture coordinates: its index in
+    /// [`Primitives::uv_maps`] ([`NO_UV_MAP`] for others).
+    uv_map: u32,
 }
+
+/// [`SlotRef::uv_map`] of slots without one.
+const NO_UV_MAP: u32 = u32::MAX;
 
 impl SlotRef {
     /// The barycentrics in triangle `prim` of a hit at (b₁, b₂) of the slot's test (the coordinates along
@@ -116,13 +122,15 @@ struct Primitives {
     /// Some packet holds a sphere or another shape (else the leaf loops skip looking: meshes only).
     has_others: bool,
     slots: Vec<SlotRef>,
+    /// The texture coordinates of the flat mesh slots that need them, as functions of the point.
+    uv_maps: Vec<UvMap>,
 }
 
 /// [`Primitives::sphere_packet`] of a packet without spheres.
 const NO_SPHERES: u32 = u32::MAX;
 
 impl Primitives {
-    fn new(shapes: &[Shape], refs: &[SlotRef], order: &[u32]) -> Self {
+    fn new(shapes: &[Shape], textured: &[bool], refs: &[SlotRef], order: &[u32]) -> Self {
         let packets = order.len() / LANES;
         let mut p = Primitives {
             triangles: vec![Triangle8::default(); packets],
@@ -132,16 +140,24 @@ impl Primitives {
             spheres: Vec::new(),
             has_others: false,
             slots: Vec::with_capacity(order.len()),
+            uv_maps: Vec::new(),
         };
         for (slot, &i) in order.iter().enumerate() {
             let (packet, lane) = (slot / LANES, slot % LANES);
             if i == EMPTY_SLOT {
-                p.slots.push(SlotRef { shape: EMPTY_SLOT, prim: 0, corner: None });
+                p.slots.push(SlotRef { shape: EMPTY_SLOT, prim: 0, corner: None, uv_map: NO_UV_MAP });
                 continue;
             }
-            let r = refs[i as usize];
+            let mut r = refs[i as usize];
             match &shapes[r.shape as usize] {
-                Shape::Mesh(m) => p.triangles[packet].set(lane, m.corner_edges(r.prim, r.corner.unwrap_or(0)), r.corner.is_some()),
+                Shape::Mesh(m) => {
+                    let k = r.corner.unwrap_or(0);
+                    p.triangles[packet].set(lane, m.corner_edges(r.prim, k), r.corner.is_some());
+                    if textured[r.shape as usize] && m.flat_frame(r.prim).is_some() {
+                        r.uv_map = p.uv_maps.len() as u32;
+                        p.uv_maps.push(m.uv_map(r.prim, k));
+                    }
+                }
                 Shape::Sphere(s) => {
                     if p.sphere_packet[packet] == NO_SPHERES {
                         p.sphere_packet[packet] = p.spheres.len() as u32;
@@ -410,7 +426,7 @@ impl Scene {
                     Shape::Mesh(m) => m.parallelogram(p, textured[s]),
                     _ => None,
                 };
-                refs.push(SlotRef { shape: s as u32, prim: p, corner });
+                refs.push(SlotRef { shape: s as u32, prim: p, corner, uv_map: NO_UV_MAP });
                 let mut b = shape.primitive_bounds(p);
                 if corner.is_some() {
                     b = b.union(shape.primitive_bounds(p + 1));
@@ -422,7 +438,7 @@ impl Scene {
             }
         }
         let bvh = Bvh::build_costed(&bounds, &alone);
-        let prims = Primitives::new(&shapes, &refs, bvh.order());
+        let prims = Primitives::new(&shapes, &textured, &refs, bvh.order());
         let bvh_seconds = start.elapsed().as_secs_f64();
         let environment = lights.iter().position(Light::is_environment).map(|i| i as u32);
         let mut first_with = std::collections::HashMap::new();
@@ -516,9 +532,13 @@ impl Scene {
             return hit.map(|hit| {
                 let mut si = mesh.interaction(r.prim, ray, &PrimHit { uv: r.barycentrics(hit.uv), ..hit }, textured);
                 (si.shape, si.prim) = (r.shape, r.prim);
-                // On a flat-shaded mesh the point is o + t d, as `surfaces` computes it (see there).
+                // On a flat-shaded mesh the point is o + t d and the texture coordinates a function of it,
+                // as `surfaces` computes them (see there).
                 if mesh.flat_frame(r.prim).is_some() {
                     si.p = ray_point::<f32>(ray.o.into(), ray.d.into(), hit.t).into();
+                    if let Some(map) = self.prims.uv_maps.get(r.uv_map as usize) {
+                        si.uv = map.at(si.p);
+                    }
                 }
                 si
             });

@@ -2,13 +2,14 @@
 //!
 //! Packet traversal keeps only each ray's distance and slot. Where the slot holds a triangle (or a
 //! parallelogram) of a flat-shaded mesh (the common case: every built-in `rectangle`, `cube` and
-//! face-normal mesh), the point is o + t d, computed in lanes, and the shading frame, constant over the
-//! triangle, is copied; where the material reads texture coordinates, the triangles hit are gathered into
-//! one [`Triangle8`] and the rays' barycentrics come from one lane test ([`Triangle8::barycentrics_hit`]).
-//! (2026-12: the point from the barycentrics, for every flat lane, had the triangles gathered for all of
-//! them: 5.7 % of a Cornell box render. o + t d is off the plane by about t · 10⁻⁷, far below the ray
-//! offset; at grazing incidence it can lie beyond the triangle's edge by a few 10⁻⁵ of t, within the ray
-//! offset too. Mitsuba's `rectangle` takes o + t d in its own space.)
+//! face-normal mesh), the point is o + t d, computed in lanes, the shading frame, constant over the
+//! triangle, is copied, and where the material reads texture coordinates they are an affine function of
+//! the point ([`UvMap`](crate::geometry::mesh::UvMap), one per such slot). (2026-12: the point from the barycentrics had the triangles
+//! hit gathered into a `Triangle8` and tested again, for every flat lane: 5.7 % of a Cornell box render;
+//! and the texture coordinates from the barycentrics, by the mesh's vertices, a further 2 % of a
+//! material spheres render. o + t d is off the plane by about t · 10⁻⁷, far below the ray offset; at
+//! grazing incidence it can lie beyond the triangle's edge by a few 10⁻⁵ of t, within the ray offset
+//! too. Mitsuba's `rectangle` takes o + t d in its own space.)
 //! Spheres need only the distance, which the packet test computed as the scalar test does: their points,
 //! normals and frames are computed in lanes too. Other shapes (disks, smooth-shaded meshes) build their
 //! interaction one lane at a time, as [`Scene::interaction_at`] does for a single ray. 2026-12: building interactions one lane at a time
@@ -16,7 +17,6 @@
 
 use super::{Scene, EMPTY_SLOT};
 use crate::geometry::bvh::{bits, Hits8, LANES};
-use crate::geometry::mesh::Triangle8;
 use crate::geometry::ray::{ray_point, RayLanes};
 use crate::geometry::sphere::sphere_surface;
 use crate::geometry::{Ray, Shape, SurfaceInteraction};
@@ -139,7 +139,6 @@ impl Scene {
         for lane in bits(lanes) {
             (out.uv[0][lane], out.uv[1][lane]) = (0.0, 0.0);
         }
-        let mut tris = Triangle8::default();
         // Lanes on flat triangles, and those of them whose material reads texture coordinates.
         let (mut flat, mut flat_uv) = (0u32, 0u32);
         // Lanes on spheres (their centres and radii), those with flipped normals, and those textured.
@@ -158,10 +157,7 @@ impl Scene {
             let shape = &self.shapes[r.shape as usize];
             if let Shape::Mesh(mesh) = shape {
                 if let Some(frame) = mesh.flat_frame(r.prim) {
-                    if textured {
-                        tris.copy_lane(lane, &self.prims.triangles[slot as usize / LANES], slot as usize % LANES);
-                        flat_uv |= 1 << lane;
-                    }
+                    flat_uv |= u32::from(textured) << lane;
                     out.set_frame(lane, frame);
                     flat |= 1 << lane;
                     continue;
@@ -189,15 +185,11 @@ impl Scene {
             let m = Mask8::from_bitmask(flat);
             out.p.store(V3::select(m, ray_point(rays.o, rays.d, hits.t), out.p.lanes()));
             out.n.store(V3::select(m, out.ns.lanes(), out.n.lanes()));
-            if flat_uv != 0 {
-                let (b1, b2) = tris.barycentrics_hit(rays.o, rays.d);
-                let (b1, b2) = (b1.to_array(), b2.to_array());
-                for lane in bits(flat_uv) {
-                    let r = self.prims.slots[hits.slot[lane] as usize];
-                    if let Shape::Mesh(mesh) = &self.shapes[r.shape as usize] {
-                        let uv = mesh.uv_at(r.prim, r.barycentrics(Vec2::new(b1[lane], b2[lane])));
-                        (out.uv[0][lane], out.uv[1][lane]) = (uv.x, uv.y);
-                    }
+            for lane in bits(flat_uv) {
+                let r = self.prims.slots[hits.slot[lane] as usize];
+                if let Some(map) = self.prims.uv_maps.get(r.uv_map as usize) {
+                    let uv = map.at(out.p.get(lane));
+                    (out.uv[0][lane], out.uv[1][lane]) = (uv.x, uv.y);
                 }
             }
         }
