@@ -64,10 +64,10 @@ test-python:
 # Benchmarks, run by hand (never part of `make test`): criterion micro-benchmarks, then gonio against
 # Mitsuba 3 (scalar_rgb, llvm_ad_rgb) on ../shared/scenes with the scaling tables (bench/render_vs_mitsuba.py),
 # and the Python package's batched f/sample against Mitsuba's bsdf.eval (bench/python_bsdf_vs_mitsuba.py).
-# gonio is timed built for this machine's CPU (-C target-cpu=native: AVX-512 here), as Mitsuba's llvm_ad_rgb
-# JIT-compiles its kernels for it; its images are the same bit for bit as the portable build's (Rust never
-# fuses a multiply and an add on its own), which is timed in the same run as the baseline row. In its own
-# target directory, so that the flags do not invalidate the portable build's cache.
+# gonio is timed built for this machine's CPU (-C target-cpu=native: AVX2 and FMA here), as Mitsuba's
+# llvm_ad_rgb JIT-compiles its kernels for it; its images differ from the portable build's only in the last
+# bits (where FMA fuses the multiply-adds of `Real::mad`), which is timed in the same run as the baseline
+# row. In its own target directory, so that the flags do not invalidate the portable build's cache.
 bench: cli python
 	$(CARGO) bench -p gonio
 	$(CARGO) build --profile dist -p gonio-cli

@@ -23,7 +23,7 @@
 use super::lanes::{flag_lanes, sample_one, LaneModel, LaneSample};
 use super::{BsdfFlags, BsdfModel, BsdfSample};
 use crate::error::{Error, Result};
-use crate::fresnel::{fresnel_conductor_rgb, fresnel_conductor_rgb_lanes};
+use crate::fresnel::{fresnel_conductor_rgb, fresnel_conductor_rgb_lanes, reflect_lanes};
 use crate::math::lanes::{channels, Real, V3};
 use crate::math::{Vec2, Vec3};
 use crate::props::Props;
@@ -129,8 +129,8 @@ impl LaneModel for Conductor {
         R::splat(0.0)
     }
 
-    /// The mirror direction (−x, −y, z) = 2 (ωo·n) n − ωo for n = +z, with probability 1 and weight
-    /// F(cos θo) · `specular_reflectance`; none from below the surface.
+    /// The mirror direction 2 (ωo·n) n − ωo, n = +z ([`reflect`](crate::fresnel::reflect)), with
+    /// probability 1 and weight F(cos θo) · `specular_reflectance`; none from below the surface.
     #[inline(always)]
     fn sample_lanes<R: Real>(&self, wo: V3<R>, _uc: R, _ux: R, _uy: R) -> LaneSample<R> {
         let above = !wo.z.le(R::splat(0.0));
@@ -140,7 +140,7 @@ impl LaneModel for Conductor {
         };
         let s = self.specular_reflectance.0;
         let value = channels!(|c| fresnel[c] * s[c]);
-        let wi = V3::new(-wo.x, -wo.y, wo.z);
+        let wi = reflect_lanes(wo, V3::splat(Vec3::Z));
         LaneSample::delta(wi, value, R::splat(1.0), flag_lanes(BsdfFlags::DELTA_REFLECTION | BsdfFlags::DELTA), R::splat(1.0), above)
     }
 }

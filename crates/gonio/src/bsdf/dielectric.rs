@@ -30,7 +30,7 @@
 use super::lanes::{flag_lanes, sample_one, LaneModel, LaneSample};
 use super::{BsdfFlags, BsdfModel, BsdfSample};
 use crate::error::{Error, Result};
-use crate::fresnel::{cos2_transmitted, fresnel_dielectric, fresnel_dielectric_lanes, reflect};
+use crate::fresnel::{cos2_transmitted, fresnel_dielectric, fresnel_dielectric_lanes, reflect, reflect_lanes};
 use crate::math::lanes::{channels, Real, V3};
 use crate::math::{Vec2, Vec3};
 use crate::props::{NumberOrName, Props};
@@ -191,7 +191,7 @@ impl LaneModel for Dielectric {
     }
 
     /// [`sample_reflect_or_transmit`] with r = [`Dielectric::reflected_fraction`]: the mirror direction
-    /// (−x, −y, z) where uc < r, else the refracted one ([`refract`](crate::fresnel::refract) about ±z, on the side of ωo), none
+    /// 2 (ωo·n) n − ωo, n = +z, where uc < r, else the refracted one ([`refract`](crate::fresnel::refract) about ±z, on the side of ωo), none
     /// under total internal reflection there and for ωo in the plane.
     #[inline(always)]
     fn sample_lanes<R: Real>(&self, wo: V3<R>, uc: R, _ux: R, _uy: R) -> LaneSample<R> {
@@ -210,7 +210,7 @@ impl LaneModel for Dielectric {
         let (refl, trans) = (self.specular_reflectance.0, self.specular_transmittance.0);
         let scale = t / (eta * eta);
         let value = channels!(|c| R::select(reflected, r * refl[c], scale * trans[c]));
-        let wi = V3::select(reflected, V3::new(-wo.x, -wo.y, wo.z), wt);
+        let wi = V3::select(reflected, reflect_lanes(wo, V3::splat(Vec3::Z)), wt);
         let flags = R::select(
             reflected,
             flag_lanes(BsdfFlags::DELTA_REFLECTION | BsdfFlags::DELTA),

@@ -106,9 +106,10 @@ impl SlotRef {
     }
 }
 
-/// The primitives in BVH leaf order, in packets of eight slots: triangles inline as a [`Triangle8`] (no
-/// index lookups in the inner loop), spheres as a [`Sphere8`] beside it where the packet has any, other
-/// shapes (disks) flagged in `others` and intersected one by one.
+/// The primitives in BVH leaf order, in packets of eight slots: triangles (and the parallelograms of two
+/// triangles, [`crate::geometry::Mesh::parallelogram`]) inline as a [`Triangle8`] (no index lookups in the
+/// inner loop), spheres as a [`Sphere8`] beside it where the packet has any, other shapes (disks) flagged
+/// in `others` and intersected one by one.
 #[derive(Clone, Debug, Default)]
 struct Primitives {
     triangles: Vec<Triangle8>,
