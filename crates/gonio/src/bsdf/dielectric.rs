@@ -61,14 +61,21 @@ impl Dielectric {
         })
     }
 
-    /// The reflected fraction for `cos_theta_o` (signed), honouring the `fresnel` switch.
+    /// The reflected fraction for `cos_theta_o` (signed), honouring the `fresnel` switch (without it, the
+    /// normal-incidence value, except under total internal reflection).
     #[must_use]
     pub fn reflected_fraction(&self, cos_theta_o: f32) -> f32 {
-        let f = fresnel_dielectric(cos_theta_o, self.eta);
-        if self.fresnel || f >= 1.0 {
+        self.reflected_fraction_lanes(cos_theta_o)
+    }
+
+    /// [`Self::reflected_fraction`] in lanes ([`Real`]), as the lane kernel samples.
+    #[inline(always)]
+    fn reflected_fraction_lanes<R: Real>(&self, cos_theta_o: R) -> R {
+        let f = fresnel_dielectric_lanes(cos_theta_o, self.eta);
+        if self.fresnel {
             f
         } else {
-            fresnel_dielectric(1.0, self.eta)
+            R::select(f.ge(R::splat(1.0)), f, R::splat(fresnel_dielectric(1.0, self.eta)))
         }
     }
 }
@@ -196,8 +203,7 @@ impl LaneModel for Dielectric {
     #[inline(always)]
     fn sample_lanes<R: Real>(&self, wo: V3<R>, uc: R, _ux: R, _uy: R) -> LaneSample<R> {
         let (zero, one) = (R::splat(0.0), R::splat(1.0));
-        let f = fresnel_dielectric_lanes(wo.z, self.eta);
-        let r = if self.fresnel { f } else { R::select(f.ge(one), f, R::splat(fresnel_dielectric(1.0, self.eta))) };
+        let r = self.reflected_fraction_lanes(wo.z);
         // Refraction from the side of ωo: η' = ηₜ/ηᵢ, n = ±z towards ωo.
         let inside = wo.z.lt(zero);
         let (eta, cos_i, nz) =
