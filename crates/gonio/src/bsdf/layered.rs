@@ -531,8 +531,10 @@ mod tests {
     /// sums in closed form: light leaving a Lambertian base is cosine-distributed, so the coating reflects
     /// the hemispherical average F̄ᵢ of it back at every internal bounce, and ρ / (1 − ρ F̄ᵢ) is exact.
     /// (`nonlinear = false`, Mitsuba's default, divides by 1 − F̄ᵢ instead: a different, non-physical
-    /// model.) The walk must agree within its stochastic error: f averaged over random pairs with 512 walks
-    /// each, and the albedo.
+    /// model.) The walk must agree within its stochastic error: f averaged over 160 random pairs with 4096
+    /// walks each (the most `samples` allows), and the albedo. (With 512 walks the per-pair spread was 5 % and the standard error of the mean
+    /// over 40 pairs about as large as the bound, so the test passed or failed with the random stream: it
+    /// failed when the build's fused multiply-adds changed the stream's use, 2026-12-04.)
     #[test]
     fn smooth_coating_over_diffuse_is_plastic() {
         let walk = |samples: u32| {
@@ -544,17 +546,21 @@ mod tests {
         };
         let p = Bsdf::from_json(r#"{"type": "plastic", "int_ior": 1.5, "ext_ior": 1.0, "diffuse_reflectance": 0.5, "nonlinear": true}"#)
             .unwrap();
-        let l = walk(512);
-        let (mut sum, mut worst, mut n) = (0.0f64, 0.0f32, 0);
-        for (wo, wi) in pairs(40) {
+        let l = walk(4096);
+        let (mut sum, mut sum2, mut worst, mut n) = (0.0f64, 0.0f64, 0.0f32, 0);
+        for (wo, wi) in pairs(160) {
             let (a, b) = (l.f(wo, wi).r(), p.f(wo, wi).r());
             let e = a / b - 1.0;
             sum += f64::from(e);
+            sum2 += f64::from(e) * f64::from(e);
             worst = worst.max(e.abs());
             n += 1;
         }
         let mean = sum / f64::from(n);
-        eprintln!("layered (512 walks) vs plastic nonlinear: mean relative difference {mean:+.2e}, worst {worst:.2e} over {n} pairs");
+        let standard_error = ((sum2 / f64::from(n) - mean * mean) / f64::from(n - 1)).sqrt();
+        eprintln!(
+            "layered (4096 walks) vs plastic nonlinear: mean relative difference {mean:+.2e} (standard error {standard_error:.1e}), worst {worst:.2e} over {n} pairs"
+        );
         // The per-pair spread is the walk's noise (a few % at 512 walks); the mean over pairs is the bias.
         assert!(mean.abs() < 5e-3, "mean {mean}, worst {worst}");
         let l = walk(4);

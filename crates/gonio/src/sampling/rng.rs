@@ -148,7 +148,7 @@ impl Pcg32x8 {
     /// lanes 0–3 and 4–7 in two registers, the 64-bit multiply from three 32 × 32 → 64-bit ones
     /// (`vpmuludq`), XSH-RR by variable shifts. The same numbers as the plain loop, in fewer instructions
     /// (LLVM vectorised the loop, but moved lanes through memory and shuffled them): 2026-12, 2 % fewer
-    /// for a whole render. Tested against [`Pcg32`] by `make test`'s native run (`test-native`).
+    /// for a whole render. Tested against [`Pcg32`] by `make test` (built for the CPU it runs on; the plain loop by `test-portable`).
     #[cfg(all(target_arch = "x86_64", target_feature = "avx2", target_feature = "fma"))]
     #[inline(always)]
     pub fn next_f32(&mut self, draw: u32) -> crate::math::simd::Float8 {
