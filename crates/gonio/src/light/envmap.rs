@@ -144,7 +144,7 @@ impl EnvMap {
     #[inline]
     fn direction_to_uv(d: Vec3) -> Vec2 {
         let u = d.x.atan2(-d.z) * (0.5 / PI);
-        let v = d.x.hypot(d.z).atan2(d.y) / PI;
+        let v = (d.x * d.x + d.z * d.z).sqrt().atan2(d.y) / PI;
         Vec2::new(u - u.floor(), v)
     }
 
@@ -182,13 +182,22 @@ impl EnvMap {
     #[inline(always)]
     fn blend<R: LaneAccess>(&self, (x, y): &Cells, fx: R, fy: R) -> [R; 3] {
         let row = self.width + 1;
-        let texel = |dx: usize, dy: usize, c: usize| {
-            R::from_fn(|i| self.texels.get((y[i] as usize + dy) * row + x[i] as usize + dx).map_or(0.0, |t| t.0[c]))
+        // One texel per lane (x, y are in range by construction; a miss would read black, never panic).
+        let texel = |dx: usize, dy: usize| -> [R; 3] {
+            let mut rgb = [[0.0f32; MAX_LANES]; 3];
+            for i in 0..R::LANES {
+                let t = self.texels.get((y[i] as usize + dy) * row + x[i] as usize + dx).copied().unwrap_or(Rgb::ZERO);
+                for (c, v) in rgb.iter_mut().zip(t.0) {
+                    c[i] = v;
+                }
+            }
+            rgb.map(|c| R::from_fn(|i| c[i]))
         };
+        let (t00, t10, t01, t11) = (texel(0, 0), texel(1, 0), texel(0, 1), texel(1, 1));
         let (one_x, one_y) = (R::splat(1.0) - fx, R::splat(1.0) - fy);
         std::array::from_fn(|c| {
-            let top = texel(0, 0, c) * one_x + texel(1, 0, c) * fx;
-            let bottom = texel(0, 1, c) * one_x + texel(1, 1, c) * fx;
+            let top = t00[c] * one_x + t10[c] * fx;
+            let bottom = t01[c] * one_x + t11[c] * fx;
             top * one_y + bottom * fy
         })
     }
@@ -217,7 +226,7 @@ impl EnvMap {
             (fx[i], fy[i], density[i]) = (s.u_coin, s.u_low, s.pmf * self.cells.len() as f32);
         }
         let (fx, fy, density) = (R::from_fn(|i| fx[i]), R::from_fn(|i| fy[i]), R::from_fn(|i| density[i]));
-        // Grid → texture coordinates: the grid starts half a texel into u (`sin_cos_turn` takes u ≥ 1).
+        // Grid → texture coordinates: the grid starts half a texel into u (no wrap: `sin_cos_turn` is periodic).
         let s = R::from_fn(|i| cells.0[i] as f32) + fx;
         let t = R::from_fn(|i| cells.1[i] as f32) + fy;
         let (u, v) = ((s + 0.5) / self.width as f32, t / (self.height - 1) as f32);
@@ -237,7 +246,7 @@ impl EnvMap {
         let zero = R::splat(0.0);
         let d = V3::select(length.gt(zero), d.div(length), V3::new(zero, zero, zero));
         let sin_theta = (d.x * d.x + d.z * d.z).sqrt();
-        // atan2 and acos lane by lane, with the grid cell and its density.
+        // (u, v) by atan2 lane by lane, with the grid cell and its density.
         let (dx, dy, dz) = (d.x.lanes(), d.y.lanes(), d.z.lanes());
         let (mut cells, mut fx, mut fy, mut density) =
             (([0u32; MAX_LANES], [0u32; MAX_LANES]), [0.0; MAX_LANES], [0.0; MAX_LANES], [0.0; MAX_LANES]);
