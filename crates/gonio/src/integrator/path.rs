@@ -219,17 +219,26 @@ fn trace(scene: &Scene, p: &mut Packet, lanes: u32, hit: &mut Surfaces8, out: &m
     let t = found.t.to_array();
     let first = lanes & lanes_where(|i| p.depth[i] == 0);
     let shown = lanes & !(if hide_emitters { first } else { 0 });
-    // A constant environment seen, in lanes: `emitter_hit`'s Le · w, with w the power heuristic
+    // An environment seen (constant or a map), in lanes: `emitter_hit`'s Le · w, with w the power heuristic
     // against light sampling, one sample of each (1 after a delta lobe and for camera rays).
     let (mut sky, mut sky_le) = (0u32, [Float8::splat(0.0); 3]);
-    if let Some(Light::Constant(constant)) = scene.environment.map(|i| &scene.lights[i as usize]) {
+    let environment = scene.environment.map(|i| &scene.lights[i as usize]);
+    let seen = match environment {
+        Some(Light::Constant(constant)) => Some((constant.radiance.0.map(Float8::splat), Float8::splat(constant.pdf_li(Vec3::Z)))),
+        Some(Light::EnvMap(env)) if shown & !hit.found != 0 => {
+            let e = env.eval_lanes(p.d.lanes(), shown & !hit.found);
+            Some((e.li, e.pdf))
+        }
+        _ => None,
+    };
+    if let Some((radiance, pdf)) = seen {
         sky = shown & !hit.found;
-        let light_pdf = Float8::splat(constant.pdf_li(Vec3::Z) / n_lights as f32);
+        let light_pdf = pdf / Float8::splat(n_lights as f32);
         let unweighted = Mask8::from_bitmask(first | p.delta);
         let w = Float8::select(unweighted, Float8::splat(1.0), power_heuristic_1(Float8::load(&p.pdf), light_pdf));
-        sky_le = constant.radiance.0.map(|c| w * c);
+        sky_le = radiance.map(|c| w * c);
     }
-    // Other emitters seen, lane by lane: emitting surfaces, and an environment map.
+    // Other emitters seen, lane by lane: emitting surfaces.
     let escaped = if scene.environment.is_some() { lanes & !hit.found & !sky } else { 0 };
     for lane in bits(shown & (hit.emits | escaped)) {
         let prev = (first & (1 << lane) == 0).then(|| BsdfSampled {
@@ -383,9 +392,9 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
             // `(u · n) as usize`, at most n − 1: u · n is in [0, n), so truncation is the cast.
             let chosen_lanes = (u_light * n_lights as f32).trunc().min(Float8::splat((n_lights - 1) as f32));
             let chosen = chosen_lanes.to_array();
-            // The lanes that chose the same light, in lanes where it is a constant environment
-            // (`ConstantLight::sample_li`; the surfaces' normals are never zero) or a small flat mesh (a
-            // `rectangle` light, say: its triangles chosen and loaded in lanes).
+            // The lanes that chose the same light, in lanes where it is an environment (constant or a map:
+            // `ConstantLight::sample_li`, `EnvMap::sample_lanes`; the surfaces' normals are never zero) or a
+            // small flat mesh (a `rectangle` light, say: its triangles chosen and loaded in lanes).
             let (sp, sn) = (hit.p.lanes(), hit.n.lanes());
             let mut rest = smooth;
             for (first, same) in groups(smooth, |l| chosen_lanes.eq(Float8::splat(chosen[l])).bitmask()) {
@@ -401,6 +410,21 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
                         shadow.merge(m, &ray);
                         sampled |= same;
                     }
+                    rest &= !same;
+                    continue;
+                }
+                if let Light::EnvMap(env) = &scene.lights[index] {
+                    // `EnvMap::sample_li` in lanes (the surfaces' normals are never zero), where the sample
+                    // carries light.
+                    let s = env.sample_lanes(u_c, u_x, u_y, same);
+                    let zero = Float8::splat(0.0);
+                    let ok = s.valid & m & (s.li[0].ne(zero) | s.li[1].ne(zero) | s.li[2].ne(zero));
+                    let ray = RayLanes { o: offset_origin_lanes(sp, sn, s.wi), d: s.wi, tmax: Float8::splat(f32::INFINITY) };
+                    li.store(V3::select(ok, V3::new(s.li[0], s.li[1], s.li[2]), li.lanes()));
+                    wi.store(V3::select(ok, s.wi, wi.lanes()));
+                    light_pdf = Float8::select(ok, s.pdf, Float8::load(&light_pdf)).to_array();
+                    shadow.merge(ok, &ray);
+                    sampled |= ok.bitmask();
                     rest &= !same;
                     continue;
                 }
