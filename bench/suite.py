@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import argparse
 import fnmatch
+import gc
 import hashlib
 import json
 import math
@@ -169,11 +170,20 @@ def mitsuba_server(variant: str, threads: int) -> None:
     import drjit as dr
 
     dr.set_thread_count(threads)
+    # Kernel history: a timed render reports the kernels it had to compile (cache misses), which a warm
+    # render should not have.
+    dr.set_flag(dr.JitFlag.KernelHistory, True)
+
+    def compiled() -> tuple[int, float]:
+        jit = [k for k in dr.kernel_history() if k.get("type") == dr.KernelType.JIT and not k.get("cache_hit")]
+        return len(jit), sum(k.get("codegen_time", 0.0) + k.get("backend_time", 0.0) for k in jit) / 1000
+
     print(RESULT + json.dumps({"ready": variant, "threads": dr.thread_count()}), flush=True)
     for line in sys.stdin:
         req = json.loads(line)
         try:
             if req["op"] == "render":
+                compiled()  # clears the history
                 wall0, cpu0 = time.perf_counter(), time.process_time()
                 scene = mi.load_file(req["scene"], **req["defines"])
                 img = mi.render(scene, spp=req["spp"], seed=req["seed"])
@@ -181,7 +191,8 @@ def mitsuba_server(variant: str, threads: int) -> None:
                 arr = np.array(img, dtype=np.float32)[..., :3]
                 wall, cpu = time.perf_counter() - wall0, time.process_time() - cpu0
                 np.save(req["out"], arr)
-                reply = {"wall": wall, "cpu": cpu}
+                misses, compile_s = compiled()
+                reply = {"wall": wall, "cpu": cpu, "kernels_compiled": misses, "compile_s": compile_s}
             elif req["op"] == "reference":
                 scene = mi.load_file(req["scene"], **req["defines"])
                 acc = None
@@ -195,6 +206,12 @@ def mitsuba_server(variant: str, threads: int) -> None:
                 reply = {"error": f"unknown op {req['op']}"}
         except Exception as e:  # a scene Mitsuba refuses: report and serve the next request
             reply = {"error": f"{type(e).__name__}: {e}"}
+        # Free the scene before the next request: Dr.Jit bakes the registry ids of a scene's objects into
+        # its kernels, and a scene loaded while the previous one lives gets other ids, so other kernels
+        # (compiled again, in a timed render). Loaded after the previous one is freed, it gets the same ids
+        # and the warm-up's kernels.
+        scene = img = None
+        gc.collect()
         print(RESULT + json.dumps(reply), flush=True)
 
 
@@ -330,6 +347,10 @@ def run_scene(scene: Scene, args, mitsuba: Mitsuba, tmp: Path) -> dict:
                 "cpu": min(t["cpu"] for t in ts),
                 "walls": [t["wall"] for t in ts],
             }
+            best = min(ts, key=lambda t: t["wall"])
+            if "kernels_compiled" in best:
+                row[label]["kernels_compiled"] = best["kernels_compiled"]
+                row[label]["compile_s"] = best["compile_s"]
             if ts[0].get("render") is not None:
                 row[label]["render_loop"] = min(t["render"] for t in ts)
             if ts[0].get("warnings"):
@@ -376,7 +397,7 @@ def fmt(x: float | None, spec: str) -> str:
 
 
 def print_table(rows: list[dict], baseline: bool) -> dict:
-    head = f"{'scene':<32} {'gonio s':>8} {'mitsuba s':>9} {'time g/m':>8} {'MSE g/m':>8} {'mean g/ref':>10} {'mean m/ref':>10}"
+    head = f"{'scene':<32} {'gonio s':>8} {'mitsuba s':>9} {'time g/m':>8} {'cpu g/m':>7} {'MSE g/m':>8} {'mean g/ref':>10} {'mean m/ref':>10}"
     if baseline:
         head += f" {'base s':>8} {'g/base':>7}"
     print(head)
@@ -398,6 +419,7 @@ def print_table(rows: list[dict], baseline: bool) -> dict:
             findings.append(f"{row['scene']}: gonio's image has {g['nonfinite']} non-finite values")
         line = (
             f"{row['scene']:<32} {fmt(g and g['wall'], '8.3f')} {fmt(m and m['wall'], '9.3f')} {fmt(tr, '8.2f')} "
+            f"{fmt(g['cpu'] / m['cpu'] if g and m else None, '7.2f')} "
             f"{fmt(mr, '8.2f')} {fmt(g and g.get('mean_ratio'), '10.4f')}{flag or ' '}{fmt(m and m.get('mean_ratio'), '9.4f')}"
         )
         if baseline:
@@ -408,6 +430,8 @@ def print_table(rows: list[dict], baseline: bool) -> dict:
             first = err.strip().splitlines()[0] if err.strip() else err
             print(f"{'':<4}{label} FAILED{expected}: {first[:300]}")
             failures.append(row["scene"])
+        if m and m.get("kernels_compiled"):
+            print(f"{'':<4}note: Mitsuba's kept render compiled {m['kernels_compiled']} kernels ({m['compile_s']:.2f} s): not warm")
         if g and g.get("warnings"):
             for w in g["warnings"]:
                 print(f"{'':<4}gonio: {w[:200]}")
@@ -457,8 +481,16 @@ def main() -> None:
     ap.add_argument("--baseline", type=Path, help="another gonio binary timed in the same rounds (e.g. a build before a change)")
     ap.add_argument("--json", type=Path, metavar="OUT", help="write every number to OUT")
     ap.add_argument("--list", action="store_true", help="list the scenes and exit")
+    ap.add_argument("--table", type=Path, metavar="JSON", help="print the table of an earlier run's --json output and exit")
     args = ap.parse_args()
     args_spp = args.spp
+    if args.table:
+        run = json.loads(args.table.read_text())
+        args_spp = run["spp"]
+        print(f"== {run['gonio']} vs Mitsuba 3 {run['variant']}, {run['spp']} spp, {run['threads']} threads, fastest of {run['repeats']}; "
+              f"reference {run['ref_spp']} spp ({run['load']} at the end)")  # fmt: skip
+        print_table(run["scenes"], run["baseline"] is not None)
+        return
     scenes = all_scenes()
     if args.scenes:
         scenes = [s for s in scenes if any(fnmatch.fnmatch(s.name, g) for g in args.scenes)]
@@ -500,6 +532,7 @@ def main() -> None:
     print(f"\n== results ({time.perf_counter() - t0:.0f} s; Mitsuba {mitsuba.variant}; {load_note()} at the end)")
     summary = print_table(rows, args.baseline is not None)
     print("(time: wall seconds, the fastest round; gonio's whole process against Mitsuba's load + render in a warm process. "
+          "cpu g/m: the same with CPU time (user + system, all threads; the least of the rounds), fairer on a loaded machine. "
           "MSE g/m: gonio's MSE / Mitsuba's, against the reference. mean x/ref: the image mean / the reference's; ! = gonio off by > 1 %)")  # fmt: skip
     if args.json:
         out = {"gonio": str(args.gonio), "baseline": str(args.baseline) if args.baseline else None, "variant": mitsuba.variant,
