@@ -273,7 +273,9 @@ def start_mitsuba(threads: int) -> tuple[Mitsuba, str | None]:
     llvm = llvm_library()
     why = None
     if llvm is None:
-        why = "libLLVM 19 not found by `ldconfig -p` (Debian: apt-get install libllvm19) and DRJIT_LIBLLVM_PATH not set"
+        given = os.environ.get("DRJIT_LIBLLVM_PATH")
+        why = (f"DRJIT_LIBLLVM_PATH={given} does not exist" if given else
+               "libLLVM 19 not found by `ldconfig -p` (Debian: apt-get install libllvm19) and DRJIT_LIBLLVM_PATH not set")  # fmt: skip
     else:
         m = Mitsuba("llvm_ad_rgb", threads, llvm)
         try:
