@@ -33,6 +33,12 @@ impl BlendBsdf {
         BlendBsdf { weight, mix: Sum::new(vec![first, second], vec![1.0 - weight, weight]) }
     }
 
+    /// The two-term sum this blend is.
+    #[inline(always)]
+    pub(crate) fn mix(&self) -> &Sum {
+        &self.mix
+    }
+
     pub fn from_props(p: &Props) -> Result<Self> {
         let weight = p.float_in("weight", 0.5, 0.0, 1.0)?;
         let nested = p.nested();

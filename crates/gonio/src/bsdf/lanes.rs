@@ -70,6 +70,36 @@ impl<R: Real> LaneSample<R> {
     }
 }
 
+impl<R: Real> LaneSample<R> {
+    /// `a` in the lanes of `m`, else `b`, field by field.
+    #[inline(always)]
+    pub fn select(m: R::Mask, a: Self, b: Self) -> Self {
+        LaneSample {
+            wi: V3::select(m, a.wi, b.wi),
+            f: channels!(|c| R::select(m, a.f[c], b.f[c])),
+            pdf: R::select(m, a.pdf, b.pdf),
+            weight: channels!(|c| R::select(m, a.weight[c], b.weight[c])),
+            flags: R::select(m, a.flags, b.flags),
+            eta: R::select(m, a.eta, b.eta),
+            valid: (m & a.valid) | (!m & b.valid),
+        }
+    }
+
+    /// Where the sampled lobe is a Dirac delta: flag bits are below 32, so the delta bit (16) is set
+    /// exactly where the number is at least 16.
+    #[inline(always)]
+    pub fn is_delta(&self) -> R::Mask {
+        self.flags.ge(R::splat(BsdfFlags::DELTA.0 as f32))
+    }
+}
+
+/// Every lane set.
+#[inline(always)]
+#[must_use]
+pub fn all<R: Real>() -> R::Mask {
+    R::splat(0.0).eq(R::splat(0.0))
+}
+
 /// The flag bits of `flags` as a lane number.
 #[inline(always)]
 #[must_use]
@@ -142,6 +172,188 @@ impl LaneModel for LaneKernel<'_> {
             LaneKernel::Plastic(k) => k.sample_lanes(wo, uc, ux, uy),
             LaneKernel::SmoothConductor(k) => k.sample_lanes(wo, uc, ux, uy),
             LaneKernel::Dielectric(k) => k.sample_lanes(wo, uc, ux, uy),
+        }
+    }
+}
+
+/// Any model in lanes, for the lanes of a mask (the others' results are unspecified): the path tracer
+/// calls it once for the lanes of a packet that share a model, and the batch drivers (through
+/// `impl LaneModel for Bsdf`) for every model. Models with a kernel run it in lanes; the composites
+/// (`twosided`, `mask`, `sum`, `blendbsdf`) combine their components' lanes; a model that cannot vectorise
+/// (a random walk, a table lookup per lane, a composite inside a composite) runs its single calls lane by
+/// lane, inside this dispatch ([`each_lane`]) rather than in its callers.
+impl Bsdf {
+    /// f(ωo, ωi) in the lanes of `active`.
+    #[inline(always)]
+    pub fn f_lanes_where<R: Real>(&self, wo: V3<R>, wi: V3<R>, active: R::Mask) -> [R; 3] {
+        if let Some(sum) = self.as_sum() {
+            return sum.f_lanes_where(wo, wi, active);
+        }
+        match self {
+            Bsdf::TwoSided(m) => m.f_lanes_where(wo, wi, active),
+            Bsdf::Mask(m) => m.f_lanes_where(wo, wi, active),
+            _ => self.leaf_f(wo, wi, active),
+        }
+    }
+
+    /// pdf(ωo, ωi) in the lanes of `active`.
+    #[inline(always)]
+    pub fn pdf_lanes_where<R: Real>(&self, wo: V3<R>, wi: V3<R>, active: R::Mask) -> R {
+        if let Some(sum) = self.as_sum() {
+            return sum.pdf_lanes_where(wo, wi, active);
+        }
+        match self {
+            Bsdf::TwoSided(m) => m.pdf_lanes_where(wo, wi, active),
+            Bsdf::Mask(m) => m.pdf_lanes_where(wo, wi, active),
+            _ => self.leaf_pdf(wo, wi, active),
+        }
+    }
+
+    /// sample(ωo, uc, (ux, uy)) in the lanes of `active` (no sample in the others).
+    #[inline(always)]
+    pub fn sample_lanes_where<R: Real>(&self, wo: V3<R>, uc: R, ux: R, uy: R, active: R::Mask) -> LaneSample<R> {
+        if let Some(sum) = self.as_sum() {
+            return sum.sample_lanes_where(wo, uc, ux, uy, active);
+        }
+        match self {
+            Bsdf::TwoSided(m) => m.sample_lanes_where(wo, uc, ux, uy, active),
+            Bsdf::Mask(m) => m.sample_lanes_where(wo, uc, ux, uy, active),
+            _ => self.leaf_sample(wo, uc, ux, uy, active),
+        }
+    }
+
+    /// The sum a `sum` or `blendbsdf` is (so that both run one copy of its lane code).
+    #[inline(always)]
+    fn as_sum(&self) -> Option<&super::Sum> {
+        match self {
+            Bsdf::Blend(m) => Some(m.mix()),
+            Bsdf::Sum(m) => Some(m),
+            _ => None,
+        }
+    }
+
+    /// [`Self::f_lanes_where`] for a component of a composite: its kernel, or lane by lane (a composite
+    /// nested in another composite runs lane by lane, so that the dispatch is not recursive and every
+    /// kernel it reaches is inlined into the caller's lane code).
+    #[inline(always)]
+    pub(crate) fn leaf_f<R: Real>(&self, wo: V3<R>, wi: V3<R>, active: R::Mask) -> [R; 3] {
+        match (self, self.lane_kernel()) {
+            (Bsdf::Diffuse(m), _) => m.f_lanes(wo, wi),
+            (_, Some(k)) => k.f_lanes(wo, wi),
+            (_, None) => each_lane::f(self, wo, wi, active),
+        }
+    }
+
+    /// [`Self::pdf_lanes_where`] for a component (see [`Self::leaf_f`]).
+    #[inline(always)]
+    pub(crate) fn leaf_pdf<R: Real>(&self, wo: V3<R>, wi: V3<R>, active: R::Mask) -> R {
+        match (self, self.lane_kernel()) {
+            (Bsdf::Diffuse(m), _) => m.pdf_lanes(wo, wi),
+            (_, Some(k)) => k.pdf_lanes(wo, wi),
+            (_, None) => each_lane::pdf(self, wo, wi, active),
+        }
+    }
+
+    /// [`Self::sample_lanes_where`] for a component (see [`Self::leaf_f`]).
+    #[inline(always)]
+    pub(crate) fn leaf_sample<R: Real>(&self, wo: V3<R>, uc: R, ux: R, uy: R, active: R::Mask) -> LaneSample<R> {
+        let s = match (self, self.lane_kernel()) {
+            (Bsdf::Diffuse(m), _) => m.sample_lanes(wo, uc, ux, uy),
+            (_, Some(k)) => k.sample_lanes(wo, uc, ux, uy),
+            (_, None) => return each_lane::sample(self, wo, uc, ux, uy, active),
+        };
+        LaneSample { valid: s.valid & active, ..s }
+    }
+}
+
+/// Every model's single calls are its lanes where all lanes are active: what the batch drivers run.
+impl LaneModel for Bsdf {
+    #[inline(always)]
+    fn f_lanes<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> [R; 3] {
+        self.f_lanes_where(wo, wi, all::<R>())
+    }
+
+    #[inline(always)]
+    fn pdf_lanes<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> R {
+        self.pdf_lanes_where(wo, wi, all::<R>())
+    }
+
+    #[inline(always)]
+    fn sample_lanes<R: Real>(&self, wo: V3<R>, uc: R, ux: R, uy: R) -> LaneSample<R> {
+        self.sample_lanes_where(wo, uc, ux, uy, all::<R>())
+    }
+}
+
+/// A model's single calls, lane by lane, for the lanes of a mask (zeros and no sample in the others): how a
+/// model that cannot vectorise runs in lanes. Up to [`each_lane::MAX_LANES`] lanes (the widest lane type).
+pub mod each_lane {
+    use super::{BsdfSample, LaneSample};
+    use crate::bsdf::{Bsdf, BsdfModel};
+    use crate::math::lanes::{channels, Real, V3};
+    use crate::math::{Vec2, Vec3};
+    use crate::spectrum::Rgb;
+
+    /// The most lanes of any lane type (`Twice<Twice<Avx16>>`).
+    pub const MAX_LANES: usize = 64;
+
+    /// Lane `i` of `w`.
+    #[inline(always)]
+    fn row<R: Real>(w: V3<R>, i: usize) -> Vec3 {
+        Vec3::new(w.x.lane(i), w.y.lane(i), w.z.lane(i))
+    }
+
+    /// The lanes set in `active`, in order.
+    #[inline(always)]
+    fn lanes<R: Real>(active: R::Mask) -> impl Iterator<Item = usize> {
+        let mut bits = R::bitmask(active);
+        std::iter::from_fn(move || {
+            (bits != 0).then(|| {
+                let i = bits.trailing_zeros() as usize;
+                bits &= bits - 1;
+                i
+            })
+        })
+    }
+
+    /// `m.f` in the lanes of `active`.
+    #[inline(never)]
+    pub fn f<R: Real>(m: &Bsdf, wo: V3<R>, wi: V3<R>, active: R::Mask) -> [R; 3] {
+        debug_assert!(R::LANES <= MAX_LANES);
+        let mut rows = [Rgb::ZERO; MAX_LANES];
+        for i in lanes::<R>(active) {
+            rows[i] = m.f(row(wo, i), row(wi, i));
+        }
+        channels!(|c| R::from_fn(|i| rows[i].0[c]))
+    }
+
+    /// `m.pdf` in the lanes of `active`.
+    #[inline(never)]
+    pub fn pdf<R: Real>(m: &Bsdf, wo: V3<R>, wi: V3<R>, active: R::Mask) -> R {
+        debug_assert!(R::LANES <= MAX_LANES);
+        let mut rows = [0.0f32; MAX_LANES];
+        for i in lanes::<R>(active) {
+            rows[i] = m.pdf(row(wo, i), row(wi, i));
+        }
+        R::from_fn(|i| rows[i])
+    }
+
+    /// `m.sample` in the lanes of `active`.
+    #[inline(never)]
+    pub fn sample<R: Real>(m: &Bsdf, wo: V3<R>, uc: R, ux: R, uy: R, active: R::Mask) -> LaneSample<R> {
+        debug_assert!(R::LANES <= MAX_LANES);
+        let mut rows: [Option<BsdfSample>; MAX_LANES] = [None; MAX_LANES];
+        for i in lanes::<R>(active) {
+            rows[i] = m.sample(row(wo, i), uc.lane(i), Vec2::new(ux.lane(i), uy.lane(i)));
+        }
+        let get = |f: &dyn Fn(&BsdfSample) -> f32| R::from_fn(|i| rows[i].as_ref().map_or(0.0, f));
+        LaneSample {
+            wi: V3::new(get(&|s| s.wi.x), get(&|s| s.wi.y), get(&|s| s.wi.z)),
+            f: channels!(|c| get(&|s| s.f.0[c])),
+            pdf: get(&|s| s.pdf),
+            weight: channels!(|c| get(&|s| s.weight.0[c])),
+            flags: get(&|s| s.flags.0 as f32),
+            eta: get(&|s| s.eta),
+            valid: R::from_fn(|i| if rows[i].is_some() { 1.0 } else { 0.0 }).gt(R::splat(0.5)),
         }
     }
 }

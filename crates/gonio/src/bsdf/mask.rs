@@ -19,8 +19,10 @@
 //! assert!((s.weight.r() - 1.0).abs() < 1e-6);
 //! ```
 
+use super::lanes::{f_one, flag_lanes, pdf_one, sample_one, LaneModel, LaneSample};
 use super::{Bsdf, BsdfFlags, BsdfModel, BsdfSample};
 use crate::error::{Error, Result};
+use crate::math::lanes::{channels, Real, V3};
 use crate::math::{Vec2, Vec3};
 use crate::props::Props;
 use crate::spectrum::Rgb;
@@ -70,22 +72,68 @@ impl BsdfModel for Mask {
     }
 
     fn f(&self, wo: Vec3, wi: Vec3) -> Rgb {
-        self.nested.f(wo, wi) * self.opacity
+        f_one(self, wo, wi)
     }
 
     fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
-        if uc < self.opacity {
-            // The nested model, chosen with probability α: f and pdf both scale by α, the weight does not.
-            let s = self.nested.sample(wo, uc / self.opacity, u)?;
-            Some(BsdfSample { f: s.f * self.opacity, pdf: s.pdf * self.opacity, ..s })
-        } else {
-            let null = 1.0 - self.opacity;
-            BsdfSample::delta(-wo, Rgb::splat(null), null, BsdfFlags::DELTA_TRANSMISSION, 1.0)
-        }
+        sample_one(self, wo, uc, u)
     }
 
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        self.nested.pdf(wo, wi) * self.opacity
+        pdf_one(self, wo, wi)
+    }
+}
+
+impl Mask {
+    /// [`Bsdf::f_lanes_where`] of `mask`: the nested model's f times the opacity α.
+    #[inline(always)]
+    pub(crate) fn f_lanes_where<R: Real>(&self, wo: V3<R>, wi: V3<R>, active: R::Mask) -> [R; 3] {
+        self.nested.leaf_f(wo, wi, active).map(|v| v * self.opacity)
+    }
+
+    /// [`Bsdf::pdf_lanes_where`] of `mask`: the nested model's density times α.
+    #[inline(always)]
+    pub(crate) fn pdf_lanes_where<R: Real>(&self, wo: V3<R>, wi: V3<R>, active: R::Mask) -> R {
+        self.nested.leaf_pdf(wo, wi, active) * self.opacity
+    }
+
+    /// [`Bsdf::sample_lanes_where`] of `mask`: with probability α the nested model (f and pdf both scale
+    /// by α, the weight does not), else straight through (a delta transmission of weight 1).
+    #[inline(always)]
+    pub(crate) fn sample_lanes_where<R: Real>(&self, wo: V3<R>, uc: R, ux: R, uy: R, active: R::Mask) -> LaneSample<R> {
+        let nested = uc.lt(R::splat(self.opacity));
+        let null = 1.0 - self.opacity;
+        let through = LaneSample::delta(
+            wo.neg(),
+            [R::splat(null); 3],
+            R::splat(null),
+            flag_lanes(BsdfFlags::DELTA_TRANSMISSION),
+            R::splat(1.0),
+            active & !nested,
+        );
+        if !R::any(active & nested) {
+            return through;
+        }
+        let s = self.nested.leaf_sample(wo, uc / self.opacity, ux, uy, active & nested);
+        let s = LaneSample { f: channels!(|c| s.f[c] * self.opacity), pdf: s.pdf * self.opacity, ..s };
+        LaneSample::select(nested, s, through)
+    }
+}
+
+impl LaneModel for Mask {
+    #[inline(always)]
+    fn f_lanes<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> [R; 3] {
+        self.f_lanes_where(wo, wi, super::lanes::all::<R>())
+    }
+
+    #[inline(always)]
+    fn pdf_lanes<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> R {
+        self.pdf_lanes_where(wo, wi, super::lanes::all::<R>())
+    }
+
+    #[inline(always)]
+    fn sample_lanes<R: Real>(&self, wo: V3<R>, uc: R, ux: R, uy: R) -> LaneSample<R> {
+        self.sample_lanes_where(wo, uc, ux, uy, super::lanes::all::<R>())
     }
 }
 

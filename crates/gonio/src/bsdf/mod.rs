@@ -532,32 +532,6 @@ pub trait Examples {
     const VIOLATIONS: &'static [(&'static str, &'static str)] = &[];
 }
 
-/// Runs `$call` (one model's batch loop, chosen by one `match`) compiled twice: for the baseline target and,
-/// on x86-64 CPUs that have them (detected at run time, so one wheel runs everywhere), with AVX2 and FMA,
-/// whose 8-wide registers the kernels' lanes fill ([`lanes`]). The `match` and the loops it inlines are the
-/// body of a function compiled with those features (`$arg: $ty` are its parameters, named as in `$call`):
-/// a closure would not do, as it is compiled once, for the baseline, and merely called from the feature
-/// function (2026-11: that was the case before, and the AVX2 build held no 256-bit instruction). Both builds
-/// round alike: Rust never fuses a multiply and an add on its own, and `mul_add` is the same exact operation
-/// in hardware and in libm, so the results are the same bit for bit on every path (test
-/// `batches_equal_single_calls`).
-macro_rules! simd_batch {
-    ($self:ident, $m:ident => $call:expr; $($arg:ident: $ty:ty),* => $ret:ty) => {{
-        #[cfg(target_arch = "x86_64")]
-        {
-            #[target_feature(enable = "avx2,fma")]
-            unsafe fn with_avx2(b: &Bsdf, $($arg: $ty),*) -> $ret {
-                dispatch!(b, $m => $call)
-            }
-            if std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma") {
-                // SAFETY: the CPU has the features the function is compiled for (checked just above).
-                return unsafe { with_avx2($self, $($arg),*) };
-            }
-        }
-        dispatch!($self, $m => $call)
-    }};
-}
-
 /// Declares the closed set of models: the enum, its `BsdfModel` forwarding, `From` conversions and the
 /// plugin-name table. Adding a model is one line here.
 macro_rules! bsdf_models {
@@ -584,24 +558,25 @@ macro_rules! bsdf_models {
             fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> { dispatch!(self, m => m.sample(wo, uc, u)) }
             #[inline]
             fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 { dispatch!(self, m => m.pdf(wo, wi)) }
+            // The batches run every model in lanes (`impl LaneModel for Bsdf`: a model's kernel, its
+            // components' lanes, or its single calls lane by lane), on the widest lanes the CPU has.
             fn f_batch(&self, wo: &[Vec3], wi: &[Vec3], out: &mut [Rgb]) {
-                simd_batch!(self, m => m.f_batch(wo, wi, out); wo: &[Vec3], wi: &[Vec3], out: &mut [Rgb] => ())
+                lanes::f_rows(self, wo, wi, out)
             }
             fn pdf_batch(&self, wo: &[Vec3], wi: &[Vec3], out: &mut [f32]) {
-                simd_batch!(self, m => m.pdf_batch(wo, wi, out); wo: &[Vec3], wi: &[Vec3], out: &mut [f32] => ())
+                lanes::pdf_rows(self, wo, wi, out)
             }
             fn sample_batch(&self, wo: &[Vec3], uc: &[f32], u: &[Vec2], out: &mut SampleColumns<'_>) {
-                simd_batch!(self, m => m.sample_batch(wo, uc, u, out); wo: &[Vec3], uc: &[f32], u: &[Vec2], out: &mut SampleColumns<'_> => ())
+                lanes::sample_rows(self, wo, uc, u, out)
             }
             fn f_batch_checked(&self, wo: &[Vec3], wi: &[Vec3], out: &mut [Rgb], check: RowCheck) -> bool {
-                simd_batch!(self, m => m.f_batch_checked(wo, wi, out, check); wo: &[Vec3], wi: &[Vec3], out: &mut [Rgb], check: RowCheck => bool)
+                lanes::f_rows_checked(self, wo, wi, out, check)
             }
             fn pdf_batch_checked(&self, wo: &[Vec3], wi: &[Vec3], out: &mut [f32], check: RowCheck) -> bool {
-                simd_batch!(self, m => m.pdf_batch_checked(wo, wi, out, check); wo: &[Vec3], wi: &[Vec3], out: &mut [f32], check: RowCheck => bool)
+                lanes::pdf_rows_checked(self, wo, wi, out, check)
             }
             fn sample_batch_checked(&self, wo: &[Vec3], uc: &[f32], u: &[Vec2], out: &mut SampleColumns<'_>, check: RowCheck) -> bool {
-                simd_batch!(self, m => m.sample_batch_checked(wo, uc, u, out, check);
-                    wo: &[Vec3], uc: &[f32], u: &[Vec2], out: &mut SampleColumns<'_>, check: RowCheck => bool)
+                lanes::sample_rows_checked(self, wo, uc, u, out, check)
             }
         }
 

@@ -19,8 +19,10 @@
 //! assert!((s.f(Vec3::Z, Vec3::Z).r() - 0.75 / std::f32::consts::PI).abs() < 1e-6);
 //! ```
 
+use super::lanes::{f_one, pdf_one, sample_one, LaneModel, LaneSample};
 use super::{Bsdf, BsdfFlags, BsdfModel, BsdfSample};
 use crate::error::{Error, Result};
+use crate::math::lanes::{channels, Real, V3};
 use crate::math::{Vec2, Vec3};
 use crate::props::Props;
 use crate::spectrum::Rgb;
@@ -78,19 +80,6 @@ impl Sum {
         };
         Ok(Sum::new(components, weights))
     }
-
-    /// Pick a component from `uc` and rescale `uc` for reuse.
-    fn select(&self, uc: f32) -> Option<(usize, f32)> {
-        let mut start = 0.0;
-        let last = self.probs.iter().rposition(|p| *p > 0.0)?;
-        for (k, p) in self.probs.iter().enumerate() {
-            if *p > 0.0 && (uc < start + p || k == last) {
-                return Some((k, ((uc - start) / p).clamp(0.0, 1.0 - f32::EPSILON)));
-            }
-            start += p;
-        }
-        None
-    }
 }
 
 impl crate::bsdf::Examples for Sum {
@@ -107,22 +96,88 @@ impl BsdfModel for Sum {
     }
 
     fn f(&self, wo: Vec3, wi: Vec3) -> Rgb {
-        self.components.iter().zip(&self.weights).fold(Rgb::ZERO, |acc, (c, w)| acc + c.f(wo, wi) * *w)
+        f_one(self, wo, wi)
     }
 
     fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
-        let (k, uc) = self.select(uc)?;
-        let s = self.components[k].sample(wo, uc, u)?;
-        let (w, p) = (self.weights[k], self.probs[k]);
-        if s.flags.has_delta() {
-            return Some(BsdfSample { f: s.f * w, pdf: s.pdf * p, weight: s.weight * (w / p), ..s });
-        }
-        // A smooth direction: every component's smooth lobes may have produced it.
-        BsdfSample::smooth(s.wi, self.f(wo, s.wi), self.pdf(wo, s.wi), s.flags, s.eta)
+        sample_one(self, wo, uc, u)
     }
 
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        self.components.iter().zip(&self.probs).filter(|(_, p)| **p > 0.0).map(|(c, p)| c.pdf(wo, wi) * p).sum()
+        pdf_one(self, wo, wi)
+    }
+}
+
+impl Sum {
+    /// [`Bsdf::f_lanes_where`] of `sum`: Σₖ wₖ fₖ.
+    #[inline(always)]
+    pub(crate) fn f_lanes_where<R: Real>(&self, wo: V3<R>, wi: V3<R>, active: R::Mask) -> [R; 3] {
+        self.components.iter().zip(&self.weights).fold([R::splat(0.0); 3], |acc, (c, &w)| {
+            let f = c.leaf_f(wo, wi, active);
+            channels!(|k| acc[k] + f[k] * w)
+        })
+    }
+
+    /// [`Bsdf::pdf_lanes_where`] of `sum`: Σₖ pₖ pdfₖ over the components that can be chosen.
+    #[inline(always)]
+    pub(crate) fn pdf_lanes_where<R: Real>(&self, wo: V3<R>, wi: V3<R>, active: R::Mask) -> R {
+        self.components
+            .iter()
+            .zip(&self.probs)
+            .filter(|(_, p)| **p > 0.0)
+            .fold(R::splat(0.0), |acc, (c, &p)| acc + c.leaf_pdf(wo, wi, active) * p)
+    }
+
+    /// [`Bsdf::sample_lanes_where`] of `sum`: component k chosen by `uc` with probability pₖ (`uc`
+    /// rescaled for its own use), then a smooth direction weighted by the whole mixture's f and pdf (every
+    /// component's smooth lobes may have produced it), a delta direction by its own probability times pₖ.
+    #[inline(always)]
+    pub(crate) fn sample_lanes_where<R: Real>(&self, wo: V3<R>, uc: R, ux: R, uy: R, active: R::Mask) -> LaneSample<R> {
+        let none = !super::lanes::all::<R>();
+        let Some(last) = self.probs.iter().rposition(|p| *p > 0.0) else {
+            return LaneSample::none(none);
+        };
+        let (mut s, mut taken, mut start) = (LaneSample::none(none), none, 0.0f32);
+        for (k, (c, (&w, &p))) in self.components.iter().zip(self.weights.iter().zip(&self.probs)).enumerate() {
+            if p > 0.0 {
+                // The last component that can be chosen takes the lanes left (rounding in Σp).
+                let here = !taken & if k == last { !none } else { uc.lt(R::splat(start + p)) };
+                taken = taken | here;
+                if R::any(active & here) {
+                    let u = ((uc - start) / p).clamp(0.0, 1.0 - f32::EPSILON);
+                    let sk = c.leaf_sample(wo, u, ux, uy, active & here);
+                    let sk =
+                        LaneSample { f: channels!(|i| sk.f[i] * w), pdf: sk.pdf * p, weight: channels!(|i| sk.weight[i] * (w / p)), ..sk };
+                    s = LaneSample::select(here, sk, s);
+                }
+            }
+            start += p;
+        }
+        // Smooth directions: the mixture's f and pdf there.
+        let smooth = s.valid & !s.is_delta();
+        if !R::any(smooth) {
+            return s;
+        }
+        let (f, pdf) = (self.f_lanes_where(wo, s.wi, smooth), self.pdf_lanes_where(wo, s.wi, smooth));
+        let mixed = LaneSample { eta: s.eta, ..LaneSample::smooth(s.wi, f, pdf, s.flags, smooth) };
+        LaneSample::select(smooth, mixed, s)
+    }
+}
+
+impl LaneModel for Sum {
+    #[inline(always)]
+    fn f_lanes<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> [R; 3] {
+        self.f_lanes_where(wo, wi, super::lanes::all::<R>())
+    }
+
+    #[inline(always)]
+    fn pdf_lanes<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> R {
+        self.pdf_lanes_where(wo, wi, super::lanes::all::<R>())
+    }
+
+    #[inline(always)]
+    fn sample_lanes<R: Real>(&self, wo: V3<R>, uc: R, ux: R, uy: R) -> LaneSample<R> {
+        self.sample_lanes_where(wo, uc, ux, uy, super::lanes::all::<R>())
     }
 }
 

@@ -14,8 +14,10 @@
 //! assert!(d.f(-Vec3::Z, -Vec3::Z).r() > 0.3);
 //! ```
 
+use super::lanes::{f_one, pdf_one, sample_one, LaneModel, LaneSample};
 use super::{Bsdf, BsdfFlags, BsdfModel, BsdfSample};
 use crate::error::{Error, Result};
+use crate::math::lanes::{channels, Real, V3};
 use crate::math::{Vec2, Vec3};
 use crate::props::Props;
 use crate::spectrum::Rgb;
@@ -25,18 +27,16 @@ use crate::spectrum::Rgb;
 pub struct TwoSided {
     front: Box<Bsdf>,
     back: Box<Bsdf>,
-}
-
-#[inline]
-fn flip(w: Vec3) -> Vec3 {
-    Vec3::new(w.x, w.y, -w.z)
+    /// Whether the back is the front's model (one nested BSDF): lanes on either side then run it once.
+    mirrored: bool,
 }
 
 impl TwoSided {
     /// `front` on the +z side, `back` (mirrored) on the −z side.
     #[must_use]
     pub fn new(front: Bsdf, back: Bsdf) -> Self {
-        TwoSided { front: Box::new(front), back: Box::new(back) }
+        let mirrored = front == back;
+        TwoSided { front: Box::new(front), back: Box::new(back), mirrored }
     }
 
     pub fn from_props(p: &Props) -> Result<Self> {
@@ -54,16 +54,6 @@ impl TwoSided {
             _ => Err(Error::spec(p.at(), format!("`twosided` needs one or two nested BSDFs, got {}", nested.len()))),
         }
     }
-
-    /// The model for the side of `wo`, and whether directions must be mirrored.
-    #[inline]
-    fn side(&self, wo: Vec3) -> (&Bsdf, bool) {
-        if wo.z < 0.0 {
-            (&self.back, true)
-        } else {
-            (&self.front, false)
-        }
-    }
 }
 
 impl crate::bsdf::Examples for TwoSided {
@@ -79,24 +69,93 @@ impl BsdfModel for TwoSided {
     }
 
     fn f(&self, wo: Vec3, wi: Vec3) -> Rgb {
-        match self.side(wo) {
-            (m, true) => m.f(flip(wo), flip(wi)),
-            (m, false) => m.f(wo, wi),
-        }
+        f_one(self, wo, wi)
     }
 
     fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
-        match self.side(wo) {
-            (m, true) => m.sample(flip(wo), uc, u).map(|s| BsdfSample { wi: flip(s.wi), ..s }),
-            (m, false) => m.sample(wo, uc, u),
-        }
+        sample_one(self, wo, uc, u)
     }
 
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        match self.side(wo) {
-            (m, true) => m.pdf(flip(wo), flip(wi)),
-            (m, false) => m.pdf(wo, wi),
+        pdf_one(self, wo, wi)
+    }
+}
+
+/// `w` mirrored through the surface (z → −z) in the lanes of `m`.
+#[inline(always)]
+fn flip_where<R: Real>(m: R::Mask, w: V3<R>) -> V3<R> {
+    V3::new(w.x, w.y, R::select(m, -w.z, w.z))
+}
+
+impl TwoSided {
+    /// Runs `side(model, wo, lanes)` for the front's lanes and the back's (wo below the surface: the
+    /// directions mirrored into the back model's upper hemisphere), and keeps each lane's own, where
+    /// `select(lanes, a, b)` merges two results. A mirrored model runs once for both sides.
+    #[inline(always)]
+    fn per_side<R: Real, T: Copy>(
+        &self,
+        wo: V3<R>,
+        active: R::Mask,
+        none: T,
+        side: impl Fn(&Bsdf, V3<R>, R::Mask) -> T,
+        select: impl Fn(R::Mask, T, T) -> T,
+    ) -> T {
+        let back = wo.z.lt(R::splat(0.0));
+        let wo = flip_where(back, wo);
+        let sides = if self.mirrored {
+            [(&*self.front, active), (&*self.front, !super::lanes::all::<R>())]
+        } else {
+            [(&*self.front, active & !back), (&*self.back, active & back)]
+        };
+        // One loop (one copy of the nested models' lane code), each side where it has lanes.
+        let mut out = none;
+        for (model, lanes) in sides {
+            if R::any(lanes) {
+                out = select(lanes, side(model, wo, lanes), out);
+            }
         }
+        out
+    }
+
+    /// [`Bsdf::f_lanes_where`] of `twosided`.
+    #[inline(always)]
+    pub(crate) fn f_lanes_where<R: Real>(&self, wo: V3<R>, wi: V3<R>, active: R::Mask) -> [R; 3] {
+        let wi = flip_where(wo.z.lt(R::splat(0.0)), wi);
+        let select = |m: R::Mask, a: [R; 3], b: [R; 3]| channels!(|c| R::select(m, a[c], b[c]));
+        self.per_side(wo, active, [R::splat(0.0); 3], |m, wo, lanes| m.leaf_f(wo, wi, lanes), select)
+    }
+
+    /// [`Bsdf::pdf_lanes_where`] of `twosided`.
+    #[inline(always)]
+    pub(crate) fn pdf_lanes_where<R: Real>(&self, wo: V3<R>, wi: V3<R>, active: R::Mask) -> R {
+        let wi = flip_where(wo.z.lt(R::splat(0.0)), wi);
+        self.per_side(wo, active, R::splat(0.0), |m, wo, lanes| m.leaf_pdf(wo, wi, lanes), R::select)
+    }
+
+    /// [`Bsdf::sample_lanes_where`] of `twosided`: the sampled direction mirrored back on the back side.
+    #[inline(always)]
+    pub(crate) fn sample_lanes_where<R: Real>(&self, wo: V3<R>, uc: R, ux: R, uy: R, active: R::Mask) -> LaneSample<R> {
+        let back = wo.z.lt(R::splat(0.0));
+        let none = LaneSample::none(!super::lanes::all::<R>());
+        let s = self.per_side(wo, active, none, |m, wo, lanes| m.leaf_sample(wo, uc, ux, uy, lanes), LaneSample::select);
+        LaneSample { wi: flip_where(back, s.wi), ..s }
+    }
+}
+
+impl LaneModel for TwoSided {
+    #[inline(always)]
+    fn f_lanes<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> [R; 3] {
+        self.f_lanes_where(wo, wi, super::lanes::all::<R>())
+    }
+
+    #[inline(always)]
+    fn pdf_lanes<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> R {
+        self.pdf_lanes_where(wo, wi, super::lanes::all::<R>())
+    }
+
+    #[inline(always)]
+    fn sample_lanes<R: Real>(&self, wo: V3<R>, uc: R, ux: R, uy: R) -> LaneSample<R> {
+        self.sample_lanes_where(wo, uc, ux, uy, super::lanes::all::<R>())
     }
 }
 

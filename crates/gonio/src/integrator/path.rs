@@ -23,8 +23,7 @@
 
 use super::{emitter_hit, mix, start_lanes, BsdfSampled, CameraSample};
 use crate::bsdf::diffuse::{diffuse_f, diffuse_pdf, diffuse_sample};
-use crate::bsdf::lanes::{LaneKernel, LaneModel};
-use crate::bsdf::{Bsdf, BsdfFlags, BsdfModel};
+use crate::bsdf::{Bsdf, BsdfModel};
 use crate::geometry::bvh::{bits, groups};
 use crate::geometry::mesh::uniform_triangle_point;
 use crate::geometry::ray::{offset_origin_lanes, spawn_ray_to_lanes, RayLanes};
@@ -351,28 +350,29 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
             rho = std::array::from_fn(|c| Float8::select(m, r[c], rho[c]));
             diffuse |= diffuse_rows;
         }
-        // Lanes that share a model with a lane kernel (GGX `roughconductor` and `roughplastic`), at least
-        // two, run it in lanes; the other models run per lane.
-        let (mut kernels, mut grouped) = ([(0u32, None::<LaneKernel<'_>>); W], 0u32);
+        // The other lanes grouped by model instance (lanes on one shape share their material's model; a
+        // textured material's model is its own lane's): each group calls its model once, in lanes
+        // (`Bsdf::f_lanes_where` and friends: the model's kernel, or its single calls lane by lane).
+        let (mut groups_of, mut n_groups) = ([(0u32, 0usize); W], 0usize);
+        let mut grouped = 0u32;
         for lane in bits(p.live & !diffuse) {
             if grouped & (1 << lane) != 0 {
                 continue;
             }
-            let Some(Cow::Borrowed(model)) = models[lane] else { continue };
-            let Some(kernel) = model.lane_kernel() else { continue };
-            let same = bits(p.live & !diffuse & !grouped)
-                .filter(|&l| matches!(models[l], Some(Cow::Borrowed(m)) if std::ptr::eq(m, model)))
-                .fold(0u32, |m, l| m | 1 << l);
-            if same.count_ones() >= 2 {
-                kernels[lane] = (same, Some(kernel));
-                grouped |= same;
-            }
+            let same = match models[lane] {
+                Some(Cow::Borrowed(model)) => bits(p.live & !diffuse & !grouped)
+                    .filter(|&l| matches!(models[l], Some(Cow::Borrowed(m)) if std::ptr::eq(m, model)))
+                    .fold(0u32, |m, l| m | 1 << l),
+                _ => 1 << lane,
+            };
+            groups_of[n_groups] = (same, lane);
+            n_groups += 1;
+            grouped |= same;
         }
-        // (Skipped where no lanes are grouped: a loop over the eight entries whose exit the predictor misses.)
-        let kernels = || kernels[..if grouped == 0 { 0 } else { W }].iter().filter_map(|&(m, k)| k.map(|k| (m, k)));
+        let groups_of = &groups_of[..n_groups];
+        let model_of = |lane: usize| models[lane].as_deref().expect("a model for every non-diffuse lane");
         let (fs, ft, fn_) = (hit.s.lanes(), hit.t.lanes(), hit.ns.lanes());
         let wo = to_local(fs, ft, fn_, p.d.lanes().neg());
-        let wo_rows = Rows3::from_lanes(wo);
         let mut beta = load_rgb(&p.beta);
 
         // Next-event estimation (on lanes whose model has a smooth component): a light chosen uniformly and
@@ -497,29 +497,19 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
             // f and the BSDF's density: in lanes for diffuse surfaces, by the model for the others.
             let mut f = diffuse_f(rho, wo, wi_local);
             let mut bsdf_pdf = diffuse_pdf(wo, wi_local);
-            for (lanes, kernel) in kernels() {
-                let m = Mask8::from_bitmask(lanes & sampled);
-                let fk = kernel.f_lanes(wo, wi_local);
+            for &(lanes, first) in groups_of {
+                let lanes = lanes & sampled;
+                if lanes == 0 {
+                    continue;
+                }
+                let m = Mask8::from_bitmask(lanes);
+                let model = model_of(first);
+                let fk = model.f_lanes_where(wo, wi_local, m);
                 for c in 0..3 {
                     f[c] = Float8::select(m, fk[c], f[c]);
                 }
-                let pdf = Float8::select(Mask8::from_bitmask(delta), Float8::splat(0.0), kernel.pdf_lanes(wo, wi_local));
+                let pdf = Float8::select(Mask8::from_bitmask(delta), Float8::splat(0.0), model.pdf_lanes_where(wo, wi_local, m));
                 bsdf_pdf = Float8::select(m, pdf, bsdf_pdf);
-            }
-            let others = sampled & !diffuse & !grouped;
-            if others != 0 {
-                let (mut f_rows, mut pdf_rows) = (Rows3::default(), [0.0f32; W]);
-                store_rgb(&mut f_rows, f);
-                let wi_rows = Rows3::from_lanes(wi_local);
-                for lane in bits(others) {
-                    let (bsdf, wo, wi) = (models[lane].as_deref().expect("a model"), wo_rows.get(lane), wi_rows.get(lane));
-                    f_rows.set_rgb(lane, bsdf.f(wo, wi));
-                    if delta & (1 << lane) == 0 {
-                        pdf_rows[lane] = bsdf.pdf(wo, wi);
-                    }
-                }
-                f = load_rgb(&f_rows);
-                bsdf_pdf = Float8::select(Mask8::from_bitmask(others), Float8::load(&pdf_rows), bsdf_pdf);
             }
             // Shadow rays where the sample carries light.
             let nonzero = (f[0].ne(Float8::splat(0.0)) | f[1].ne(Float8::splat(0.0)) | f[2].ne(Float8::splat(0.0))).bitmask();
@@ -554,36 +544,16 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
         let mut valid = ds.valid.bitmask() & diffuse;
         let (mut s_wi, mut s_pdf, mut s_eta, mut s_weight) = (ds.wi, ds.pdf, ds.eta, ds.weight);
         let mut s_delta = 0u32;
-        for (lanes, kernel) in kernels() {
-            let s = kernel.sample_lanes(wo, uc, ux, uy);
+        for &(lanes, first) in groups_of {
             let m = Mask8::from_bitmask(lanes);
+            let s = model_of(first).sample_lanes_where(wo, uc, ux, uy, m);
             s_wi = V3::select(m, s.wi, s_wi);
             for (w, k) in s_weight.iter_mut().zip(s.weight) {
                 *w = Float8::select(m, k, *w);
             }
             (s_pdf, s_eta) = (Float8::select(m, s.pdf, s_pdf), Float8::select(m, s.eta, s_eta));
-            valid |= s.valid.bitmask() & lanes;
-            let flags = s.flags.to_array();
-            s_delta |= bits(lanes).fold(0, |d, l| d | u32::from(BsdfFlags(flags[l] as u32).contains(BsdfFlags::DELTA)) << l);
-        }
-        let (uc, ux, uy) = (uc.to_array(), ux.to_array(), uy.to_array());
-        let others = p.live & !diffuse & !grouped;
-        if others != 0 {
-            let (mut wi_rows, mut w_rows) = (Rows3::default(), Rows3::default());
-            let (mut pdf_rows, mut eta_rows) = (s_pdf.to_array(), s_eta.to_array());
-            wi_rows.store(s_wi);
-            store_rgb(&mut w_rows, s_weight);
-            for lane in bits(others) {
-                let bsdf = models[lane].as_deref().expect("a model");
-                let Some(s) = bsdf.sample(wo_rows.get(lane), uc[lane], Vec2::new(ux[lane], uy[lane])) else { continue };
-                wi_rows.set(lane, s.wi);
-                w_rows.set_rgb(lane, s.weight);
-                pdf_rows[lane] = s.pdf;
-                eta_rows[lane] = s.eta;
-                s_delta |= u32::from(s.flags.contains(BsdfFlags::DELTA)) << lane;
-                valid |= 1 << lane;
-            }
-            (s_wi, s_weight, s_pdf, s_eta) = (wi_rows.lanes(), load_rgb(&w_rows), Float8::load(&pdf_rows), Float8::load(&eta_rows));
+            valid |= (s.valid & m).bitmask();
+            s_delta |= (s.is_delta() & m).bitmask();
         }
         for lane in bits(p.live & !valid) {
             p.finish(lane, out);

@@ -432,6 +432,18 @@ impl Real for Avx8 {
     fn any(m: Mask8) -> bool {
         m.bitmask() != 0
     }
+    #[inline(always)]
+    fn lane(self, i: usize) -> f32 {
+        self.to_array()[i]
+    }
+    #[inline(always)]
+    fn from_fn(f: impl FnMut(usize) -> f32) -> Self {
+        Avx8::load(&std::array::from_fn(f))
+    }
+    #[inline(always)]
+    fn bitmask(m: Mask8) -> u64 {
+        u64::from(m.bitmask())
+    }
 }
 
 impl Rows for Avx8 {

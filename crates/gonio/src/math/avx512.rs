@@ -302,6 +302,18 @@ impl Real for Avx16 {
     fn any(m: Mask16) -> bool {
         m.0 != 0
     }
+    #[inline(always)]
+    fn lane(self, i: usize) -> f32 {
+        self.to_array()[i]
+    }
+    #[inline(always)]
+    fn from_fn(f: impl FnMut(usize) -> f32) -> Self {
+        <Avx16 as Rows>::load(&std::array::from_fn::<f32, 16, _>(f))
+    }
+    #[inline(always)]
+    fn bitmask(m: Mask16) -> u64 {
+        u64::from(m.0)
+    }
 }
 
 impl Rows for Avx16 {

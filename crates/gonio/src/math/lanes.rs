@@ -87,6 +87,13 @@ pub trait Real:
     fn select(m: Self::Mask, a: Self, b: Self) -> Self;
     /// Whether any lane of `m` is set.
     fn any(m: Self::Mask) -> bool;
+    /// Lane `i`, for code that works lane by lane (a model that cannot vectorise: see
+    /// `bsdf::lanes::each_lane`).
+    fn lane(self, i: usize) -> f32;
+    /// Lane `i` = `f(i)`, for `i` in 0..`LANES`, in that order.
+    fn from_fn(f: impl FnMut(usize) -> f32) -> Self;
+    /// Bit `i` set where lane `i` of `m` is.
+    fn bitmask(m: Self::Mask) -> u64;
 }
 
 impl Real for f32 {
@@ -191,6 +198,18 @@ impl Real for f32 {
     #[inline(always)]
     fn any(m: bool) -> bool {
         m
+    }
+    #[inline(always)]
+    fn lane(self, _: usize) -> f32 {
+        self
+    }
+    #[inline(always)]
+    fn from_fn(mut f: impl FnMut(usize) -> f32) -> Self {
+        f(0)
+    }
+    #[inline(always)]
+    fn bitmask(m: bool) -> u64 {
+        u64::from(m)
     }
 }
 
@@ -367,6 +386,18 @@ impl Real for F32x8 {
     #[inline(always)]
     fn any(m: M32x8) -> bool {
         m.0.iter().fold(0, |acc, &v| acc | v) != 0
+    }
+    #[inline(always)]
+    fn lane(self, i: usize) -> f32 {
+        self.0[i]
+    }
+    #[inline(always)]
+    fn from_fn(f: impl FnMut(usize) -> f32) -> Self {
+        F32x8(std::array::from_fn(f))
+    }
+    #[inline(always)]
+    fn bitmask(m: M32x8) -> u64 {
+        (0..8).fold(0, |b, i| b | u64::from(m.0[i] != 0) << i)
     }
 }
 
@@ -630,6 +661,9 @@ pub(crate) fn check_lane_type<R: Rows>() {
         same(x.xor_sign(y), &|p, q| f32::from_bits(p.to_bits() ^ (q.to_bits() & 0x8000_0000)), "xor_sign");
         same(x.map(|v| v * 2.0 + 1.0), &|p, _| p * 2.0 + 1.0, "map");
         same(R::select(x.lt(y), x, y), &|p, q| if p < q { p } else { q }, "select");
+        same(R::from_fn(|i| x.lane(i) - y.lane(i)), &|p, q| p - q, "lane, from_fn");
+        let lt = R::bitmask(x.lt(y));
+        assert_eq!(lt, (0..n).fold(0u64, |m, i| m | u64::from(a[i] < b[i]) << i), "bitmask");
         let mask = |m: R::Mask, f: &dyn Fn(f32, f32) -> bool, what: &str| {
             let mut o = vec![false; n];
             R::store_mask(m, &mut o);

@@ -148,6 +148,23 @@ impl<R: Real> Real for Twice<R> {
     fn any(m: Self::Mask) -> bool {
         R::any(m.0 | m.1)
     }
+    #[inline(always)]
+    fn lane(self, i: usize) -> f32 {
+        if i < R::LANES {
+            self.0.lane(i)
+        } else {
+            self.1.lane(i - R::LANES)
+        }
+    }
+    #[inline(always)]
+    fn from_fn(mut f: impl FnMut(usize) -> f32) -> Self {
+        let first = R::from_fn(&mut f);
+        Twice(first, R::from_fn(|i| f(i + R::LANES)))
+    }
+    #[inline(always)]
+    fn bitmask(m: Self::Mask) -> u64 {
+        R::bitmask(m.0) | R::bitmask(m.1) << R::LANES
+    }
 }
 
 impl<R: Rows> Rows for Twice<R> {
