@@ -31,12 +31,12 @@
 //!
 //! ## Lanes
 //! [`EnvMap::sample_lanes`] and [`EnvMap::eval_lanes`] are the light, written once over a
-//! [`LaneAccess`] type: the table reads (the alias table, the texels, and `atan2`/`acos` of a direction)
+//! [`Real`] type: the table reads (the alias table, the texels, and `atan2`/`acos` of a direction)
 //! loop over the lanes, everything else runs in lanes. The scalar [`EnvMap::sample_li`],
 //! [`EnvMap::radiance`] and [`EnvMap::pdf_li`] are those functions at `f32`; the path tracer runs them on
 //! eight lanes.
 
-use super::{LaneAccess, LightSample, MAX_LANES};
+use super::LightSample;
 use crate::error::{Error, Result};
 use crate::geometry::ray::spawn_ray;
 use crate::geometry::Ray;
@@ -89,6 +89,16 @@ pub struct EnvEval<R: Real> {
 }
 
 /// Per-lane integer cell coordinates of the bilinear grid.
+/// The most lanes of a lane type the lookups take (`f32` and the renderer's `Float8` here).
+const MAX_LANES: usize = 16;
+
+/// The lanes of `v`, in the first `R::LANES` entries (the others 0).
+#[inline(always)]
+fn numbers<R: Real>(v: R) -> [f32; MAX_LANES] {
+    debug_assert!(R::LANES <= MAX_LANES);
+    std::array::from_fn(|i| if i < R::LANES { v.lane(i) } else { 0.0 })
+}
+
 type Cells = ([u32; MAX_LANES], [u32; MAX_LANES]);
 
 impl EnvMap {
@@ -180,7 +190,7 @@ impl EnvMap {
     /// The bilinear blend of the four texels around each lane's cell with fractions (fx, fy): the texels
     /// read lane by lane, the blend in lanes.
     #[inline(always)]
-    fn blend<R: LaneAccess>(&self, (x, y): &Cells, fx: R, fy: R) -> [R; 3] {
+    fn blend<R: Real>(&self, (x, y): &Cells, fx: R, fy: R) -> [R; 3] {
         let row = self.width + 1;
         // One texel per lane (x, y are in range by construction; a miss would read black, never panic).
         let texel = |dx: usize, dy: usize| -> [R; 3] {
@@ -215,8 +225,8 @@ impl EnvMap {
     /// bit 0): the cell from the alias table with `uc` and `ux`, the point in it from the coin's remapped
     /// number and `uy` (module docs). Other lanes are left invalid.
     #[inline(always)]
-    pub fn sample_lanes<R: LaneAccess>(&self, uc: R, ux: R, uy: R, lanes: u32) -> EnvSample<R> {
-        let (uc, ux, uy) = (uc.lanes(), ux.lanes(), uy.lanes());
+    pub fn sample_lanes<R: Real>(&self, uc: R, ux: R, uy: R, lanes: u32) -> EnvSample<R> {
+        let (uc, ux, uy) = (numbers(uc), numbers(ux), numbers(uy));
         let (mut cells, mut fx, mut fy, mut density) =
             (([0u32; MAX_LANES], [0u32; MAX_LANES]), [0.0; MAX_LANES], [0.0; MAX_LANES], [0.0; MAX_LANES]);
         for i in (0..R::LANES).filter(|i| lanes >> i & 1 != 0) {
@@ -240,14 +250,14 @@ impl EnvMap {
     /// Radiance arriving along world directions `wi` (towards the environment) and the density with which
     /// [`Self::sample_lanes`] picks them, in the lanes set in `lanes` (others read cell (0, 0)).
     #[inline(always)]
-    pub fn eval_lanes<R: LaneAccess>(&self, wi: V3<R>, lanes: u32) -> EnvEval<R> {
+    pub fn eval_lanes<R: Real>(&self, wi: V3<R>, lanes: u32) -> EnvEval<R> {
         let d = self.to_local.vector_lanes(wi);
         let length = d.length();
         let zero = R::splat(0.0);
         let d = V3::select(length.gt(zero), d.div(length), V3::new(zero, zero, zero));
         let sin_theta = (d.x * d.x + d.z * d.z).sqrt();
         // (u, v) by atan2 lane by lane, with the grid cell and its density.
-        let (dx, dy, dz) = (d.x.lanes(), d.y.lanes(), d.z.lanes());
+        let (dx, dy, dz) = (numbers(d.x), numbers(d.y), numbers(d.z));
         let (mut cells, mut fx, mut fy, mut density) =
             (([0u32; MAX_LANES], [0u32; MAX_LANES]), [0.0; MAX_LANES], [0.0; MAX_LANES], [0.0; MAX_LANES]);
         for i in (0..R::LANES).filter(|i| lanes >> i & 1 != 0) {

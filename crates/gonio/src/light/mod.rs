@@ -21,49 +21,8 @@ pub use point::PointLight;
 pub use spot::SpotLight;
 
 use crate::geometry::{Ray, Shape};
-use crate::math::lanes::Real;
-use crate::math::simd::Float8;
 use crate::spectrum::Rgb;
 use glam::{Vec2, Vec3};
-
-/// The most lanes a [`LaneAccess`] type has.
-pub const MAX_LANES: usize = 16;
-
-/// A lane type whose lanes a light can read and build one at a time, for its table lookups (an image's
-/// texels, an alias table): the loop over the lanes sits visibly inside the light, the arithmetic around it
-/// runs in lanes. Implemented for `f32` (the scalar API) and [`Float8`] (the path tracer's packets).
-pub trait LaneAccess: Real {
-    /// The value with `f(i)` in lane `i`.
-    fn from_fn(f: impl FnMut(usize) -> f32) -> Self;
-    /// The lanes, in the first `Self::LANES` entries (the others 0).
-    fn lanes(self) -> [f32; MAX_LANES];
-}
-
-impl LaneAccess for f32 {
-    #[inline(always)]
-    fn from_fn(mut f: impl FnMut(usize) -> f32) -> Self {
-        f(0)
-    }
-    #[inline(always)]
-    fn lanes(self) -> [f32; MAX_LANES] {
-        let mut a = [0.0; MAX_LANES];
-        a[0] = self;
-        a
-    }
-}
-
-impl LaneAccess for Float8 {
-    #[inline(always)]
-    fn from_fn(f: impl FnMut(usize) -> f32) -> Self {
-        Float8::from_fn(f)
-    }
-    #[inline(always)]
-    fn lanes(self) -> [f32; MAX_LANES] {
-        let (l, mut a) = (self.to_array(), [0.0; MAX_LANES]);
-        a[..8].copy_from_slice(&l);
-        a
-    }
-}
 
 /// A sampled direction towards a light.
 #[derive(Clone, Copy, Debug, PartialEq)]
