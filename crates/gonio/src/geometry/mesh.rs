@@ -292,26 +292,22 @@ impl Mesh {
         SurfaceInteraction { t: hit.t, p, n: ng, shading, uv, shape: 0, prim: tri }
     }
 
-    /// The shading frame around `ns`, oriented as Mitsuba 3 orients it (`SurfaceInteraction::
-    /// initialize_sh_frame`): with texture coordinates, the first tangent is ∂p/∂u made orthogonal to `ns`
-    /// (Gram–Schmidt), so anisotropic models (`alpha_u` along s) follow the parameterisation. ∂p/∂u solves
-    /// [Δp₁ Δp₂] = [∂p/∂u ∂p/∂v] [Δuv₁ Δuv₂] over the triangle's edges (pbrt-v4 §6.5.3). Without texture
-    /// coordinates, or for a degenerate parameterisation, any frame around `ns` will do.
+    /// The shading frame around `ns`, oriented as Mitsuba 3 orients it (`src/shapes/mesh.cpp`,
+    /// `compute_surface_interaction`, then `SurfaceInteraction::initialize_sh_frame`): the first tangent is
+    /// ∂p/∂u made orthogonal to `ns` (Gram–Schmidt), so anisotropic models (`alpha_u` along s) follow the
+    /// parameterisation. With texture coordinates ∂p/∂u solves [Δp₁ Δp₂] = [∂p/∂u ∂p/∂v] [Δuv₁ Δuv₂] over
+    /// the triangle's edges (pbrt-v4 §6.5.3); without them, or for a degenerate parameterisation, Mitsuba
+    /// takes the first edge p₁ − p₀ (observed with Mitsuba 3.9.1).
     fn shading_frame(&self, tri: u32, ns: Vec3) -> Frame {
-        let Some(uvs) = &self.uvs else { return Frame::from_normal(ns) };
-        let idx = self.indices[tri as usize];
         let [p0, p1, p2] = self.vertices(tri);
+        let edge = p1 - p0;
+        let Some(uvs) = &self.uvs else { return Frame::from_normal_and_dp_du(ns, edge) };
+        let idx = self.indices[tri as usize];
         let (uv0, uv1, uv2) = (uvs[idx[0] as usize], uvs[idx[1] as usize], uvs[idx[2] as usize]);
         let (duv1, duv2) = (uv1 - uv0, uv2 - uv0);
         let det = duv1.x * duv2.y - duv1.y * duv2.x;
-        if det == 0.0 {
-            return Frame::from_normal(ns);
-        }
-        let dp_du = ((p1 - p0) * duv2.y - (p2 - p0) * duv1.y) / det;
-        match (dp_du - ns * ns.dot(dp_du)).try_normalize() {
-            Some(s) => Frame { s, t: ns.cross(s), n: ns },
-            None => Frame::from_normal(ns),
-        }
+        let dp_du = if det == 0.0 { edge } else { ((p1 - p0) * duv2.y - (p2 - p0) * duv1.y) / det };
+        Frame::from_normal_and_dp_du(ns, dp_du)
     }
 
     /// The shading frame of triangle `tri` of a flat-shaded mesh (its `n` is the geometric normal), `None`
@@ -808,6 +804,24 @@ mod tests {
         let f = m.interaction(h.0, &r, &h.1, true).shading;
         assert!((f.s - tilt.vector(-Vec3::Y)).length() < 1e-5, "{:?}", f.s);
         assert!((f.s.cross(f.t) - f.n).length() < 1e-5 && f.s.dot(f.n).abs() < 1e-6);
+    }
+
+    /// Without texture coordinates the first shading tangent is the first edge p₁ − p₀ made orthogonal to
+    /// the normal, as Mitsuba 3 takes it; s and t were read from Mitsuba 3.9.1 (`scalar_rgb`,
+    /// `si.sh_frame`) for one triangle with its vertices in two orders.
+    #[test]
+    fn shading_tangent_without_uvs_is_the_first_edge() {
+        let (a, b, c) = (Vec3::new(-1.0, -1.0, 0.0), Vec3::new(2.0, -1.0, 0.2), Vec3::new(-1.0, 2.0, 0.1));
+        let cases = [
+            (vec![a, b, c], Vec3::new(0.997_785_15, 0.0, 0.066_519_015), Vec3::new(-0.002_211_166_8, 0.999_447_35, 0.033_167_504)),
+            (vec![b, c, a], Vec3::new(-0.706_910_4, 0.706_910_4, -0.023_563_683), Vec3::new(-0.704_171_6, -0.706_521_45, -0.070_495_49)),
+        ];
+        for (p, s, t) in cases {
+            let m = Mesh::new(p, None, None, vec![[0, 1, 2]], &Transform::IDENTITY, false, false, "test").unwrap();
+            let r = Ray::new(Vec3::new(0.3, -0.2, 3.0), -Vec3::Z, 10.0);
+            let f = m.interaction(0, &r, &m.intersect(0, &r).unwrap(), false).shading;
+            assert!((f.s - s).length() < 1e-5 && (f.t - t).length() < 1e-5, "s {} t {}", f.s, f.t);
+        }
     }
 
     #[test]

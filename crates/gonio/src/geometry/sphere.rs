@@ -7,11 +7,20 @@
 //! | `to_world`     | transform | identity  | object → world; must be a similarity (uniform scale)     |
 //! | `flip_normals` | boolean   | false     | normals point inwards                                    |
 //!
+//! A mirroring `to_world` turns the normals inwards too, as Mitsuba 3 does (observed with 3.9.1).
+//!
 //! The quadratic is solved with the discriminant in the form of pbrt-v4 §6.8.5 (eq. 6.10),
 //! b² − 4ac = 4a (r² − |o − (b/2a) d|²), which keeps its precision for distant spheres.
+//!
+//! The shading frame is Mitsuba 3's (`src/shapes/sphere.cpp`, `compute_surface_interaction`, then
+//! `SurfaceInteraction::initialize_sh_frame`): `s` is ∂p/∂u of the parameterisation u = φ/2π, v = θ/π
+//! (the direction of increasing φ about the object's z axis) made orthogonal to `n`, and `t = n × s`, so an
+//! anisotropic model's `alpha_u` runs along the parallels and its highlight converges at the poles. At the
+//! poles, where ∂p/∂u vanishes, the frame is [`Frame::from_normal`]'s, as Mitsuba's is there.
 
 use super::interaction::{PositionSample, SurfaceInteraction};
 use super::{Bounds3, PrimHit, Ray};
+use crate::math::frame::tangents_along;
 use crate::math::lanes::{Real, V3};
 use crate::math::simd::Float8;
 use crate::math::{Frame, Transform};
@@ -27,6 +36,9 @@ pub struct Sphere {
     pub flip_normals: bool,
     /// World → object rotation, for texture coordinates.
     to_object: Transform,
+    /// The unit world direction `a` with ∂p/∂u ∝ a × (outward normal): the object's z axis, negated when
+    /// `to_world` mirrors (a mirror turns the cross product around).
+    pole_axis: Vec3,
 }
 
 impl Sphere {
@@ -42,7 +54,14 @@ impl Sphere {
         if axes.iter().any(|a| (a.length() - r).abs() > 1e-3 * r) || !(r > 0.0) || !c.is_finite() {
             return None;
         }
-        Some(Sphere { center: c, radius: r, flip_normals, to_object: full.inverse() })
+        // Object space ∂p/∂u = 2π (−y, x, 0) = 2π ẑ × p; the linear part r·Q (Q orthogonal) maps it to
+        // 2π r det(Q) (Qẑ × Qp), Qp being the outward normal.
+        let z = axes[2] / r;
+        let pole_axis = if full.flips_handedness() { -z } else { z };
+        // Mitsuba turns a sphere's normals inwards when `to_world` mirrors (observed with Mitsuba 3.9.1:
+        // scale(1, 1, −1) gives n = −outward), so the flag flips with the handedness.
+        let flip_normals = flip_normals ^ full.flips_handedness();
+        Some(Sphere { center: c, radius: r, flip_normals, to_object: full.inverse(), pole_axis })
     }
 
     #[must_use]
@@ -81,7 +100,15 @@ impl Sphere {
         let (p, outward) = (Vec3::from(p), Vec3::from(outward));
         let n = if self.flip_normals { -outward } else { outward };
         let uv = if uv { self.uv_at(outward) } else { Vec2::ZERO };
-        SurfaceInteraction { t, p, n, shading: Frame::from_normal(n), uv, shape: 0, prim: 0 }
+        let (s, tangent) = sphere_tangents::<f32>(self.pole_axis.into(), outward.into(), n.into());
+        SurfaceInteraction { t, p, n, shading: Frame { s: s.into(), t: tangent.into(), n }, uv, shape: 0, prim: 0 }
+    }
+
+    /// The unit world direction `a` with ∂p/∂u ∝ a × (outward normal), for [`sphere_tangents`].
+    #[inline]
+    #[must_use]
+    pub fn pole_axis(&self) -> Vec3 {
+        self.pole_axis
     }
 
     /// For a reference point outside the sphere: `1 − cos θmax` of the cone of directions it subtends,
@@ -157,6 +184,17 @@ impl Sphere {
 pub fn sphere_surface<R: Real>(o: V3<R>, d: V3<R>, t: R, center: V3<R>, radius: R) -> (V3<R>, V3<R>) {
     let outward = o.add(d.scale(t)).sub(center).normalize();
     (center.add(outward.scale(radius)), outward)
+}
+
+/// The shading tangents (s, t) at the sphere point with outward unit normal `outward` and shading normal `n`
+/// (`outward`, or its negation for flipped normals), `pole_axis` being [`Sphere::pole_axis`], in lanes:
+/// Mitsuba 3's frame (see the module doc). At the poles, where ∂p/∂u vanishes, those of
+/// [`Frame::from_normal`].
+#[inline(always)]
+#[must_use]
+pub fn sphere_tangents<R: Real>(pole_axis: V3<R>, outward: V3<R>, n: V3<R>) -> (V3<R>, V3<R>) {
+    // ∂p/∂u, up to its positive length 2π r sin θ.
+    tangents_along(n, pole_axis.cross(outward))
 }
 
 /// The nearer hit in (0, tmax) of the ray o + t d with the sphere (`center`, `radius`), in lanes (of rays,
@@ -264,6 +302,69 @@ mod tests {
         let s = Sphere::new(Vec3::ZERO, 1.5, t, false).unwrap();
         assert!((s.radius - 3.0).abs() < 1e-6 && (s.center - Vec3::X).length() < 1e-6);
         assert!(Sphere::new(Vec3::ZERO, 1.0, Transform::scale(Vec3::new(1.0, 2.0, 1.0)).unwrap(), false).is_none());
+    }
+
+    /// Mitsuba 3.9.1 (`scalar_rgb`): the shading frames `si.sh_frame` of the rays from `o` towards `target`,
+    /// as (o, target, s, t); the shapes of [`shading_frame_is_mitsubas`].
+    type MitsubaFrame = ([f32; 3], [f32; 3], [f32; 3], [f32; 3]);
+
+    fn check_frames(sphere: &Sphere, frames: &[MitsubaFrame]) {
+        for &(o, target, s, t) in frames {
+            let (o, s, t) = (Vec3::from(o), Vec3::from(s), Vec3::from(t));
+            let ray = Ray::new(o, (Vec3::from(target) - o).normalize(), f32::INFINITY);
+            let hit = sphere.intersect(&ray).unwrap();
+            let f = sphere.interaction(&ray, hit.t, true).shading;
+            // 2026-12: 2e-5 absorbs the f32 rounding of two renderers computing the same point.
+            assert!((f.s - s).length() < 2e-5 && (f.t - t).length() < 2e-5, "from {o}: s {} t {}, Mitsuba s {s} t {t}", f.s, f.t);
+            assert!((f.s.cross(f.t) - f.n).length() < 1e-5 && f.s.dot(f.n).abs() < 1e-5);
+        }
+    }
+
+    /// The shading frame is Mitsuba 3's: s along ∂p/∂u (the parallels of the object's z axis), t = n × s,
+    /// Duff's frame at the poles; for flipped normals, a rotated, scaled and moved sphere and a mirrored
+    /// one. The frames were read from Mitsuba 3.9.1 (`scalar_rgb`, `shape.ray_intersect`, `si.sh_frame`).
+    #[test]
+    fn shading_frame_is_mitsubas() {
+        const O: [f32; 3] = [0.0; 3];
+        let unit = [
+            ([3.0, 0.5, 0.8], O, [-0.164_398_98, 0.986_394, 0.0], [-0.250_924_02, -0.041_820_668, 0.967_103_06]),
+            ([-2.0, 1.0, 2.0], O, [-0.447_213_6, -0.894_427_2, 0.0], [0.596_284_8, -0.298_142_4, 0.745_356]),
+            ([0.2, 0.1, -4.0], O, [-0.447_213_56, 0.894_427_1, 0.0], [0.893_032_9, 0.446_516_45, 0.055_814_568]),
+            ([0.3, -3.0, 0.2], O, [0.995_037_14, 0.099_503_726, 0.0], [-0.006_586_186, 0.065_861_85, 0.997_807_1]),
+            // The poles, where ∂p/∂u vanishes.
+            ([0.0, 0.0, 5.0], O, [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]),
+            ([0.0, 0.0, -5.0], O, [1.0, 0.0, 0.0], [0.0, -1.0, 0.0]),
+        ];
+        check_frames(&Sphere::new(Vec3::ZERO, 1.0, Transform::IDENTITY, false).unwrap(), &unit);
+        let flipped = [
+            ([3.0, 0.5, 0.8], O, [-0.164_398_98, 0.986_394, 0.0], [0.250_924_02, 0.041_820_668, -0.967_103_06]),
+            ([0.0, 0.0, 5.0], O, [1.0, 0.0, 0.0], [0.0, -1.0, 0.0]),
+        ];
+        check_frames(&Sphere::new(Vec3::ZERO, 1.0, Transform::IDENTITY, true).unwrap(), &flipped);
+        // Mitsuba: translate([0.5, -0.2, 0.1]) @ rotate([1, 1, 0] / √2, 40) @ scale(1.5) (Mitsuba's `rotate` takes
+        // the axis as given: unnormalised, its matrix is not a rotation).
+        let moved = Transform::translate(Vec3::new(0.5, -0.2, 0.1))
+            .then_after(Transform::rotate(Vec3::new(1.0, 1.0, 0.0), 40.0).unwrap().then_after(Transform::scale(Vec3::splat(1.5)).unwrap()));
+        let c = [0.5, -0.2, 0.1];
+        let turned = [
+            ([3.5, 0.3, 0.9], c, [-0.285_681_96, 0.740_193_96, 0.608_686_15], [-0.091_518_916, -0.653_326_1, 0.751_524_8]),
+            ([0.8, -3.2, 0.3], c, [0.872_676_1, 0.054_920_882, -0.485_201_18], [0.478_099_26, 0.105_936_19, 0.871_893_76]),
+            ([-1.5, 0.8, 2.1], c, [-0.559_244_2, -0.814_996_3, -0.151_746_1], [0.492_748_86, -0.473_993_57, 0.729_745_7]),
+        ];
+        check_frames(&Sphere::new(Vec3::ZERO, 1.0, moved, false).unwrap(), &turned);
+        // A mirror turns Mitsuba's normals inwards (n = −outward) and keeps s.
+        let mirrored = [
+            ([3.0, 0.5, 0.8], O, [-0.164_398_98, 0.986_394, 0.0], [0.250_924_02, 0.041_820_668, -0.967_103_06]),
+            ([-2.0, 1.0, 2.0], O, [-0.447_213_6, -0.894_427_2, 0.0], [-0.596_284_8, 0.298_142_4, -0.745_356]),
+        ];
+        let mirror = Sphere::new(Vec3::ZERO, 1.0, Transform::scale(Vec3::new(1.0, 1.0, -1.0)).unwrap(), false).unwrap();
+        check_frames(&mirror, &mirrored);
+        let mirror_x = Sphere::new(Vec3::ZERO, 1.0, Transform::scale(Vec3::new(-1.0, 1.0, 1.0)).unwrap(), false).unwrap();
+        let s = [0.164_398_98, -0.986_394, 0.0];
+        check_frames(&mirror_x, &[([6.0, 1.0, 2.0], O, s, [-0.308_097_7, -0.051_349_61, 0.949_968_04])]);
+        let ray = Ray::new(Vec3::new(3.0, 0.5, 0.8), Vec3::new(-3.0, -0.5, -0.8).normalize(), f32::INFINITY);
+        let si = mirror.interaction(&ray, mirror.intersect(&ray).unwrap().t, true);
+        assert!((si.n + si.p).length() < 1e-5, "inward normal {}", si.n);
     }
 
     /// The eight-sphere test agrees with the scalar one, lane by lane, bit for bit.

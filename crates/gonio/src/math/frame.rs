@@ -21,6 +21,22 @@ pub fn tangents<R: Real>(n: V3<R>) -> (V3<R>, V3<R>) {
     (s, t)
 }
 
+/// The shading tangents (s, t) of Mitsuba 3 (`SurfaceInteraction::initialize_sh_frame`) around the unit
+/// normal `n`, in lanes: s is `dp_du` (a shape's ∂p/∂u) made orthogonal to `n` (Gram–Schmidt) and
+/// normalised, t = n × s. Where that vanishes (∂p/∂u zero, at a sphere's pole or a disk's centre, or along
+/// `n`), those of [`tangents`], as Mitsuba's are there.
+#[inline(always)]
+#[must_use]
+pub fn tangents_along<R: Real>(n: V3<R>, dp_du: V3<R>) -> (V3<R>, V3<R>) {
+    let s = dp_du.sub(n.scale(n.dot(dp_du)));
+    let len2 = s.dot(s);
+    // 2026-12: below the smallest normal f32 the direction is rounding noise and the length would not
+    // invert safely.
+    let regular = len2.gt(R::splat(f32::MIN_POSITIVE));
+    let s = V3::select(regular, s.div(len2.sqrt()), tangents(n).0);
+    (s, n.cross(s))
+}
+
 /// An orthonormal basis `(s, t, n)`; `to_local` and `to_world` convert directions.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Frame {
@@ -36,6 +52,15 @@ impl Frame {
     pub fn from_normal(n: Vec3) -> Self {
         debug_assert!((n.length_squared() - 1.0).abs() < 1e-4, "normal must be unit length");
         let (s, t) = tangents::<f32>(n.into());
+        Frame { s: s.into(), t: t.into(), n }
+    }
+
+    /// Mitsuba 3's shading frame around the unit normal `n` with its first tangent along `dp_du`, made
+    /// orthogonal to `n` ([`tangents_along`]).
+    #[must_use]
+    pub fn from_normal_and_dp_du(n: Vec3, dp_du: Vec3) -> Self {
+        debug_assert!((n.length_squared() - 1.0).abs() < 1e-4, "normal must be unit length");
+        let (s, t) = tangents_along::<f32>(n.into(), dp_du.into());
         Frame { s: s.into(), t: t.into(), n }
     }
 
