@@ -4,8 +4,11 @@
 //!
 //! A model (or one configuration of it, e.g. GGX with visible-normal sampling) that has a kernel implements
 //! [`LaneModel`]; its `BsdfModel` methods call [`f_one`], [`pdf_one`], [`sample_one`] for that
-//! configuration, and its batch methods the drivers [`f_rows`], [`pdf_rows`], [`sample_rows`] and their
-//! `_checked` forms (through the `lane_batch_methods!` macro). A driver loads the rows into
+//! configuration. Every [`Bsdf`] runs in lanes through one dispatch (`Bsdf::f_lanes_where` and friends,
+//! below): its kernel, its components' lanes for the composites, or its single calls lane by lane
+//! ([`each_lane`]). The path tracer calls that dispatch for the lanes of a packet that share a model, and
+//! `Bsdf`'s batch methods call the drivers [`f_rows`], [`pdf_rows`], [`sample_rows`] and their `_checked`
+//! forms with it (`impl LaneModel for Bsdf`). A driver loads the rows into
 //! structure-of-arrays lanes ([`V3`] of the widest lane type the CPU runs: `Twice<Twice<Avx16>>` with AVX-512, `Avx8`
 //! with AVX2, else [`F32x8`]), runs the kernel and stores the lanes back; the last rows (fewer than a
 //! register) run on single `f32`s. The `_checked` forms also test the rows against a [`RowCheck`] on the
@@ -118,8 +121,8 @@ pub trait LaneModel {
     fn sample_lanes<R: Real>(&self, wo: V3<R>, uc: R, ux: R, uy: R) -> LaneSample<R>;
 }
 
-/// The kernel of a model whose configuration has one, for callers that run rows of one model in lanes
-/// outside the batch drivers: the path tracer's packets, for the lanes whose surfaces share a material.
+/// The kernel of a model whose configuration has one: the models the `Bsdf` lane dispatch runs in lanes
+/// besides `diffuse` and the composites.
 #[derive(Clone, Copy, Debug)]
 pub enum LaneKernel<'a> {
     Conductor(GgxConductor),
@@ -129,8 +132,8 @@ pub enum LaneKernel<'a> {
 }
 
 impl Bsdf {
-    /// This model's [`LaneKernel`], `None` for models and configurations without one (`diffuse` has its
-    /// own lanes in the renderer).
+    /// This model's [`LaneKernel`], `None` for models and configurations without one (`diffuse` and the
+    /// composites have their own arms in the lane dispatch).
     #[inline]
     #[must_use]
     pub fn lane_kernel(&self) -> Option<LaneKernel<'_>> {
@@ -266,23 +269,8 @@ impl Bsdf {
     }
 }
 
-/// Every model's single calls are its lanes where all lanes are active: what the batch drivers run.
-impl LaneModel for Bsdf {
-    #[inline(always)]
-    fn f_lanes<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> [R; 3] {
-        self.f_lanes_where(wo, wi, all::<R>())
-    }
-
-    #[inline(always)]
-    fn pdf_lanes<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> R {
-        self.pdf_lanes_where(wo, wi, all::<R>())
-    }
-
-    #[inline(always)]
-    fn sample_lanes<R: Real>(&self, wo: V3<R>, uc: R, ux: R, uy: R) -> LaneSample<R> {
-        self.sample_lanes_where(wo, uc, ux, uy, all::<R>())
-    }
-}
+// Every lane active: what the batch drivers run.
+lane_model_where!(Bsdf);
 
 /// A model's single calls, lane by lane, for the lanes of a mask (zeros and no sample in the others): how a
 /// model that cannot vectorise runs in lanes. Up to [`each_lane::MAX_LANES`] lanes (the widest lane type).

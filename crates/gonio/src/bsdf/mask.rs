@@ -19,7 +19,7 @@
 //! assert!((s.weight.r() - 1.0).abs() < 1e-6);
 //! ```
 
-use super::lanes::{f_one, flag_lanes, pdf_one, sample_one, LaneModel, LaneSample};
+use super::lanes::{f_one, flag_lanes, pdf_one, sample_one, LaneSample};
 use super::{Bsdf, BsdfFlags, BsdfModel, BsdfSample};
 use crate::error::{Error, Result};
 use crate::math::lanes::{channels, Real, V3};
@@ -120,22 +120,7 @@ impl Mask {
     }
 }
 
-impl LaneModel for Mask {
-    #[inline(always)]
-    fn f_lanes<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> [R; 3] {
-        self.f_lanes_where(wo, wi, super::lanes::all::<R>())
-    }
-
-    #[inline(always)]
-    fn pdf_lanes<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> R {
-        self.pdf_lanes_where(wo, wi, super::lanes::all::<R>())
-    }
-
-    #[inline(always)]
-    fn sample_lanes<R: Real>(&self, wo: V3<R>, uc: R, ux: R, uy: R) -> LaneSample<R> {
-        self.sample_lanes_where(wo, uc, ux, uy, super::lanes::all::<R>())
-    }
-}
+lane_model_where!(Mask);
 
 #[cfg(test)]
 mod tests {

@@ -98,6 +98,35 @@ macro_rules! forward_bsdf_model {
     };
 }
 
+/// `impl LaneModel` for a model whose lane code takes a mask of active lanes (`f_lanes_where`,
+/// `pdf_lanes_where`, `sample_lanes_where`: [`Bsdf`] and the composites): the same with every lane active.
+macro_rules! lane_model_where {
+    ($ty:ty) => {
+        impl $crate::bsdf::lanes::LaneModel for $ty {
+            #[inline(always)]
+            fn f_lanes<R: $crate::math::lanes::Real>(&self, wo: $crate::math::lanes::V3<R>, wi: $crate::math::lanes::V3<R>) -> [R; 3] {
+                self.f_lanes_where(wo, wi, $crate::bsdf::lanes::all::<R>())
+            }
+
+            #[inline(always)]
+            fn pdf_lanes<R: $crate::math::lanes::Real>(&self, wo: $crate::math::lanes::V3<R>, wi: $crate::math::lanes::V3<R>) -> R {
+                self.pdf_lanes_where(wo, wi, $crate::bsdf::lanes::all::<R>())
+            }
+
+            #[inline(always)]
+            fn sample_lanes<R: $crate::math::lanes::Real>(
+                &self,
+                wo: $crate::math::lanes::V3<R>,
+                uc: R,
+                ux: R,
+                uy: R,
+            ) -> $crate::bsdf::lanes::LaneSample<R> {
+                self.sample_lanes_where(wo, uc, ux, uy, $crate::bsdf::lanes::all::<R>())
+            }
+        }
+    };
+}
+
 /// The batch methods (plain and `_checked`) of a model with a SIMD kernel ([`lanes::LaneModel`]) for some configurations:
 /// `lane_batch_methods!(kernel);` inside its `impl BsdfModel`, where `self.kernel()` returns `Some(k)` for a
 /// configuration `k` runs (`Option<impl LaneModel>`) and `None` for the others, which take the per-pair loops

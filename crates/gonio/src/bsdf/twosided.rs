@@ -14,7 +14,7 @@
 //! assert!(d.f(-Vec3::Z, -Vec3::Z).r() > 0.3);
 //! ```
 
-use super::lanes::{f_one, pdf_one, sample_one, LaneModel, LaneSample};
+use super::lanes::{f_one, pdf_one, sample_one, LaneSample};
 use super::{Bsdf, BsdfFlags, BsdfModel, BsdfSample};
 use crate::error::{Error, Result};
 use crate::math::lanes::{channels, Real, V3};
@@ -142,22 +142,7 @@ impl TwoSided {
     }
 }
 
-impl LaneModel for TwoSided {
-    #[inline(always)]
-    fn f_lanes<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> [R; 3] {
-        self.f_lanes_where(wo, wi, super::lanes::all::<R>())
-    }
-
-    #[inline(always)]
-    fn pdf_lanes<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> R {
-        self.pdf_lanes_where(wo, wi, super::lanes::all::<R>())
-    }
-
-    #[inline(always)]
-    fn sample_lanes<R: Real>(&self, wo: V3<R>, uc: R, ux: R, uy: R) -> LaneSample<R> {
-        self.sample_lanes_where(wo, uc, ux, uy, super::lanes::all::<R>())
-    }
-}
+lane_model_where!(TwoSided);
 
 #[cfg(test)]
 mod tests {
