@@ -6,9 +6,12 @@
 //! [`LaneModel`]; its `BsdfModel` methods call [`f_one`], [`pdf_one`], [`sample_one`] for that
 //! configuration. Every [`Bsdf`] runs in lanes through one dispatch (`Bsdf::f_lanes_where` and friends,
 //! below): its kernel, its components' lanes for the composites, or its single calls lane by lane
-//! ([`each_lane`]). The path tracer calls that dispatch for the lanes of a packet that share a model, and
-//! `Bsdf`'s batch methods call the drivers [`f_rows`], [`pdf_rows`], [`sample_rows`] and their `_checked`
-//! forms with it (`impl LaneModel for Bsdf`). A driver loads the rows into
+//! ([`each_lane`]). The path tracer calls that dispatch for the lanes of a packet that share a model. The
+//! batch methods of a model with a kernel call the drivers [`f_rows`], [`pdf_rows`], [`sample_rows`] and
+//! their `_checked` forms (`Bsdf`'s batches choose the model once and call its batch methods: running every
+//! batch through the dispatch made models without a kernel up to 6× slower from Python, 2026-12-04, as
+//! its single calls lane by lane cannot be inlined and vectorised the way a per-pair loop over one model
+//! type is). A driver loads the rows into
 //! structure-of-arrays lanes ([`V3`] of the widest lane type the CPU runs: `Twice<Twice<Avx16>>` with AVX-512, `Avx8`
 //! with AVX2, else [`F32x8`]), runs the kernel and stores the lanes back; the last rows (fewer than a
 //! register) run on single `f32`s. The `_checked` forms also test the rows against a [`RowCheck`] on the
@@ -269,7 +272,7 @@ impl Bsdf {
     }
 }
 
-// Every lane active: what the batch drivers run.
+// Every lane active (the drivers can run any model this way).
 lane_model_where!(Bsdf);
 
 /// A model's single calls, lane by lane, for the lanes of a mask (zeros and no sample in the others): how a

@@ -82,6 +82,8 @@ impl BsdfModel for Mask {
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         pdf_one(self, wo, wi)
     }
+
+    self_lane_batch_methods!();
 }
 
 impl Mask {

@@ -127,6 +127,57 @@ macro_rules! lane_model_where {
     };
 }
 
+/// The batch methods (plain and `_checked`) of a model that is its own [`lanes::LaneModel`] in every
+/// configuration (the composites: their lane code combines their components' kernels): the drivers
+/// ([`lanes::f_rows`] and friends) on `self`.
+macro_rules! self_lane_batch_methods {
+    () => {
+        #[inline(always)]
+        fn f_batch(&self, wo: &[$crate::math::Vec3], wi: &[$crate::math::Vec3], out: &mut [$crate::spectrum::Rgb]) {
+            $crate::bsdf::lanes::f_rows(self, wo, wi, out)
+        }
+        #[inline(always)]
+        fn pdf_batch(&self, wo: &[$crate::math::Vec3], wi: &[$crate::math::Vec3], out: &mut [f32]) {
+            $crate::bsdf::lanes::pdf_rows(self, wo, wi, out)
+        }
+        #[inline(always)]
+        fn sample_batch(&self, wo: &[$crate::math::Vec3], uc: &[f32], u: &[$crate::math::Vec2], out: &mut $crate::bsdf::SampleColumns<'_>) {
+            $crate::bsdf::lanes::sample_rows(self, wo, uc, u, out)
+        }
+        #[inline(always)]
+        fn f_batch_checked(
+            &self,
+            wo: &[$crate::math::Vec3],
+            wi: &[$crate::math::Vec3],
+            out: &mut [$crate::spectrum::Rgb],
+            check: $crate::bsdf::RowCheck,
+        ) -> bool {
+            $crate::bsdf::lanes::f_rows_checked(self, wo, wi, out, check)
+        }
+        #[inline(always)]
+        fn pdf_batch_checked(
+            &self,
+            wo: &[$crate::math::Vec3],
+            wi: &[$crate::math::Vec3],
+            out: &mut [f32],
+            check: $crate::bsdf::RowCheck,
+        ) -> bool {
+            $crate::bsdf::lanes::pdf_rows_checked(self, wo, wi, out, check)
+        }
+        #[inline(always)]
+        fn sample_batch_checked(
+            &self,
+            wo: &[$crate::math::Vec3],
+            uc: &[f32],
+            u: &[$crate::math::Vec2],
+            out: &mut $crate::bsdf::SampleColumns<'_>,
+            check: $crate::bsdf::RowCheck,
+        ) -> bool {
+            $crate::bsdf::lanes::sample_rows_checked(self, wo, uc, u, out, check)
+        }
+    };
+}
+
 /// The batch methods (plain and `_checked`) of a model with a SIMD kernel ([`lanes::LaneModel`]) for some configurations:
 /// `lane_batch_methods!(kernel);` inside its `impl BsdfModel`, where `self.kernel()` returns `Some(k)` for a
 /// configuration `k` runs (`Option<impl LaneModel>`) and `None` for the others, which take the per-pair loops
@@ -561,6 +612,32 @@ pub trait Examples {
     const VIOLATIONS: &'static [(&'static str, &'static str)] = &[];
 }
 
+/// Runs `$call` (one model's batch loop, chosen by one `match`) compiled twice: for the baseline target and,
+/// on x86-64 CPUs that have them (detected at run time, so one wheel runs everywhere), with AVX2 and FMA,
+/// whose 8-wide registers the kernels' lanes fill ([`lanes`]). The `match` and the loops it inlines are the
+/// body of a function compiled with those features (`$arg: $ty` are its parameters, named as in `$call`):
+/// a closure would not do, as it is compiled once, for the baseline, and merely called from the feature
+/// function (2026-11: that was the case before, and the AVX2 build held no 256-bit instruction). Both builds
+/// round alike: Rust never fuses a multiply and an add on its own, and `mul_add` is the same exact operation
+/// in hardware and in libm, so the results are the same bit for bit on every path (test
+/// `batches_equal_single_calls`).
+macro_rules! simd_batch {
+    ($self:ident, $m:ident => $call:expr; $($arg:ident: $ty:ty),* => $ret:ty) => {{
+        #[cfg(target_arch = "x86_64")]
+        {
+            #[target_feature(enable = "avx2,fma")]
+            unsafe fn with_avx2(b: &Bsdf, $($arg: $ty),*) -> $ret {
+                dispatch!(b, $m => $call)
+            }
+            if std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma") {
+                // SAFETY: the CPU has the features the function is compiled for (checked just above).
+                return unsafe { with_avx2($self, $($arg),*) };
+            }
+        }
+        dispatch!($self, $m => $call)
+    }};
+}
+
 /// Declares the closed set of models: the enum, its `BsdfModel` forwarding, `From` conversions and the
 /// plugin-name table. Adding a model is one line here.
 macro_rules! bsdf_models {
@@ -587,25 +664,24 @@ macro_rules! bsdf_models {
             fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> { dispatch!(self, m => m.sample(wo, uc, u)) }
             #[inline]
             fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 { dispatch!(self, m => m.pdf(wo, wi)) }
-            // The batches run every model in lanes (`impl LaneModel for Bsdf`: a model's kernel, its
-            // components' lanes, or its single calls lane by lane), on the widest lanes the CPU has.
             fn f_batch(&self, wo: &[Vec3], wi: &[Vec3], out: &mut [Rgb]) {
-                lanes::f_rows(self, wo, wi, out)
+                simd_batch!(self, m => m.f_batch(wo, wi, out); wo: &[Vec3], wi: &[Vec3], out: &mut [Rgb] => ())
             }
             fn pdf_batch(&self, wo: &[Vec3], wi: &[Vec3], out: &mut [f32]) {
-                lanes::pdf_rows(self, wo, wi, out)
+                simd_batch!(self, m => m.pdf_batch(wo, wi, out); wo: &[Vec3], wi: &[Vec3], out: &mut [f32] => ())
             }
             fn sample_batch(&self, wo: &[Vec3], uc: &[f32], u: &[Vec2], out: &mut SampleColumns<'_>) {
-                lanes::sample_rows(self, wo, uc, u, out)
+                simd_batch!(self, m => m.sample_batch(wo, uc, u, out); wo: &[Vec3], uc: &[f32], u: &[Vec2], out: &mut SampleColumns<'_> => ())
             }
             fn f_batch_checked(&self, wo: &[Vec3], wi: &[Vec3], out: &mut [Rgb], check: RowCheck) -> bool {
-                lanes::f_rows_checked(self, wo, wi, out, check)
+                simd_batch!(self, m => m.f_batch_checked(wo, wi, out, check); wo: &[Vec3], wi: &[Vec3], out: &mut [Rgb], check: RowCheck => bool)
             }
             fn pdf_batch_checked(&self, wo: &[Vec3], wi: &[Vec3], out: &mut [f32], check: RowCheck) -> bool {
-                lanes::pdf_rows_checked(self, wo, wi, out, check)
+                simd_batch!(self, m => m.pdf_batch_checked(wo, wi, out, check); wo: &[Vec3], wi: &[Vec3], out: &mut [f32], check: RowCheck => bool)
             }
             fn sample_batch_checked(&self, wo: &[Vec3], uc: &[f32], u: &[Vec2], out: &mut SampleColumns<'_>, check: RowCheck) -> bool {
-                lanes::sample_rows_checked(self, wo, uc, u, out, check)
+                simd_batch!(self, m => m.sample_batch_checked(wo, uc, u, out, check);
+                    wo: &[Vec3], uc: &[f32], u: &[Vec2], out: &mut SampleColumns<'_>, check: RowCheck => bool)
             }
         }
 

@@ -106,6 +106,8 @@ impl BsdfModel for Sum {
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         pdf_one(self, wo, wi)
     }
+
+    self_lane_batch_methods!();
 }
 
 impl Sum {

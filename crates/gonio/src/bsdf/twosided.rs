@@ -79,6 +79,8 @@ impl BsdfModel for TwoSided {
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         pdf_one(self, wo, wi)
     }
+
+    self_lane_batch_methods!();
 }
 
 /// `w` mirrored through the surface (z → −z) in the lanes of `m`.
