@@ -182,6 +182,8 @@ impl BsdfModel for Dielectric {
     fn pdf(&self, _wo: Vec3, _wi: Vec3) -> f32 {
         0.0
     }
+
+    self_lane_batch_methods!();
 }
 
 /// The model in lanes ([`LaneModel`]), which its `sample` runs for one direction: the path tracer's packets
