@@ -115,7 +115,15 @@ impl BsdfModel for Conductor {
         0.0
     }
 
-    self_lane_batch_methods!();
+    lane_batch_methods!(lanes);
+}
+
+impl Conductor {
+    /// Itself: its lane code runs every configuration (the batch methods' `lane_batch_methods!`).
+    #[inline(always)]
+    fn lanes(&self) -> Option<&Self> {
+        Some(self)
+    }
 }
 
 /// The model in lanes ([`LaneModel`]), which its `sample` runs for one direction: the path tracer's packets

@@ -124,6 +124,24 @@ pub trait LaneModel {
     fn sample_lanes<R: Real>(&self, wo: V3<R>, uc: R, ux: R, uy: R) -> LaneSample<R>;
 }
 
+/// A model's lane code through a reference (the batch methods' kernel of a model that is its own).
+impl<K: LaneModel> LaneModel for &K {
+    #[inline(always)]
+    fn f_lanes<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> [R; 3] {
+        (**self).f_lanes(wo, wi)
+    }
+
+    #[inline(always)]
+    fn pdf_lanes<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> R {
+        (**self).pdf_lanes(wo, wi)
+    }
+
+    #[inline(always)]
+    fn sample_lanes<R: Real>(&self, wo: V3<R>, uc: R, ux: R, uy: R) -> LaneSample<R> {
+        (**self).sample_lanes(wo, uc, ux, uy)
+    }
+}
+
 /// The kernel of a model whose configuration has one: the models the `Bsdf` lane dispatch runs in lanes
 /// besides `diffuse` and the composites.
 #[derive(Clone, Copy, Debug)]

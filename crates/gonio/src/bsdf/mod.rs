@@ -127,61 +127,11 @@ macro_rules! lane_model_where {
     };
 }
 
-/// The batch methods (plain and `_checked`) of a model that is its own [`lanes::LaneModel`] in every
-/// configuration (the composites: their lane code combines their components' kernels): the drivers
-/// ([`lanes::f_rows`] and friends) on `self`.
-macro_rules! self_lane_batch_methods {
-    () => {
-        #[inline(always)]
-        fn f_batch(&self, wo: &[$crate::math::Vec3], wi: &[$crate::math::Vec3], out: &mut [$crate::spectrum::Rgb]) {
-            $crate::bsdf::lanes::f_rows(self, wo, wi, out)
-        }
-        #[inline(always)]
-        fn pdf_batch(&self, wo: &[$crate::math::Vec3], wi: &[$crate::math::Vec3], out: &mut [f32]) {
-            $crate::bsdf::lanes::pdf_rows(self, wo, wi, out)
-        }
-        #[inline(always)]
-        fn sample_batch(&self, wo: &[$crate::math::Vec3], uc: &[f32], u: &[$crate::math::Vec2], out: &mut $crate::bsdf::SampleColumns<'_>) {
-            $crate::bsdf::lanes::sample_rows(self, wo, uc, u, out)
-        }
-        #[inline(always)]
-        fn f_batch_checked(
-            &self,
-            wo: &[$crate::math::Vec3],
-            wi: &[$crate::math::Vec3],
-            out: &mut [$crate::spectrum::Rgb],
-            check: $crate::bsdf::RowCheck,
-        ) -> bool {
-            $crate::bsdf::lanes::f_rows_checked(self, wo, wi, out, check)
-        }
-        #[inline(always)]
-        fn pdf_batch_checked(
-            &self,
-            wo: &[$crate::math::Vec3],
-            wi: &[$crate::math::Vec3],
-            out: &mut [f32],
-            check: $crate::bsdf::RowCheck,
-        ) -> bool {
-            $crate::bsdf::lanes::pdf_rows_checked(self, wo, wi, out, check)
-        }
-        #[inline(always)]
-        fn sample_batch_checked(
-            &self,
-            wo: &[$crate::math::Vec3],
-            uc: &[f32],
-            u: &[$crate::math::Vec2],
-            out: &mut $crate::bsdf::SampleColumns<'_>,
-            check: $crate::bsdf::RowCheck,
-        ) -> bool {
-            $crate::bsdf::lanes::sample_rows_checked(self, wo, uc, u, out, check)
-        }
-    };
-}
-
 /// The batch methods (plain and `_checked`) of a model with a SIMD kernel ([`lanes::LaneModel`]) for some configurations:
 /// `lane_batch_methods!(kernel);` inside its `impl BsdfModel`, where `self.kernel()` returns `Some(k)` for a
 /// configuration `k` runs (`Option<impl LaneModel>`) and `None` for the others, which take the per-pair loops
-/// ([`f_each`] and friends).
+/// ([`f_each`] and friends). A model that is its own lane code in every configuration (the composites, the
+/// smooth conductor and dielectric) returns `Some(self)`.
 macro_rules! lane_batch_methods {
     ($kernel:ident) => {
         #[inline(always)]

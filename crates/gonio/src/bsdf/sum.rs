@@ -107,7 +107,15 @@ impl BsdfModel for Sum {
         pdf_one(self, wo, wi)
     }
 
-    self_lane_batch_methods!();
+    lane_batch_methods!(lanes);
+}
+
+impl Sum {
+    /// Itself: its lane code runs every configuration (the batch methods' `lane_batch_methods!`).
+    #[inline(always)]
+    fn lanes(&self) -> Option<&Self> {
+        Some(self)
+    }
 }
 
 impl Sum {

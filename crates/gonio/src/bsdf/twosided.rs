@@ -80,7 +80,15 @@ impl BsdfModel for TwoSided {
         pdf_one(self, wo, wi)
     }
 
-    self_lane_batch_methods!();
+    lane_batch_methods!(lanes);
+}
+
+impl TwoSided {
+    /// Itself: its lane code runs every configuration (the batch methods' `lane_batch_methods!`).
+    #[inline(always)]
+    fn lanes(&self) -> Option<&Self> {
+        Some(self)
+    }
 }
 
 /// `w` mirrored through the surface (z → −z) in the lanes of `m`.
