@@ -33,6 +33,7 @@ pub mod light;
 pub mod math;
 pub mod measured;
 pub mod microfacet;
+pub mod numerics;
 pub mod plot;
 pub mod preview;
 pub mod props;

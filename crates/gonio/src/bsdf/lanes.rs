@@ -20,7 +20,7 @@
 
 use super::conductor::Conductor;
 use super::dielectric::Dielectric;
-use super::rough_conductor::GgxConductor;
+use super::rough_conductor::ConductorKernel;
 use super::rough_plastic::GgxPlastic;
 use super::{Bsdf, BsdfFlags, BsdfSample, SampleColumns};
 use crate::math::lanes::{channels, F32x8, Real, Rows, V3};
@@ -146,7 +146,7 @@ impl<K: LaneModel> LaneModel for &K {
 /// besides `diffuse` and the composites.
 #[derive(Clone, Copy, Debug)]
 pub enum LaneKernel<'a> {
-    Conductor(GgxConductor),
+    Conductor(ConductorKernel),
     Plastic(GgxPlastic<'a>),
     SmoothConductor(&'a Conductor),
     Dielectric(&'a Dielectric),
@@ -160,6 +160,7 @@ impl Bsdf {
     pub fn lane_kernel(&self) -> Option<LaneKernel<'_>> {
         match self {
             Bsdf::RoughConductor(m) => m.0.lanes().map(LaneKernel::Conductor),
+            Bsdf::TorranceSparrow(m) => m.0.lanes().map(LaneKernel::Conductor),
             Bsdf::RoughPlastic(m) => m.lanes().map(LaneKernel::Plastic),
             Bsdf::Conductor(m) => Some(LaneKernel::SmoothConductor(m)),
             Bsdf::Dielectric(m) => Some(LaneKernel::Dielectric(m)),
@@ -651,13 +652,23 @@ mod tests {
     use crate::sampling::Pcg32;
 
     /// A model's [`LaneKernel`] on the renderer's eight lanes gives in every lane what the model's single
-    /// calls give, bit for bit (GGX conductors and plastics, smooth conductors and dielectrics, from both
-    /// sides: the directions cover the sphere); models without a kernel in their configuration have none.
+    /// calls give, bit for bit (rough conductors of every distribution — GGX, Beckmann, Torrance–Sparrow's
+    /// Blinn — isotropic and anisotropic, visible and D·cos sampling; GGX plastics; smooth conductors and
+    /// dielectrics; from both sides: the directions cover the sphere); models without a kernel in their
+    /// configuration have none.
     #[test]
     fn lane_kernels_equal_single_calls() {
         let with = [
             r#"{"type": "roughconductor", "distribution": "ggx", "alpha": 0.2, "material": "Au"}"#,
             r#"{"type": "roughconductor", "distribution": "ggx", "alpha_u": 0.05, "alpha_v": 0.4}"#,
+            r#"{"type": "roughconductor", "distribution": "ggx", "alpha": 0.5, "sample_visible": false, "material": "Cu"}"#,
+            r#"{"type": "roughconductor"}"#,
+            r#"{"type": "roughconductor", "alpha": 0.6, "material": "Au"}"#,
+            r#"{"type": "roughconductor", "alpha_u": 0.02, "alpha_v": 0.5, "material": "Al"}"#,
+            r#"{"type": "roughconductor", "alpha_u": 0.4, "alpha_v": 0.05, "sample_visible": false}"#,
+            r#"{"type": "roughconductor", "alpha": 0.001}"#,
+            r#"{"type": "torrance_sparrow"}"#,
+            r#"{"type": "torrance_sparrow", "distribution": "beckmann", "alpha": 0.3, "shadowing": "smith_correlated"}"#,
             r#"{"type": "roughplastic", "distribution": "ggx", "alpha": 0.1, "diffuse_reflectance": [0.7, 0.1, 0.1]}"#,
             r#"{"type": "conductor", "material": "Al"}"#,
             r#"{"type": "conductor", "specular_reflectance": [0.2, 0.5, 1.0]}"#,
@@ -665,7 +676,11 @@ mod tests {
             r#"{"type": "dielectric", "int_ior": 1.0, "ext_ior": 1.5, "specular_transmittance": [0.2, 0.7, 0.9]}"#,
             r#"{"type": "dielectric", "int_ior": 1.5, "fresnel": false}"#,
         ];
-        let without = [r#"{"type": "roughconductor", "alpha": 0.2}"#, r#"{"type": "diffuse"}"#, r#"{"type": "thindielectric"}"#];
+        let without = [
+            r#"{"type": "roughconductor", "alpha": 0.2, "energy_compensation": true}"#,
+            r#"{"type": "diffuse"}"#,
+            r#"{"type": "thindielectric"}"#,
+        ];
         for spec in without {
             assert!(Bsdf::from_json(spec).unwrap().lane_kernel().is_none(), "{spec}");
         }

@@ -23,9 +23,12 @@
 //! and agree to 1e-5 once that approximation is undone). One-sided: light from below is absorbed. The `material`,
 //! `eta`, `k` and `specular_reflectance` parameters are those of [`Conductor`].
 //!
-//! Sampling draws ωh from [`MicrofacetDistribution::sample_wm`] and reflects ωo about it;
+//! Sampling draws ωh from the distribution (visible normals or D·cos) and reflects ωo about it;
 //! pdf(ωi) = pdf(ωh) / (4 ωo·ωh) (Walter 2007 eq. 14). `f` and `pdf` of a sample are evaluated from the
-//! returned ωi, so `sample`, `f` and `pdf` agree to the last bit.
+//! returned ωi, so `sample`, `f` and `pdf` agree to the last bit. The lobe is written once over the lanes
+//! and the distribution ([`ConductorLobe`], [`ReflectionLobe`]): single calls run it at `f32`, batches and
+//! the renderer's packets in SIMD lanes, for GGX and Beckmann alike (the energy-compensated configuration
+//! adds its tabulated lobe in single calls).
 //!
 //! Roughness range: below α = 1e-4 the lobe is narrower than f32 can place a half vector reliably
 //! (round-off in ωo + ωi is ~1e-7 rad, 0.1 % of the lobe at 1e-4); use `conductor`. Above 10 the model
@@ -46,10 +49,13 @@ use super::energy_compensation::ConductorCompensation;
 use super::lanes::{f_one, flag_lanes, pdf_one, sample_one, LaneModel, LaneSample};
 use super::{BsdfFlags, BsdfModel, BsdfSample, Conductor};
 use crate::error::{Error, Result};
-use crate::fresnel::{fresnel_conductor_rgb_lanes, reflect, reflect_lanes};
+use crate::fresnel::fresnel_conductor_rgb_lanes;
 use crate::math::lanes::{channels, Real, V3};
 use crate::math::{Vec2, Vec3};
-use crate::microfacet::{alpha_from_blinn_exponent, Ggx, MicrofacetDistribution, MicrofacetKind, Shadowing};
+use crate::microfacet::reflection::ReflectionLobe;
+use crate::microfacet::{
+    alpha_from_blinn_exponent, on_distribution, Beckmann, Blinn, Distribution, Ggx, MicrofacetDistribution, MicrofacetKind, Shadowing,
+};
 use crate::props::Props;
 use crate::spectrum::Rgb;
 
@@ -129,121 +135,139 @@ impl MicrofacetConductor {
         Ok(MicrofacetConductor::new(distribution, shadowing, sample_visible, fresnel))
     }
 
-    /// f = F(ωo·ωh) D(ωh) G(ωo, ωi, ωh) / (4 cos θo cos θi) for both directions above the surface.
+    /// f = F(ωo·ωh) D(ωh) G(ωo, ωi, ωh) / (4 cos θo cos θi) for both directions above the surface: the
+    /// lobe's kernel ([`ConductorKernel`]) at one pair.
     #[must_use]
     #[inline(always)]
     pub fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
-        if wo.z <= 0.0 || wi.z <= 0.0 {
-            return Rgb::ZERO;
-        }
-        let wm = (wo + wi).normalize();
-        let d = self.distribution.d(wm);
-        if d == 0.0 {
-            return Rgb::ZERO;
-        }
-        let g = self.distribution.g(wo, wi, wm, self.shadowing);
-        let value = d * g / (4.0 * wo.z * wi.z);
-        // Within f32 underflow of the horizon 4 cos θo cos θi rounds to 0 and only an unshadowed (G = 1)
-        // model can get here with D > 0: its f is unbounded there; report 0 (2026-11: never NaN/Inf).
-        if !value.is_finite() {
-            return Rgb::ZERO;
-        }
-        // ωo·ωh = ωi·ωh exactly, but not in f32: average them so that f(ωo, ωi) = f(ωi, ωo) bit for bit.
-        let cos_theta_d = 0.5 * (wo.dot(wm) + wi.dot(wm));
-        self.fresnel.reflectance(cos_theta_d) * value
+        f_one(&self.kernel(), wo, wi)
     }
 
     /// The solid-angle density of [`sample_lobe`](Self::sample_lobe): pdf(ωh) / (4 ωo·ωh).
     #[must_use]
     #[inline(always)]
     pub fn pdf_lobe(&self, wo: Vec3, wi: Vec3) -> f32 {
-        if wo.z <= 0.0 || wi.z <= 0.0 {
-            return 0.0;
-        }
-        let wm = (wo + wi).normalize();
-        self.distribution.pdf_reflected(wo, wm, self.sample_visible)
+        pdf_one(&self.kernel(), wo, wi)
     }
 
     /// Sample ωh, reflect ωo about it; `f` and `pdf` are those of the returned ωi.
     #[must_use]
     #[inline(always)]
     pub fn sample_lobe(&self, wo: Vec3, u: Vec2) -> Option<BsdfSample> {
-        if wo.z <= 0.0 {
-            return None;
-        }
-        let wm = self.distribution.sample_wm(wo, u, self.sample_visible);
-        let wi = reflect(wo, wm).normalize();
-        if wi.z.is_nan() || wi.z <= 0.0 {
-            return None;
-        }
-        let s = BsdfSample::smooth(wi, self.eval(wo, wi), self.pdf_lobe(wo, wi), BsdfFlags::GLOSSY_REFLECTION, 1.0)?;
-        // Far out in the tails f and pdf are both subnormal and f·cos/pdf overflows; such a direction
-        // carries no measurable energy (2026-11: seen at u = 0 with normal incidence in the NaN sweep).
-        s.weight.is_finite().then_some(s)
+        sample_one(&self.kernel(), wo, 0.0, u)
     }
-}
 
-/// The common configuration of [`MicrofacetConductor`] — GGX, separable Smith, visible normals, no
-/// compensation — in lanes ([`LaneModel`]): `f`, `pdf` and `sample` of that configuration are these, for
-/// single calls and batches alike.
-#[derive(Clone, Copy, Debug)]
-pub struct GgxConductor {
-    ggx: Ggx,
-    eta_k: Option<(Rgb, Rgb)>,
-    specular_reflectance: Rgb,
-}
-
-impl MicrofacetConductor {
-    /// The [`GgxConductor`] kernel of this model, `None` for other configurations.
+    /// The glossy lobe of this model as a lane kernel, for its distribution (matched here, once per call).
     #[inline(always)]
-    pub(crate) fn lanes(&self) -> Option<GgxConductor> {
-        let d = self.distribution;
-        (d.kind == MicrofacetKind::Ggx && self.shadowing == Shadowing::Smith && self.sample_visible && self.compensation.is_none())
-            .then_some(GgxConductor { ggx: d.ggx(), eta_k: self.fresnel.eta_k, specular_reflectance: self.fresnel.specular_reflectance })
+    pub(crate) fn kernel(&self) -> ConductorKernel {
+        let fresnel = ConductorFresnel { eta_k: self.fresnel.eta_k, specular_reflectance: self.fresnel.specular_reflectance };
+        let (shadowing, visible) = (self.shadowing, self.sample_visible);
+        on_distribution!(self.distribution, |d| ConductorKernel::from(ConductorLobe {
+            lobe: ReflectionLobe { distribution: d, shadowing, visible },
+            fresnel
+        }))
+    }
+
+    /// The kernel of this model when the glossy lobe is all of it (no energy compensation, whose lobe
+    /// looks its tables up per lane and stays on the single calls).
+    #[inline(always)]
+    pub(crate) fn lanes(&self) -> Option<ConductorKernel> {
+        self.compensation.is_none().then(|| self.kernel())
     }
 }
 
-impl LaneModel for GgxConductor {
-    /// [`MicrofacetConductor::eval`] for GGX, with selects for its early returns, from the unnormalised
-    /// half vector h = ωo + ωi ([`Ggx::reflection_term`]): ωo·ωh = ωi·ωh = |h|/2 since ωo·h + ωi·h = h·h,
-    /// so F's cosine is √(h·h)/2 (the average `eval` takes, without its division).
+/// A conductor's Fresnel term: the complex index (`None`: a perfect mirror) and the multiplier.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ConductorFresnel {
+    pub eta_k: Option<(Rgb, Rgb)>,
+    pub specular_reflectance: Rgb,
+}
+
+/// The microfacet conductor's glossy lobe for the distribution `D` in lanes ([`LaneModel`]): the Walter
+/// 2007 reflection lobe ([`ReflectionLobe`]) times the conductor's Fresnel term. `f`, `pdf` and `sample`
+/// of [`MicrofacetConductor`] are these, for single calls and batches alike.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ConductorLobe<D> {
+    pub lobe: ReflectionLobe<D>,
+    pub fresnel: ConductorFresnel,
+}
+
+impl<D: Distribution> LaneModel for ConductorLobe<D> {
+    /// F(ωo·ωh) D G / (4 cos θo cos θi), 0 where the lobe is (see [`LobeValue`](crate::microfacet::reflection::LobeValue)).
     #[inline(always)]
     fn f_lanes<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> [R; 3] {
         let zero = R::splat(0.0);
-        let h = wo.add(wi);
-        let l = h.dot(h);
-        let value = self.ggx.reflection_term(wo, wi, h, l);
-        // Below the surface, a direction behind ωh, or within f32 underflow of the horizon (see `eval`): 0.
-        let ok = wo.z.gt(zero) & wi.z.gt(zero) & wo.dot(h).gt(zero) & wi.dot(h).gt(zero) & value.is_finite();
-        let cos_theta_d = l.sqrt() * 0.5;
-        let fresnel = match self.eta_k {
-            Some((eta, k)) => fresnel_conductor_rgb_lanes(cos_theta_d, eta, k),
+        let v = self.lobe.eval(wo, wi);
+        let fresnel = match self.fresnel.eta_k {
+            Some((eta, k)) => fresnel_conductor_rgb_lanes(v.cos_theta_d, eta, k),
             None => [R::splat(1.0); 3],
         };
-        let s = self.specular_reflectance.0;
-        channels!(|c| R::select(ok, fresnel[c] * s[c] * value, zero))
+        let s = self.fresnel.specular_reflectance.0;
+        channels!(|c| R::select(v.ok, fresnel[c] * s[c] * v.value, zero))
     }
 
-    /// [`MicrofacetConductor::pdf_lobe`] for GGX visible normals ([`Ggx::pdf_reflected_visible_h`]).
     #[inline(always)]
     fn pdf_lanes<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> R {
-        let zero = R::splat(0.0);
-        let h = wo.add(wi);
-        R::select(wo.z.le(zero) | wi.z.le(zero), zero, self.ggx.pdf_reflected_visible_h(wo, h, h.dot(h)))
+        self.lobe.pdf(wo, wi)
     }
 
-    /// [`MicrofacetConductor::sample_lobe`] for GGX visible normals.
     #[inline(always)]
     fn sample_lanes<R: Real>(&self, wo: V3<R>, _uc: R, ux: R, uy: R) -> LaneSample<R> {
-        let zero = R::splat(0.0);
-        let above = !wo.z.le(zero);
+        let above = !wo.z.le(R::splat(0.0));
         if !R::any(above) {
             return LaneSample::none(above);
         }
-        let wm = self.ggx.sample_visible(wo, ux, uy);
-        let wi = reflect_lanes(wo, wm).normalize();
-        let valid = above & !(wi.z.is_nan() | wi.z.le(zero));
-        LaneSample::smooth(wi, self.f_lanes(wo, wi), self.pdf_lanes(wo, wi), flag_lanes(BsdfFlags::GLOSSY_REFLECTION), valid)
+        let s = self.lobe.sample(wo, ux, uy);
+        LaneSample::smooth(s.wi, self.f_lanes(wo, s.wi), self.pdf_lanes(wo, s.wi), flag_lanes(BsdfFlags::GLOSSY_REFLECTION), s.valid)
+    }
+}
+
+/// [`ConductorLobe`] for the distribution a model has: the kind matched once per call.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ConductorKernel {
+    Ggx(ConductorLobe<Ggx>),
+    Beckmann(ConductorLobe<Beckmann>),
+    Blinn(ConductorLobe<Blinn>),
+}
+
+macro_rules! conductor_kernel_from {
+    ($($kind:ident),*) => {$(
+        impl From<ConductorLobe<$kind>> for ConductorKernel {
+            #[inline(always)]
+            fn from(k: ConductorLobe<$kind>) -> Self {
+                ConductorKernel::$kind(k)
+            }
+        }
+    )*};
+}
+conductor_kernel_from!(Ggx, Beckmann, Blinn);
+
+impl LaneModel for ConductorKernel {
+    #[inline(always)]
+    fn f_lanes<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> [R; 3] {
+        match self {
+            ConductorKernel::Ggx(k) => k.f_lanes(wo, wi),
+            ConductorKernel::Beckmann(k) => k.f_lanes(wo, wi),
+            ConductorKernel::Blinn(k) => k.f_lanes(wo, wi),
+        }
+    }
+
+    #[inline(always)]
+    fn pdf_lanes<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> R {
+        match self {
+            ConductorKernel::Ggx(k) => k.pdf_lanes(wo, wi),
+            ConductorKernel::Beckmann(k) => k.pdf_lanes(wo, wi),
+            ConductorKernel::Blinn(k) => k.pdf_lanes(wo, wi),
+        }
+    }
+
+    #[inline(always)]
+    fn sample_lanes<R: Real>(&self, wo: V3<R>, uc: R, ux: R, uy: R) -> LaneSample<R> {
+        match self {
+            ConductorKernel::Ggx(k) => k.sample_lanes(wo, uc, ux, uy),
+            ConductorKernel::Beckmann(k) => k.sample_lanes(wo, uc, ux, uy),
+            ConductorKernel::Blinn(k) => k.sample_lanes(wo, uc, ux, uy),
+        }
     }
 }
 

@@ -585,7 +585,7 @@ impl GgxPlastic<'_> {
     }
 
     /// [`RoughDielectric::reflection`] (no compensation): Walter 2007 eq. 20, from the unnormalised half
-    /// vector h = ωo + ωi as in [`GgxConductor`](super::rough_conductor::GgxConductor) (one division and
+    /// vector h = ωo + ωi as in [`ConductorLobe`](super::rough_conductor::ConductorLobe) (one division and
     /// three square roots besides F's, 2026-12; F's cosine ωo·ωh = √(h·h)/2).
     #[inline(always)]
     fn reflection<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> [R; 3] {
