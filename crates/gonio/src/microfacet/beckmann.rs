@@ -66,7 +66,11 @@ const LAMBDA_H: [f32; 9] = [
 /// - a ≥ 2.5: Λ = e^{−a²} h(1/a²)/(4a³√π) ([`LAMBDA_H`]), no cancellation.
 ///
 /// e^{−a²} takes a² split exactly ([`square_split`]).
-#[inline(always)]
+///
+/// Not inlined: one copy per lane type. Inlined into every lane driver (with its ten-step neighbour
+/// [`visible_slope_x`]), it made LLVM's loop passes run for over half an hour on one codegen unit
+/// (2026-12-04; the array lane types' operations are loops of their own).
+#[inline(never)]
 #[must_use]
 pub fn beckmann_lambda_lanes<R: Real>(a: R) -> R {
     // Beyond 16 Λ underflows to 0 either way; the clamp keeps a² finite (NaN passes).
@@ -97,7 +101,9 @@ const SLOPE_STEPS: usize = 10;
 /// CDF, and |x − C⁻¹(u)| ≤ 10⁻⁴ for u ∈ [0.001, 0.999] (test `visible_slope_matches_the_exact_inverse`).
 /// b is clamped to ±(1 − 2⁻²⁴) (|x| ≤ 3.85, see [`erf_inv_lanes`]): the slopes beyond carry less than
 /// 2·10⁻⁸ of the probability.
-#[inline(always)]
+///
+/// Not inlined (see [`beckmann_lambda_lanes`]); a call per lane batch against ten Newton steps.
+#[inline(never)]
 #[must_use]
 pub fn visible_slope_x<R: Real>(sin_theta: R, cos_theta: R, u: R) -> R {
     let one = R::splat(1.0);
