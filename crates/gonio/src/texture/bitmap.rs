@@ -32,6 +32,10 @@ impl Wrap {
     #[inline]
     fn apply(self, i: i64, n: usize) -> usize {
         let n = n as i64;
+        if (0..n).contains(&i) {
+            // Every mode leaves [0, n) as it is (most lookups: no integer division).
+            return i as usize;
+        }
         let r = match self {
             Wrap::Repeat => i.rem_euclid(n),
             Wrap::Clamp => i.clamp(0, n - 1),
@@ -90,9 +94,9 @@ impl Bitmap {
     }
 
     #[inline]
-    fn texel(&self, x: i64, y: i64) -> Rgb {
-        let (w, h) = (self.image.width, self.image.height);
-        let i = 3 * (self.wrap.apply(y, h) * w + self.wrap.apply(x, w));
+    /// Texel (`x`, `y`) of the image, both coordinates already wrapped into it.
+    fn texel(&self, x: usize, y: usize) -> Rgb {
+        let i = 3 * (y * self.image.width + x);
         let d = &self.image.data;
         Rgb::new(d[i], d[i + 1], d[i + 2])
     }
@@ -101,15 +105,19 @@ impl Bitmap {
     pub fn eval(&self, uv: Vec2) -> Rgb {
         let q = self.to_uv.point(Vec3::new(uv.x, uv.y, 0.0));
         let (w, h) = (self.image.width as f32, self.image.height as f32);
+        let (iw, ih) = (self.image.width, self.image.height);
         if !self.bilinear {
-            return self.texel((q.x * w).floor() as i64, (q.y * h).floor() as i64);
+            return self.texel(self.wrap.apply((q.x * w).floor() as i64, iw), self.wrap.apply((q.y * h).floor() as i64, ih));
         }
         let (x, y) = (q.x * w - 0.5, q.y * h - 0.5);
         let (x0, y0) = (x.floor(), y.floor());
         let (fx, fy) = (x - x0, y - y0);
         let (x0, y0) = (x0 as i64, y0 as i64);
-        let top = self.texel(x0, y0) * (1.0 - fx) + self.texel(x0 + 1, y0) * fx;
-        let bottom = self.texel(x0, y0 + 1) * (1.0 - fx) + self.texel(x0 + 1, y0 + 1) * fx;
+        // Each of the two columns and rows wrapped once.
+        let (c0, c1) = (self.wrap.apply(x0, iw), self.wrap.apply(x0 + 1, iw));
+        let (r0, r1) = (self.wrap.apply(y0, ih), self.wrap.apply(y0 + 1, ih));
+        let top = self.texel(c0, r0) * (1.0 - fx) + self.texel(c1, r0) * fx;
+        let bottom = self.texel(c0, r1) * (1.0 - fx) + self.texel(c1, r1) * fx;
         top * (1.0 - fy) + bottom * fy
     }
 }
