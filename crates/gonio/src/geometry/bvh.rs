@@ -58,6 +58,11 @@ const ALL_AXES_BELOW: usize = 4096;
 /// Above this depth the binary build splits at the median, which bounds the tree depth by
 /// `MAX_SAH_DEPTH + log2(n)` and so the traversal stack.
 const MAX_SAH_DEPTH: usize = 48;
+/// Subtrees of at least this many primitives build their two halves on two threads (rayon's join): the
+/// tree is the one the serial build makes, node for node (see [`Builder::append`]). Below it the halves
+/// build on the thread that split them: every parallel level copies its subtrees' nodes once more, and
+/// from 10⁶ primitives down to this there are already 16 tasks.
+const PARALLEL_FROM: usize = 1 << 16;
 /// Traversal stack entries: a node pushes at most seven, and the tree is at most
 /// `MAX_SAH_DEPTH + 32` deep.
 const STACK: usize = 7 * (MAX_SAH_DEPTH + 32) + 8;
@@ -187,14 +192,10 @@ impl Bvh {
             .enumerate()
             .map(|(i, b)| BuildPrim { bounds: *b, centroid: b.centroid(), index: i as u32, alone: alone.get(i).copied().unwrap_or(false) })
             .collect();
-        let mut builder = Builder { nodes: Vec::with_capacity(2 * bounds.len().max(1)), order: Vec::with_capacity(bounds.len() + 8) };
         if prims.is_empty() {
             return Bvh::default();
         }
-        builder.build_node(&mut prims, 0);
-        while builder.order.len() % LANES != 0 {
-            builder.order.push(EMPTY_SLOT);
-        }
+        let builder = Builder::build(&mut prims, PARALLEL_FROM);
         let mut bvh = Bvh { nodes: Vec::with_capacity(builder.nodes.len() / 4 + 1), order: builder.order };
         let bin = &builder.nodes;
         if bin[0].count > 0 {
@@ -692,6 +693,8 @@ fn any_from(bvh: &Bvh, start: u32, ray: &Ray, mut leaf: impl FnMut(u32, u32) -> 
 struct Builder {
     nodes: Vec<BinNode>,
     order: Vec<u32>,
+    /// Subtrees of at least this many primitives build their halves in parallel ([`PARALLEL_FROM`]).
+    parallel_from: usize,
 }
 
 /// SAH cost of `n` primitives of which `alone` are tested each by itself (a test each), the others an
@@ -707,6 +710,22 @@ fn tests(n: usize, alone: usize) -> f32 {
 }
 
 impl Builder {
+    /// The binary tree over `prims` (reordered), its slots padded to a packet boundary.
+    fn build(prims: &mut [BuildPrim], parallel_from: usize) -> Builder {
+        let mut builder = Builder::subtree(prims, 0, parallel_from);
+        while builder.order.len() % LANES != 0 {
+            builder.order.push(EMPTY_SLOT);
+        }
+        builder
+    }
+
+    /// The tree of `prims`, at `depth`, in a builder of its own.
+    fn subtree(prims: &mut [BuildPrim], depth: usize, parallel_from: usize) -> Builder {
+        let mut sub = Builder { nodes: Vec::with_capacity(2 * prims.len()), order: Vec::with_capacity(prims.len() + 8), parallel_from };
+        sub.build_node(prims, depth);
+        sub
+    }
+
     fn push_leaf(&mut self, bounds: Bounds3, prims: &[BuildPrim]) {
         // Leaves start on a packet boundary.
         while self.order.len() % LANES != 0 {
@@ -747,9 +766,33 @@ impl Builder {
         let me = self.nodes.len();
         self.nodes.push(BinNode { bounds, offset: 0, count: 0 });
         let (left, right) = prims.split_at_mut(mid);
-        self.build_node(left, depth + 1);
-        self.nodes[me].offset = self.nodes.len() as u32;
-        self.build_node(right, depth + 1);
+        if n >= self.parallel_from {
+            let from = self.parallel_from;
+            let (l, r) = rayon::join(|| Builder::subtree(left, depth + 1, from), || Builder::subtree(right, depth + 1, from));
+            self.append(l);
+            self.nodes[me].offset = self.nodes.len() as u32;
+            self.append(r);
+        } else {
+            self.build_node(left, depth + 1);
+            self.nodes[me].offset = self.nodes.len() as u32;
+            self.build_node(right, depth + 1);
+        }
+    }
+
+    /// Append a subtree built by a builder of its own, as if this builder had built it next: its nodes
+    /// move by the nodes here, its slots by the slots here after padding them to a packet boundary (which
+    /// its first leaf would have done; the subtree's own slots start at 0, a boundary), so the result is
+    /// the serial build's.
+    fn append(&mut self, sub: Builder) {
+        while self.order.len() % LANES != 0 {
+            self.order.push(EMPTY_SLOT);
+        }
+        let (node_base, slot_base) = (self.nodes.len() as u32, self.order.len() as u32);
+        self.nodes.extend(sub.nodes.into_iter().map(|mut n| {
+            n.offset += if n.count > 0 { slot_base } else { node_base };
+            n
+        }));
+        self.order.extend(sub.order);
     }
 }
 
@@ -839,6 +882,28 @@ mod tests {
                 Bounds3 { min: c, max: c + Vec3::splat(0.05 + 0.2 * rng.next_f32()) }
             })
             .collect()
+    }
+
+    /// The parallel build makes the serial build's tree, node for node and slot for slot.
+    #[test]
+    fn parallel_build_is_the_serial_build() {
+        let mut rng = Pcg32::new(5, 11);
+        for n in [9, 100, 5000, 40_000] {
+            let boxes = random_boxes(&mut rng, n);
+            let prims = |alone: bool| -> Vec<BuildPrim> {
+                boxes.iter().enumerate().map(|(i, b)| BuildPrim { bounds: *b, centroid: b.centroid(), index: i as u32, alone: alone && i % 3 == 0 }).collect()
+            };
+            for alone in [false, true] {
+                let serial = Builder::build(&mut prims(alone), usize::MAX);
+                // Down to subtrees of two primitives in parallel: every join and append exercised.
+                let parallel = Builder::build(&mut prims(alone), 2);
+                assert_eq!(serial.order, parallel.order, "n = {n}");
+                assert_eq!(serial.nodes.len(), parallel.nodes.len(), "n = {n}");
+                for (a, b) in serial.nodes.iter().zip(&parallel.nodes) {
+                    assert!(a.offset == b.offset && a.count == b.count && a.bounds == b.bounds, "n = {n}");
+                }
+            }
+        }
     }
 
     /// Random small boxes; the BVH must find exactly what brute force finds, built with every primitive
