@@ -8,6 +8,7 @@
 //! | `to_world`  | transform | identity | camera → world                                                |
 //! | `near_clip` | float     | 0.01     | rays start at this depth                                      |
 //! | `far_clip`  | float     | 10000    | and end at this one                                           |
+//! | `focus_distance` | float | 0     | accepted and ignored: Mitsuba 3's pinhole `perspective` reads it too (for `thinlens`-style scenes) and its image does not depend on it |
 //!
 //! In camera space the camera looks down +z with +y up and **+x to the left of the image** (Mitsuba's
 //! convention; `lookat`'s local x is up × direction). A film position (sx, sy) ∈ [0, 1]², (0, 0) the
@@ -84,6 +85,8 @@ impl PerspectiveCamera {
             let _ = p.string("fov_axis")?;
             ((36.0f32.hypot(24.0) / (2.0 * f)).atan().to_degrees() * 2.0, "diagonal".to_string())
         };
+        // A pinhole has everything in focus: Mitsuba's `perspective` accepts the parameter and ignores it.
+        let _ = p.float_in("focus_distance", 0.0, 0.0, f32::MAX)?;
         let near = p.float_positive("near_clip", 1e-2)?;
         let far = p.float_positive("far_clip", 1e4)?;
         if far <= near {
@@ -155,6 +158,19 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// Mitsuba's pinhole accepts `focus_distance` (scenes written for `thinlens` give it); the camera is
+    /// the same with it as without.
+    #[test]
+    fn focus_distance_is_accepted_and_changes_nothing() {
+        let plain = Props::from_json(r#"{"type": "perspective", "fov": 40}"#).unwrap();
+        let focused = Props::from_json(r#"{"type": "perspective", "fov": 40, "focus_distance": 6.0}"#).unwrap();
+        let (a, b) = (PerspectiveCamera::from_props(&plain, 64, 48).unwrap(), PerspectiveCamera::from_props(&focused, 64, 48).unwrap());
+        focused.finish().unwrap();
+        assert_eq!(a, b);
+        let negative = Props::from_json(r#"{"type": "perspective", "focus_distance": -1}"#).unwrap();
+        assert!(PerspectiveCamera::from_props(&negative, 4, 4).unwrap_err().to_string().contains("focus_distance"));
     }
 
     /// Horizontal fields of view Mitsuba 3.9.1 reports (`x_fov`) for these sensors.

@@ -3,8 +3,12 @@
 //! | parameter          | type    | default | meaning                                           |
 //! |--------------------|---------|---------|---------------------------------------------------|
 //! | `width`, `height`  | integer | 768, 576| resolution: each in [1, 65536], at most 2²⁶ pixels |
-//! | `pixel_format`     | string  | rgb     | accepted (gonio writes RGB)                       |
-//! | `component_format` | string  | float16 | accepted (the output format follows the file name) |
+//! | `file_format`      | string  | openexr | `openexr`, `exr`, `rgbe` or `pfm`: accepted (the output format follows the file name) |
+//! | `pixel_format`     | string  | rgb     | one of Mitsuba's (`rgb`, `rgba`, `luminance`, `xyz`, …): accepted (gonio writes RGB) |
+//! | `component_format` | string  | float16 | `float16`, `float32` or `uint32`: accepted (the output format follows the file name) |
+//! | `crop_offset_x`, `crop_offset_y`, `crop_width`, `crop_height` | integer | 0, 0, width, height | a crop window: only the whole film (gonio renders no partial films yet; anything else is an error) |
+//! | `sample_border`    | boolean | false   | only `false` (samples in the film's pixels; `true` is an error) |
+//! | `compensate`       | boolean | false   | accepted: gonio always sums in f64 (what Mitsuba's Kahan summation is for) |
 //! | nested `rfilter`   | plugin  | box     | `box`; others are rendered with a box and a warning |
 //!
 //! A non-finite sample is dropped and counted: it adds nothing to the sum but still counts in the
@@ -40,8 +44,25 @@ impl FilmSpec {
                 format!("a {width}×{height} film has more than {MAX_PIXELS} pixels (e.g. 8192×8192), the most gonio renders"),
             ));
         }
-        let _ = p.string("pixel_format")?;
-        let _ = p.string("component_format")?;
+        one_of(p, "file_format", &["openexr", "exr", "rgbe", "pfm"])?;
+        one_of(p, "pixel_format", &["luminance", "luminance_alpha", "rgb", "rgba", "xyz", "xyza"])?;
+        one_of(p, "component_format", &["float16", "float32", "uint32"])?;
+        let _ = p.bool("compensate", false)?;
+        if p.bool("sample_border", false)? {
+            return Err(Error::spec(p.at_param("sample_border"), "`sample_border` = true is not supported by gonio yet (only false)"));
+        }
+        let crop = [
+            ("crop_offset_x", 0, p.integer_in("crop_offset_x", 0, 0, i64::from(width))?),
+            ("crop_offset_y", 0, p.integer_in("crop_offset_y", 0, 0, i64::from(height))?),
+            ("crop_width", i64::from(width), p.integer_in("crop_width", i64::from(width), 1, i64::from(width))?),
+            ("crop_height", i64::from(height), p.integer_in("crop_height", i64::from(height), 1, i64::from(height))?),
+        ];
+        if let Some((name, whole, _)) = crop.iter().find(|(_, whole, got)| got != whole) {
+            return Err(Error::spec(
+                p.at_param(name),
+                format!("crop windows are not supported by gonio yet: `{name}` must be {whole} (the whole {width}×{height} film)"),
+            ));
+        }
         for f in p.nested_of("rfilter") {
             if f.plugin_type() != "box" {
                 warnings.push(format!("{}: rfilter `{}` is rendered as a box filter", f.at(), f.plugin_type()));
@@ -49,6 +70,16 @@ impl FilmSpec {
         }
         p.finish()?;
         Ok(FilmSpec { width, height })
+    }
+}
+
+/// A string parameter that, when given, must be one of `allowed`.
+fn one_of(p: &Props, name: &'static str, allowed: &[&str]) -> Result<()> {
+    match p.string(name)? {
+        Some(v) if !allowed.contains(&v.as_str()) => {
+            Err(Error::spec(p.at_param(name), format!("`{name}` must be one of {}, got \"{v}\"", allowed.join(", "))))
+        }
+        _ => Ok(()),
     }
 }
 
@@ -101,5 +132,35 @@ impl Film {
     pub fn mean(&self, spp: u32) -> Vec<f32> {
         let inv = if spp > 0 { 1.0 / f64::from(spp) } else { 0.0 };
         self.sum.iter().flat_map(|s| s.map(|v| (v * inv) as f32)).collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn film(json: &str) -> Result<FilmSpec> {
+        let p = Props::from_json(json).unwrap();
+        FilmSpec::from_props(&p, &mut Vec::new())
+    }
+
+    /// The `hdrfilm` parameters Mitsuba 3 accepts are accepted; values gonio cannot honour are errors
+    /// that name the parameter.
+    #[test]
+    fn mitsubas_hdrfilm_parameters_are_accepted() {
+        let all = r#"{"type": "hdrfilm", "width": 8, "height": 4, "file_format": "openexr", "pixel_format": "rgba",
+            "component_format": "float32", "crop_offset_x": 0, "crop_offset_y": 0, "crop_width": 8, "crop_height": 4,
+            "sample_border": false, "compensate": true}"#;
+        assert_eq!(film(all).unwrap(), FilmSpec { width: 8, height: 4 });
+        for (json, want) in [
+            (r#"{"type": "hdrfilm", "file_format": "png"}"#, "`file_format` must be one of openexr"),
+            (r#"{"type": "hdrfilm", "pixel_format": "bgr"}"#, "`pixel_format` must be one of"),
+            (r#"{"type": "hdrfilm", "width": 8, "height": 4, "crop_width": 4}"#, "crop windows are not supported by gonio yet: `crop_width` must be 8"),
+            (r#"{"type": "hdrfilm", "crop_offset_y": 2}"#, "`crop_offset_y` must be 0"),
+            (r#"{"type": "hdrfilm", "sample_border": true}"#, "`sample_border` = true is not supported"),
+        ] {
+            let e = film(json).unwrap_err().to_string();
+            assert!(e.contains(want), "{json}: {e}");
+        }
     }
 }
