@@ -19,6 +19,9 @@ pub struct XmlEnv {
     pub params: HashMap<String, String>,
     pub refs: HashMap<String, Props>,
     pub search_paths: Vec<PathBuf>,
+    /// A `<ref>` to an id not declared yet becomes a placeholder, resolved once the whole scene is read
+    /// ([`Props::resolve_refs`]), as Mitsuba 3 allows; otherwise it is an error at once.
+    pub forward_refs: bool,
     /// Bytes produced by `$name` substitution so far (checked against [`MAX_SUBSTITUTED_TOTAL`]).
     substituted: Cell<usize>,
 }
