@@ -31,7 +31,7 @@
 
 use crate::camera::PerspectiveCamera;
 use crate::error::{Error, Result};
-use crate::film::FilmSpec;
+use crate::film::{Filter, FilmSpec};
 use crate::geometry::sphere::Sphere;
 use crate::geometry::Shape;
 use crate::image::{read_image, Image};
@@ -156,7 +156,7 @@ pub fn preview_scene(material: Material, lighting: &Lighting, size: u32) -> Resu
         vec![None],
         lights,
         camera,
-        FilmSpec { width: size, height: size },
+        FilmSpec { width: size, height: size, filter: Filter::BOX },
         SamplerSpec { sample_count: 64, seed: 0 },
         IntegratorKind::Path { max_depth: -1, rr_depth: 5, hide_emitters: false },
         Vec::new(),

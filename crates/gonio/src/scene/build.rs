@@ -64,7 +64,7 @@ impl Scene {
         }
         let sensor = desc.sensor.as_ref().ok_or_else(|| Error::spec(&desc.source, "the scene has no <sensor>"))?;
         let film = match sensor.nested_of("film").as_slice() {
-            [] => FilmSpec { width: 768, height: 576 },
+            [] => FilmSpec::mitsuba_default(),
             [f] => FilmSpec::from_props(f, &mut warnings)?,
             [_, second, ..] => return Err(Error::spec(second.at(), "a sensor takes one <film>")),
         };
