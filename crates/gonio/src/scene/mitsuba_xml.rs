@@ -37,6 +37,8 @@ pub struct SceneDescription {
     pub emitters: Vec<Props>,
     /// Where the scene came from (for messages).
     pub source: String,
+    /// Things accepted but worth a note, found while reading (see [`XmlEnv::warnings`]).
+    pub warnings: Vec<String>,
 }
 
 /// Parse a scene file; `overrides` are `-D name=value` pairs that take precedence over `<default>`s.
@@ -96,6 +98,7 @@ impl Loader {
                 return Err(Error::spec(p.at(), format!("more than {MAX_PLUGINS} plugins in the scene once references are expanded")));
             }
         }
+        self.desc.warnings = self.env.warnings.take();
         Ok(self.desc)
     }
 
