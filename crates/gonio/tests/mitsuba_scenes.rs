@@ -51,7 +51,6 @@ const REFUSED: &[(&str, &str)] = &[
     ("d_projector", "emitter_projector_textured.xml:4:5: unsupported emitter `projector`"),
     ("d_aov", "integrator_aov.xml:4:2: unsupported integrator `aov`"),
     ("d_sss", "medium_homogeneous_sss.xml:14:5: unsupported element <medium> in <scene>"),
-    ("d_stratified", "sampler_stratified_16spp.xml:4:5: unsupported sampler `stratified`"),
     ("d_thinlens", "sensor_thinlens.xml:4:2: unsupported sensor `thinlens`"),
     ("d_cylinder", "shape_cylinder_twosided.xml:10:5: unsupported shape `cylinder`"),
     ("d_sdfgrid", "shape_sdfgrid.xml:8:5: unsupported shape `shapegroup`"),
