@@ -45,7 +45,6 @@ const REFUSED: &[(&str, &str)] = &[
     ("t_normalmap", "test_normalmap_path.xml:7:9: unknown BSDF type `normalmap`"),
     ("t_principled1", "test_texturedprincipled1_path.xml:5:9: unknown BSDF type `principled`"),
     ("t_instancing", "test_instancing_path.xml:41:5: unsupported shape `shapegroup`"),
-    ("t_orthographic", "test_orthographic_path.xml:12:5: unsupported sensor `orthographic`"),
     ("t_media_area", "test_homo_area_light_volpath.xml:8:5: unsupported element <medium> in <scene>"),
     ("t_various_shapes", "test_various_shapes_path.xml:57:5: unsupported shape `cylinder`"),
     ("d_projector", "emitter_projector_textured.xml:4:5: unsupported emitter `projector`"),

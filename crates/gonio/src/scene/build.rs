@@ -5,7 +5,7 @@
 use super::mitsuba_xml::SceneDescription;
 use super::{IntegratorKind, Material, SamplerSpec, Scene};
 use crate::bsdf::{Bsdf, Diffuse};
-use crate::camera::PerspectiveCamera;
+use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::film::FilmSpec;
 use crate::geometry::builtin_meshes::{cube, rectangle};
@@ -73,7 +73,7 @@ impl Scene {
             [s] => sampler_from_props(s, &mut warnings)?,
             [_, second, ..] => return Err(Error::spec(second.at(), "a sensor takes one <sampler>")),
         };
-        let camera = PerspectiveCamera::from_props(sensor, film.width, film.height)?;
+        let camera = Camera::from_props(sensor, film.width, film.height)?;
         sensor.finish()?;
         let integrator = match &desc.integrator {
             Some(p) => integrator_from_props(p)?,
