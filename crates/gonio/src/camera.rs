@@ -135,7 +135,8 @@ impl Camera {
     pub fn rays<R: Real>(&self, x: R, y: R) -> RayLanes<R> {
         let (one, two) = (R::splat(1.0), R::splat(2.0));
         if let Some(dir) = self.orthographic {
-            let near = V3::new((one - two * x) * R::splat(self.tan_half_x), (one - two * y) * R::splat(self.tan_half_y), R::splat(self.near));
+            let near =
+                V3::new((one - two * x) * R::splat(self.tan_half_x), (one - two * y) * R::splat(self.tan_half_y), R::splat(self.near));
             return RayLanes { o: self.to_world.point_lanes(near), d: V3::splat(dir), tmax: R::splat(self.far - self.near) };
         }
         let local = V3::new((one - two * x) * R::splat(self.tan_half_x), (one - two * y) * R::splat(self.tan_half_y), one);
@@ -194,8 +195,9 @@ mod tests {
     /// their rays where Mitsuba 3's `orthographic_projection` puts them, all rays parallel.
     #[test]
     fn orthographic_rays_start_on_the_scaled_near_plane() {
-        let to_world =
-            Transform::look_at(Vec3::new(5.0, 0.0, 3.0), Vec3::new(0.0, 0.0, 3.0), Vec3::Z).unwrap().then_after(Transform::scale(Vec3::new(1.5, 1.5, 1.0)).unwrap());
+        let to_world = Transform::look_at(Vec3::new(5.0, 0.0, 3.0), Vec3::new(0.0, 0.0, 3.0), Vec3::Z)
+            .unwrap()
+            .then_after(Transform::scale(Vec3::new(1.5, 1.5, 1.0)).unwrap());
         let cam = Camera::orthographic(to_world, 200, 100, 1.0, 1000.0).unwrap();
         // Camera +x is the image's left: world −y here (looking along −x with +z up); +y is world +z.
         for (s, want) in [

@@ -330,7 +330,10 @@ mod tests {
         for (json, want) in [
             (r#"{"type": "hdrfilm", "file_format": "png"}"#, "`file_format` must be one of openexr"),
             (r#"{"type": "hdrfilm", "pixel_format": "bgr"}"#, "`pixel_format` must be one of"),
-            (r#"{"type": "hdrfilm", "width": 8, "height": 4, "crop_width": 4}"#, "crop windows are not supported by gonio yet: `crop_width` must be 8"),
+            (
+                r#"{"type": "hdrfilm", "width": 8, "height": 4, "crop_width": 4}"#,
+                "crop windows are not supported by gonio yet: `crop_width` must be 8",
+            ),
             (r#"{"type": "hdrfilm", "crop_offset_y": 2}"#, "`crop_offset_y` must be 0"),
             (r#"{"type": "hdrfilm", "sample_border": true}"#, "`sample_border` = true is not supported"),
         ] {
@@ -344,7 +347,10 @@ mod tests {
     #[test]
     fn filters_match_mitsuba() {
         let g = Filter::gaussian(0.5);
-        assert_eq!((g.radius(), g.border(), Filter::tent(1.0).border(), Filter::tent(1.5).border(), Filter::BOX.border()), (2.0, 2, 1, 1, 0));
+        assert_eq!(
+            (g.radius(), g.border(), Filter::tent(1.0).border(), Filter::tent(1.5).border(), Filter::BOX.border()),
+            (2.0, 2, 1, 1, 0)
+        );
         assert_eq!(Filter::gaussian(1.5).border(), 6);
         // (x, Mitsuba's gaussian eval, tent radius 1, tent radius 1.5)
         for (x, gauss, tent1, tent15) in [

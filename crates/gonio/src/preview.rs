@@ -31,7 +31,7 @@
 
 use crate::camera::Camera;
 use crate::error::{Error, Result};
-use crate::film::{Filter, FilmSpec};
+use crate::film::{FilmSpec, Filter};
 use crate::geometry::sphere::Sphere;
 use crate::geometry::Shape;
 use crate::image::{read_image, Image};

@@ -153,7 +153,10 @@ fn standard_error(a: &[f32], b: &[f32], width: u32, height: u32) -> [f64; 3] {
 #[test]
 fn every_scene_loads_or_is_a_documented_refusal_and_means_match_mitsuba() {
     let Some(rows) = rows() else {
-        assert!(std::env::var_os("GONIO_SKIP_MISSING_DATA").is_some(), "{DATA}/results.tsv is missing (set GONIO_SKIP_MISSING_DATA to skip)");
+        assert!(
+            std::env::var_os("GONIO_SKIP_MISSING_DATA").is_some(),
+            "{DATA}/results.tsv is missing (set GONIO_SKIP_MISSING_DATA to skip)"
+        );
         eprintln!("skipped: {DATA}/results.tsv is missing");
         return;
     };

@@ -162,10 +162,9 @@ mod tests {
             assert!((s.direction_to_uv(local) - want).length() < 1e-5, "{local}: {}", s.direction_to_uv(local));
         }
         // A checkerboard over the cone: light reaching a point below the axis at u, v < ½ takes colour0.
-        let board = Texture::from_props(
-            &Props::from_json(r#"{"type": "checkerboard", "color0": [1, 0, 0], "color1": [0, 0, 1]}"#).unwrap(),
-        )
-        .unwrap();
+        let board =
+            Texture::from_props(&Props::from_json(r#"{"type": "checkerboard", "color0": [1, 0, 0], "color1": [0, 0, 1]}"#).unwrap())
+                .unwrap();
         let s = s.with_texture(board.clone());
         let p = Vec3::new(-0.2 * t, -0.2 * t, 1.0) * 2.0;
         let ls = s.sample_li(p, Vec3::ZERO).unwrap();

@@ -209,7 +209,10 @@ impl Loader {
                         "emitter" if props.plugin_type() == "area" && props.id().is_some() => {}
                         "emitter" => self.desc.emitters.push(props),
                         "sampler" | "film" | "rfilter" if props.id().is_none() => {
-                            return Err(Error::spec(at, format!("a top-level <{tag}> is used by a <ref id=\"…\"> in the sensor: give it an id")))
+                            return Err(Error::spec(
+                                at,
+                                format!("a top-level <{tag}> is used by a <ref id=\"…\"> in the sensor: give it an id"),
+                            ))
                         }
                         _ => {}
                     }
