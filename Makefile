@@ -1,5 +1,6 @@
 # gonio — the only entry points a newcomer needs.
-#   make demo   build, render scenes/demo.xml to out/demo.png, then prove every model's physics with `gonio check --all`
+#   make demo   build, render scenes/demo.xml to out/demo.png, then check three models' physics with `gonio check` (about a minute)
+#   make check-all  every example model of every plugin through the harness (`gonio check --all`, ~10 min on 2 cores)
 #   make test   build, then run the Rust tests, the Python tests (incl. the Mitsuba 3 cross-checks) and the lane code's tests in the portable build
 #   make bench  criterion benchmarks, and gonio vs Mitsuba 3 timings, errors and scaling tables
 #   make gallery  regenerate docs/gallery/*.png and docs/gallery/README.md (the lecture's figures, < 10 min on 2 cores)
@@ -20,7 +21,7 @@ CARGO  ?= cargo
 GONIO_CPU ?= native
 export RUSTFLAGS ?= -C target-cpu=$(GONIO_CPU)
 
-.PHONY: all build cli venv python demo test test-portable test-rust test-python bench gallery fit-table fuzz fmt lint clean
+.PHONY: all build cli venv python demo check-all test test-portable test-rust test-python bench gallery fit-table fuzz fmt lint clean
 
 all: build
 
@@ -32,8 +33,13 @@ cli:
 $(VPY):
 	$(PYTHON) -m venv $(VENV)
 
-# Re-run pip only when requirements-dev.txt changes (the stamp lives inside .venv).
+# Re-run pip only when requirements-dev.txt changes (the stamp lives inside .venv, touched only when every
+# install succeeded). A venv whose python or pip no longer runs (e.g. `pip install --upgrade pip` interrupted
+# halfway leaves pip unimportable) is made anew rather than failing on every `make` from then on.
 $(VENV)/.requirements-stamp: requirements-dev.txt | $(VPY)
+	@$(VPY) -m pip --version >/dev/null 2>&1 || { \
+		echo "make: $(VENV) is broken ($(VPY) -m pip does not run; an interrupted install?): making it anew"; \
+		rm -rf $(VENV) && $(PYTHON) -m venv $(VENV); }
 	$(VPY) -m pip install --quiet --upgrade pip
 	$(VPY) -m pip install --quiet -r requirements-dev.txt
 	touch $@
@@ -45,12 +51,20 @@ python: venv
 		$(VENV)/bin/maturin develop --release --quiet -m crates/gonio-py/Cargo.toml
 	$(VPY) -c "import gonio; print('gonio', gonio.__version__, 'for Python installed in $(VENV):', ', '.join(gonio.plugins()))"
 
+# The demo: one render and a real check of three models (each a chi-square of sample against pdf at 10⁶
+# samples, sample weights, reciprocity, energy, a NaN/Inf sweep), a couple of minutes in all after the build;
+# `make check-all` runs the same harness on every example model of every plugin.
+DEMO_MODELS := '{"type": "diffuse"}' '{"type": "roughconductor", "material": "Au", "alpha": 0.2}' '{"type": "dielectric"}'
+
 demo: build
 	@mkdir -p out
 	./target/release/gonio render scenes/demo.xml -o out/demo.png --spp 64
 	@echo "demo: rendered scenes/demo.xml (paper, rough gold, glass, Oren-Nayar moon, aluminium) to out/demo.png"
+	@for m in $(DEMO_MODELS); do echo "./target/release/gonio check '$$m'"; ./target/release/gonio check "$$m" || exit 1; done
+	@echo "demo: gonio check ran the verification harness (chi-square of sample against pdf, sample weights, reciprocity, energy conservation, NaN/Inf sweep) on three models; exit status 0 means every check passed. Every model of every plugin: make check-all"
+
+check-all: cli
 	./target/release/gonio check --all
-	@echo "demo: gonio check --all ran the verification harness (chi-square of sample against pdf, sample weights, reciprocity, energy conservation, NaN/Inf sweep) on every example model; exit status 0 means every check passed."
 
 test: build
 	$(CARGO) test --release -p gonio -p gonio-cli

@@ -19,6 +19,14 @@ def unit(n, upper=True):
     return w
 
 
+def test_namespace_holds_only_the_api():
+    """``import gonio`` leaves gonio's API in the namespace, not its helpers' modules and names (issue 29)."""
+    public = {name for name in dir(gonio) if not name.startswith("_")}
+    for helper in ("Any", "Mapping", "Optional", "Sequence", "Union", "annotations", "enum", "json"):
+        assert helper not in public, helper
+    assert set(gonio.__all__) - {"__version__"} <= public | {"plot"}
+
+
 def test_version_and_plugins():
     assert isinstance(gonio.__version__, str) and gonio.__version__.count(".") == 2
     assert {"diffuse", "conductor", "dielectric", "thindielectric", "blendbsdf", "twosided"} <= set(gonio.plugins())

@@ -1,4 +1,4 @@
-//! `perspective` — Mitsuba's pinhole camera.
+//! `perspective` — Mitsuba's pinhole camera — and `orthographic`.
 //!
 //! | parameter   | type      | default  | meaning                                                       |
 //! |-------------|-----------|----------|---------------------------------------------------------------|
@@ -8,6 +8,12 @@
 //! | `to_world`  | transform | identity | camera → world                                                |
 //! | `near_clip` | float     | 0.01     | rays start at this depth                                      |
 //! | `far_clip`  | float     | 10000    | and end at this one                                           |
+//! | `focus_distance` | float | 0     | accepted and ignored: Mitsuba 3's pinhole `perspective` reads it too (for `thinlens`-style scenes) and its image does not depend on it |
+//!
+//! `orthographic` takes `to_world`, `near_clip` and `far_clip`: as Mitsuba 3's (`orthographic_projection`),
+//! film position (sx, sy) starts its ray at (1 − 2 sx, (1 − 2 sy) / aspect, near_clip) in camera space (the
+//! image spans [−1, 1] across, so a `<scale>` in `to_world` sets the view's size) and every ray runs along
+//! `to_world · +z` (normalised), `far_clip − near_clip` long.
 //!
 //! In camera space the camera looks down +z with +y up and **+x to the left of the image** (Mitsuba's
 //! convention; `lookat`'s local x is up × direction). A film position (sx, sy) ∈ [0, 1]², (0, 0) the
@@ -21,17 +27,21 @@ use crate::math::Transform;
 use crate::props::Props;
 use glam::{Vec2, Vec3};
 
-/// A perspective camera.
+/// A perspective or orthographic camera.
 #[derive(Clone, Debug, PartialEq)]
-pub struct PerspectiveCamera {
+pub struct Camera {
     to_world: Transform,
+    /// Half the image's extent in camera space: on the plane z = 1 (perspective: tan of half the field of
+    /// view), or on the near plane (orthographic: 1 and 1 / aspect).
     tan_half_x: f32,
     tan_half_y: f32,
     near: f32,
     far: f32,
+    /// For an orthographic camera, the rays' world direction (`to_world · +z`, normalised).
+    orthographic: Option<Vec3>,
 }
 
-impl PerspectiveCamera {
+impl Camera {
     /// A camera for a film of `width × height` pixels with field of view `fov_deg` along `axis`.
     #[allow(clippy::too_many_arguments)] // one argument per plugin parameter, as in the table above
     pub fn new(to_world: Transform, fov_deg: f32, axis: &str, width: u32, height: u32, near: f32, far: f32, at: &str) -> Result<Self> {
@@ -63,13 +73,30 @@ impl PerspectiveCamera {
             }
             other => return Err(Error::spec(at, format!("`fov_axis` must be x, y, smaller, larger or diagonal, got `{other}`"))),
         };
-        Ok(PerspectiveCamera { to_world, tan_half_x, tan_half_y, near, far })
+        Ok(Camera { to_world, tan_half_x, tan_half_y, near, far, orthographic: None })
     }
 
-    /// Read `perspective` parameters (the film size comes from the nested film).
+    /// An orthographic camera for a film of `width × height` pixels (module docs); `None` when `to_world`
+    /// maps +z to nothing.
+    #[must_use]
+    pub fn orthographic(to_world: Transform, width: u32, height: u32, near: f32, far: f32) -> Option<Self> {
+        let dir = to_world.vector(Vec3::Z).try_normalize()?;
+        let aspect = width as f32 / height as f32;
+        Some(Camera { to_world, tan_half_x: 1.0, tan_half_y: 1.0 / aspect, near, far, orthographic: Some(dir) })
+    }
+
+    /// Read `perspective` or `orthographic` parameters (the film size comes from the nested film).
     pub fn from_props(p: &Props, width: u32, height: u32) -> Result<Self> {
+        if p.plugin_type() == "orthographic" {
+            let (near, far) = (p.float_positive("near_clip", 1e-2)?, p.float_positive("far_clip", 1e4)?);
+            if far <= near {
+                return Err(Error::spec(p.at_param("far_clip"), format!("`far_clip` ({far}) must exceed `near_clip` ({near})")));
+            }
+            return Camera::orthographic(p.transform("to_world")?, width, height, near, far)
+                .ok_or_else(|| Error::spec(p.at_param("to_world"), "`to_world` maps the viewing direction +z to zero"));
+        }
         if p.plugin_type() != "perspective" {
-            return Err(Error::spec(p.at(), format!("unsupported sensor `{}` (gonio has: perspective)", p.plugin_type())));
+            return Err(Error::spec(p.at(), format!("unsupported sensor `{}` (gonio has: perspective, orthographic)", p.plugin_type())));
         }
         let (fov, axis) = if p.has("fov") {
             if p.has("focal_length") {
@@ -84,12 +111,14 @@ impl PerspectiveCamera {
             let _ = p.string("fov_axis")?;
             ((36.0f32.hypot(24.0) / (2.0 * f)).atan().to_degrees() * 2.0, "diagonal".to_string())
         };
+        // A pinhole has everything in focus: Mitsuba's `perspective` accepts the parameter and ignores it.
+        let _ = p.float_in("focus_distance", 0.0, 0.0, f32::MAX)?;
         let near = p.float_positive("near_clip", 1e-2)?;
         let far = p.float_positive("far_clip", 1e4)?;
         if far <= near {
             return Err(Error::spec(p.at_param("far_clip"), format!("`far_clip` ({far}) must exceed `near_clip` ({near})")));
         }
-        PerspectiveCamera::new(p.transform("to_world")?, fov, &axis, width, height, near, far, p.at_param("fov_axis"))
+        Camera::new(p.transform("to_world")?, fov, &axis, width, height, near, far, p.at_param("fov_axis"))
     }
 
     /// The primary ray through film position `s` ∈ [0, 1]² (top-left origin).
@@ -105,6 +134,11 @@ impl PerspectiveCamera {
     #[must_use]
     pub fn rays<R: Real>(&self, x: R, y: R) -> RayLanes<R> {
         let (one, two) = (R::splat(1.0), R::splat(2.0));
+        if let Some(dir) = self.orthographic {
+            let near =
+                V3::new((one - two * x) * R::splat(self.tan_half_x), (one - two * y) * R::splat(self.tan_half_y), R::splat(self.near));
+            return RayLanes { o: self.to_world.point_lanes(near), d: V3::splat(dir), tmax: R::splat(self.far - self.near) };
+        }
         let local = V3::new((one - two * x) * R::splat(self.tan_half_x), (one - two * y) * R::splat(self.tan_half_y), one);
         let d = self.to_world.vector_lanes(local);
         let len = d.length();
@@ -120,13 +154,13 @@ mod tests {
     #[test]
     fn left_of_the_image_is_camera_plus_x() {
         let look = Transform::look_at(Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO, Vec3::Y).unwrap();
-        let cam = PerspectiveCamera::new(look, 90.0, "x", 2, 1, 1e-2, 1e4, "t").unwrap();
+        let cam = Camera::new(look, 90.0, "x", 2, 1, 1e-2, 1e4, "t").unwrap();
         // Looking down −z with +y up, the left edge of the image sees world −x, the top sees +y.
         let left = cam.ray(Vec2::new(0.0, 0.5));
         assert!(left.d.x < 0.0 && (left.d.x - left.d.z).abs() < 1e-5, "{:?}", left.d);
         let top = cam.ray(Vec2::new(0.5, 0.0));
         assert!(top.d.y > 0.0 && (top.d.y - 0.5 * -top.d.z).abs() < 1e-5, "{:?}", top.d);
-        assert!(PerspectiveCamera::new(look, 90.0, "z", 2, 1, 1e-2, 1e4, "t").is_err());
+        assert!(Camera::new(look, 90.0, "z", 2, 1, 1e-2, 1e4, "t").is_err());
     }
 
     /// `rays`, on one `f32` (`ray`) and in eight lanes, gives bit for bit the ray that glam's `Vec3` and
@@ -136,7 +170,7 @@ mod tests {
     fn rays_in_lanes_match() {
         use crate::math::simd::Float8;
         let look = Transform::look_at(Vec3::new(0.3, 2.0, 5.0), Vec3::new(0.0, 0.5, 0.0), Vec3::Y).unwrap();
-        let cam = PerspectiveCamera::new(look, 39.3, "x", 400, 160, 0.1, 1e3, "t").unwrap();
+        let cam = Camera::new(look, 39.3, "x", 400, 160, 0.1, 1e3, "t").unwrap();
         let mut rng = crate::sampling::Pcg32::new(4, 1);
         let bits = |v: Vec3| v.to_array().map(f32::to_bits);
         for _ in 0..100 {
@@ -157,12 +191,51 @@ mod tests {
         }
     }
 
+    /// An orthographic camera scaled by 1.5 and looking along −x from (5, 0, 3): the image's corners start
+    /// their rays where Mitsuba 3's `orthographic_projection` puts them, all rays parallel.
+    #[test]
+    fn orthographic_rays_start_on_the_scaled_near_plane() {
+        let to_world = Transform::look_at(Vec3::new(5.0, 0.0, 3.0), Vec3::new(0.0, 0.0, 3.0), Vec3::Z)
+            .unwrap()
+            .then_after(Transform::scale(Vec3::new(1.5, 1.5, 1.0)).unwrap());
+        let cam = Camera::orthographic(to_world, 200, 100, 1.0, 1000.0).unwrap();
+        // Camera +x is the image's left: world −y here (looking along −x with +z up); +y is world +z.
+        for (s, want) in [
+            (Vec2::new(0.0, 0.0), Vec3::new(4.0, -1.5, 3.75)),
+            (Vec2::new(1.0, 1.0), Vec3::new(4.0, 1.5, 2.25)),
+            (Vec2::new(0.5, 0.5), Vec3::new(4.0, 0.0, 3.0)),
+        ] {
+            let r = cam.ray(s);
+            assert!((r.o - want).length() < 1e-5 && (r.d - Vec3::NEG_X).length() < 1e-6, "{s}: {:?} {:?}", r.o, r.d);
+            assert!((r.tmax - 999.0).abs() < 1e-3);
+        }
+        let p = Props::from_json(r#"{"type": "orthographic", "near_clip": 1, "far_clip": 1000}"#).unwrap();
+        assert_eq!(Camera::from_props(&p, 200, 100).unwrap(), Camera::orthographic(Transform::IDENTITY, 200, 100, 1.0, 1000.0).unwrap());
+        p.finish().unwrap();
+        let p = Props::from_json(r#"{"type": "orthographic", "fov": 30}"#).unwrap();
+        let _ = Camera::from_props(&p, 4, 4).unwrap();
+        assert!(p.finish().unwrap_err().to_string().contains("unknown parameter `fov` for `orthographic`"));
+    }
+
+    /// Mitsuba's pinhole accepts `focus_distance` (scenes written for `thinlens` give it); the camera is
+    /// the same with it as without.
+    #[test]
+    fn focus_distance_is_accepted_and_changes_nothing() {
+        let plain = Props::from_json(r#"{"type": "perspective", "fov": 40}"#).unwrap();
+        let focused = Props::from_json(r#"{"type": "perspective", "fov": 40, "focus_distance": 6.0}"#).unwrap();
+        let (a, b) = (Camera::from_props(&plain, 64, 48).unwrap(), Camera::from_props(&focused, 64, 48).unwrap());
+        focused.finish().unwrap();
+        assert_eq!(a, b);
+        let negative = Props::from_json(r#"{"type": "perspective", "focus_distance": -1}"#).unwrap();
+        assert!(Camera::from_props(&negative, 4, 4).unwrap_err().to_string().contains("focus_distance"));
+    }
+
     /// Horizontal fields of view Mitsuba 3.9.1 reports (`x_fov`) for these sensors.
     #[test]
     fn fields_of_view_match_mitsuba() {
         let x_fov = |xml: &str, w: u32, h: u32| {
             let p = Props::from_json(xml).unwrap();
-            let c = PerspectiveCamera::from_props(&p, w, h).unwrap();
+            let c = Camera::from_props(&p, w, h).unwrap();
             2.0 * c.tan_half_x.atan().to_degrees()
         };
         for (xml, w, h, want) in [

@@ -29,9 +29,9 @@
 //! assert_eq!((scene.film.width, scene.film.height), (32, 32));
 //! ```
 
-use crate::camera::PerspectiveCamera;
+use crate::camera::Camera;
 use crate::error::{Error, Result};
-use crate::film::FilmSpec;
+use crate::film::{FilmSpec, Filter};
 use crate::geometry::sphere::Sphere;
 use crate::geometry::Shape;
 use crate::image::{read_image, Image};
@@ -149,14 +149,14 @@ pub fn preview_scene(material: Material, lighting: &Lighting, size: u32) -> Resu
         .ok_or_else(|| Error::spec("preview", "cannot place the camera"))?;
     // The sphere subtends a half-angle asin(1/d); widen the view so that it fills FILL of the frame.
     let fov = 2.0 * ((1.0 / CAMERA_DISTANCE).asin().tan() / FILL).atan().to_degrees();
-    let camera = PerspectiveCamera::new(to_world, fov, "x", size, size, 0.01, 1.0e4, "preview")?;
+    let camera = Camera::new(to_world, fov, "x", size, size, 0.01, 1.0e4, "preview")?;
     Ok(Scene::assemble(
         vec![Shape::Sphere(sphere)],
         vec![material],
         vec![None],
         lights,
         camera,
-        FilmSpec { width: size, height: size },
+        FilmSpec { width: size, height: size, filter: Filter::BOX },
         SamplerSpec { sample_count: 64, seed: 0 },
         IntegratorKind::Path { max_depth: -1, rr_depth: 5, hide_emitters: false },
         Vec::new(),

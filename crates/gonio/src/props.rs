@@ -282,6 +282,15 @@ impl Props {
         self.entries.iter().find(|e| e.name == name).map_or(&self.at, |e| &e.at)
     }
 
+    /// The nested plugin given as parameter `name` (e.g. a spot light's `texture`), or `None` when absent.
+    pub fn plugin(&self, name: &'static str) -> Result<Option<&Props>> {
+        let Some(e) = self.entry(name) else { return Ok(None) };
+        match &e.value {
+            Value::Nested(p) => Ok(Some(p)),
+            _ => Err(self.wrong(e, "a nested plugin")),
+        }
+    }
+
     /// Nested plugins of one class (`"emitter"`, `"bsdf"`, …), marking them as read.
     #[must_use]
     pub fn nested_of(&self, class: &str) -> Vec<&Props> {
@@ -392,6 +401,37 @@ impl Props {
         Ok(())
     }
 
+    /// Replace every `<ref>` to a plugin declared after it (read with [`XmlEnv::forward_refs`]) by the
+    /// plugin `target(id, at)` returns (fully resolved already, so its size is known before it is copied).
+    /// A tree past [`MAX_PLUGINS`] is an error at the `<ref>`.
+    pub fn resolve_refs(&mut self, target: &mut dyn FnMut(&str, &str) -> Result<Props>) -> Result<()> {
+        for i in 0..self.entries.len() {
+            let e = &mut self.entries[i];
+            let Value::Nested(p) = &mut e.value else { continue };
+            if p.class == REF_PLACEHOLDER {
+                let id = p.id.clone().unwrap_or_default();
+                let found = target(&id, &e.at)?;
+                if self.plugins + found.plugins > MAX_PLUGINS {
+                    return Err(Error::spec(
+                        &e.at,
+                        format!("<ref id=\"{id}\">: more than {MAX_PLUGINS} plugins in one tree once references are expanded"),
+                    ));
+                }
+                *p = found;
+            } else {
+                p.resolve_refs(target)?;
+            }
+            self.plugins = 1 + self.entries.iter().map(|e| if let Value::Nested(p) = &e.value { p.plugins } else { 0 }).sum::<usize>();
+        }
+        Ok(())
+    }
+
+    /// Whether this tree holds a `<ref>` not resolved yet.
+    #[must_use]
+    pub fn has_forward_refs(&self) -> bool {
+        self.entries.iter().any(|e| matches!(&e.value, Value::Nested(p) if p.class == REF_PLACEHOLDER || p.has_forward_refs()))
+    }
+
     // ---------------------------------------------------------------- JSON
 
     /// Parse a JSON object in Mitsuba's dictionary form.
@@ -500,11 +540,19 @@ impl Props {
             }
             if ctag == "ref" {
                 let id = env.required(child, "id", source)?;
-                let target = env
-                    .refs
-                    .get(&id)
-                    .ok_or_else(|| Error::spec(&cat, format!("<ref id=\"{id}\">: no plugin with this id was declared before")))?;
                 let key = name.unwrap_or_else(&mut auto_name);
+                let Some(target) = env.refs.get(&id) else {
+                    if !env.forward_refs {
+                        return Err(Error::spec(&cat, format!("<ref id=\"{id}\">: no plugin with this id was declared before")));
+                    }
+                    // Declared later in the scene (Mitsuba 3 resolves ids once the whole file is read):
+                    // a placeholder that [`Props::resolve_refs`] replaces.
+                    let mut placeholder = Props::new(REF_PLACEHOLDER, &cat);
+                    placeholder.class = REF_PLACEHOLDER.into();
+                    placeholder.id = Some(id);
+                    props.set_checked(&key, Value::Nested(placeholder), &cat)?;
+                    continue;
+                };
                 if props.plugins + target.plugins > MAX_PLUGINS {
                     return Err(Error::spec(
                         &cat,
@@ -557,6 +605,9 @@ impl Props {
         Ok(props)
     }
 }
+
+/// The class and type of a `<ref>` to a plugin not declared yet (see [`Props::resolve_refs`]).
+const REF_PLACEHOLDER: &str = "ref";
 
 /// Elements that describe a plugin (and may nest).
 const PLUGIN_TAGS: &[&str] =

@@ -1,7 +1,12 @@
 //! The render loop: passes of a few samples per pixel over 16×16 tiles on rayon's threads.
 //!
 //! Deterministic for a seed whatever the number of threads: sample `k` of pixel `i` draws from its own PCG32
-//! stream ([`integrator::start`]), and every pixel sums its samples in order. Cancellation (the
+//! stream ([`integrator::start`]), every tile sums its samples in order, and the tiles' sums are added to
+//! the film in tile order.
+//!
+//! With a reconstruction filter wider than the box ([`crate::film::Filter`]), a tile splats its samples into
+//! its pixels and a border of [`crate::film::Filter::border`] pixels around them, which overlaps the
+//! neighbouring tiles and is added with them. Cancellation (the
 //! `cancel` flag, e.g. set by Ctrl-C) is checked between tiles; the pass in flight is dropped, so the image
 //! holds exactly `spp_done` samples in every pixel.
 
@@ -36,7 +41,9 @@ pub struct RenderOutput {
 pub fn render(scene: &Scene, spp: u32, seed: u64, cancel: &AtomicBool, progress: &(dyn Fn(u64) + Sync)) -> RenderOutput {
     let start = Instant::now();
     let (w, h) = (scene.film.width, scene.film.height);
-    let mut film = Film::new(w, h);
+    let filter = &scene.film.filter;
+    let border = filter.border();
+    let mut film = if filter.is_box() { Film::new(w, h) } else { Film::weighted(w, h) };
     let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE)).flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE))).collect();
     let nonfinite = AtomicU64::new(0);
     let done = AtomicU64::new(0);
@@ -46,14 +53,14 @@ pub fn render(scene: &Scene, spp: u32, seed: u64, cancel: &AtomicBool, progress:
     while spp_done < spp && !cancel.load(Ordering::Relaxed) {
         let n = pass.min(spp - spp_done);
         let first = spp_done;
-        let results: Vec<Option<Vec<[f64; 3]>>> = tiles
+        let results: Vec<Option<Film>> = tiles
             .par_iter()
             .map(|&(x0, y0)| {
                 if cancel.load(Ordering::Relaxed) {
                     return None;
                 }
                 let (tw, th) = (TILE.min(w - x0), TILE.min(h - y0));
-                let mut tile = Film::new(tw, th);
+                let mut tile = if filter.is_box() { Film::new(tw, th) } else { Film::weighted(tw + 2 * border, th + 2 * border) };
                 let mut bad = 0;
                 // The tile's camera samples, pixel by pixel and sample by sample within a pixel; the integrator
                 // may trace them in any order (several at once), and the film sums them in this one.
@@ -68,9 +75,25 @@ pub fn render(scene: &Scene, spp: u32, seed: u64, cancel: &AtomicBool, progress:
                 let mut radiance = vec![Rgb::ZERO; samples.len()];
                 integrator::radiance(scene, seed, &samples, &mut radiance);
                 // Pixel by pixel, its `n` samples in order (the tile's pixels are row-major, as `samples`).
-                for (pixel, ls) in radiance.chunks_exact(n as usize).enumerate() {
-                    for &l in ls {
-                        if !tile.add(pixel, l) {
+                if filter.is_box() {
+                    for (pixel, ls) in radiance.chunks_exact(n as usize).enumerate() {
+                        for &l in ls {
+                            if !tile.add(pixel, l) {
+                                bad += 1;
+                            }
+                        }
+                    }
+                } else {
+                    // Each sample into the (2b + 1)² pixels around its own, b = the border.
+                    let taps = 2 * border as usize + 1;
+                    let (mut wx, mut wy) = (vec![0.0; taps], vec![0.0; taps]);
+                    for (s, &l) in samples.iter().zip(&radiance) {
+                        let u = integrator::pixel_offset(scene, seed, *s);
+                        filter.weights(u.x, &mut wx);
+                        filter.weights(u.y, &mut wy);
+                        // The tile's pixel (x − x0, y − y0) sits at (x − x0 + b, y − y0 + b) of its buffer;
+                        // the taps start b before it.
+                        if !tile.splat(s.x - x0, s.y - y0, &wx, &wy, l) {
                             bad += 1;
                         }
                     }
@@ -78,14 +101,14 @@ pub fn render(scene: &Scene, spp: u32, seed: u64, cancel: &AtomicBool, progress:
                 nonfinite.fetch_add(bad, Ordering::Relaxed);
                 let total = done.fetch_add(u64::from(tw * th * n), Ordering::Relaxed) + u64::from(tw * th * n);
                 progress(total);
-                Some(tile.into_sums())
+                Some(tile)
             })
             .collect();
         if results.iter().any(Option::is_none) {
             break;
         }
-        for (&(x0, y0), sums) in tiles.iter().zip(results.into_iter().flatten()) {
-            film.add_tile(x0, y0, TILE.min(w - x0), &sums);
+        for (&(x0, y0), tile) in tiles.iter().zip(results.into_iter().flatten()) {
+            film.add_tile(i64::from(x0) - i64::from(border), i64::from(y0) - i64::from(border), &tile);
         }
         spp_done += n;
         pass = (pass * 2).min(16);

@@ -19,6 +19,11 @@ pub struct XmlEnv {
     pub params: HashMap<String, String>,
     pub refs: HashMap<String, Props>,
     pub search_paths: Vec<PathBuf>,
+    /// A `<ref>` to an id not declared yet becomes a placeholder, resolved once the whole scene is read
+    /// ([`Props::resolve_refs`]), as Mitsuba 3 allows; otherwise it is an error at once.
+    pub forward_refs: bool,
+    /// Things accepted but worth a note (e.g. a `<rotate>` axis that is not of unit length).
+    pub warnings: std::cell::RefCell<Vec<String>>,
     /// Bytes produced by `$name` substitution so far (checked against [`MAX_SUBSTITUTED_TOTAL`]).
     substituted: Cell<usize>,
 }
@@ -341,6 +346,26 @@ pub fn parse_spectrum(node: roxmltree::Node, env: &XmlEnv, source: &XmlSource, w
     Ok(reduce(&wavelengths, &values))
 }
 
+/// Mitsuba 3's `<rotate>` (`Transform4f::rotate`): M = cos θ I + (1 − cos θ) a aᵀ + sin θ [a]×, with the
+/// axis `a` *as given*. For a unit axis that is the rotation by θ about it (Rodrigues' formula); Mitsuba 3
+/// does not normalise (Mitsuba 0.6 did), so a longer axis also stretches: 3.9.1 loads `<rotate x="0" y="1"
+/// z="1" angle="30"/>` as the rows (0.866, −0.5, 0.5), (0.5, 1, 0.134), (−0.5, 0.134, 1), and gonio does
+/// the same so that such a file renders as in Mitsuba 3. `None` when the matrix is singular.
+#[must_use]
+pub fn mitsuba_rotate(axis: Vec3, angle_deg: f32) -> Option<Transform> {
+    let a = axis.as_dvec3();
+    let (sin, cos) = f64::from(angle_deg).to_radians().sin_cos();
+    let c = 1.0 - cos;
+    #[rustfmt::skip]
+    let rows = [
+        cos + c * a.x * a.x,       c * a.x * a.y - sin * a.z, c * a.x * a.z + sin * a.y, 0.0,
+        c * a.y * a.x + sin * a.z, cos + c * a.y * a.y,       c * a.y * a.z - sin * a.x, 0.0,
+        c * a.z * a.x - sin * a.y, c * a.z * a.y + sin * a.x, cos + c * a.z * a.z,       0.0,
+        0.0,                       0.0,                       0.0,                       1.0,
+    ];
+    Transform::from_rows(&rows)
+}
+
 /// A `<transform>` element: its operations in document order, each left-multiplying the result so far
 /// (Mitsuba's order: the first operation is applied to the object first).
 pub fn parse_transform(node: roxmltree::Node, env: &XmlEnv, source: &XmlSource) -> Result<Transform> {
@@ -356,7 +381,17 @@ pub fn parse_transform(node: roxmltree::Node, env: &XmlEnv, source: &XmlSource) 
                 let axis = parse_vector(op, env, source, 0.0)?;
                 let angle = env.required(op, "angle", source)?;
                 let angle: f32 = angle.trim().parse().map_err(|_| bad(&format!("`angle` must be a number of degrees, got \"{angle}\"")))?;
-                Transform::rotate(axis, angle).ok_or_else(|| bad("the rotation axis is zero (give x, y and/or z)"))?
+                if axis == Vec3::ZERO {
+                    return Err(bad("the rotation axis is zero (give x, y and/or z)"));
+                }
+                if (axis.length() - 1.0).abs() > 1e-4 {
+                    env.warnings.borrow_mut().push(format!(
+                        "{at}: <rotate> axis ({}, {}, {}) is not of unit length: as in Mitsuba 3, the matrix is built from it as \
+                         given, which rotates and stretches (normalise the axis for a pure rotation)",
+                        axis.x, axis.y, axis.z
+                    ));
+                }
+                mitsuba_rotate(axis, angle).ok_or_else(|| bad("the transform is singular"))?
             }
             "matrix" => {
                 let v = env.required(op, "value", source)?;
@@ -435,6 +470,29 @@ mod tests {
         let doc = roxmltree::Document::parse("<transform><matrix value=\"1 0 0 5  0 1 0 6  0 0 1 7  0 0 0 1\"/></transform>").unwrap();
         let t = parse_transform(first(&doc), &XmlEnv::default(), &XmlSource::new("t.xml", doc.input_text())).unwrap();
         assert!((t.point(Vec3::ZERO) - Vec3::new(5.0, 6.0, 7.0)).length() < 1e-6);
+    }
+
+    /// `<rotate>` as Mitsuba 3.9.1 loads it: a unit axis gives the rotation gonio's `Transform::rotate`
+    /// gives; the axis (0, 1, 1) gives Mitsuba's unnormalised matrix (printed by `mi.traverse`), with a warning.
+    #[test]
+    fn rotate_uses_the_axis_as_given_like_mitsuba() {
+        let unit = mitsuba_rotate(Vec3::new(0.0, 0.6, 0.8), 37.0).unwrap();
+        let glam_rotation = Transform::rotate(Vec3::new(0.0, 0.6, 0.8), 37.0).unwrap();
+        for p in [Vec3::X, Vec3::Y, Vec3::new(0.3, -2.0, 1.0)] {
+            assert!((unit.point(p) - glam_rotation.point(p)).length() < 1e-5, "{p}");
+        }
+        let doc = roxmltree::Document::parse("<transform>\n<rotate x=\"0\" y=\"1\" z=\"1\" angle=\"30\"/></transform>").unwrap();
+        let env = XmlEnv::default();
+        let t = parse_transform(first(&doc), &env, &XmlSource::new("t.xml", doc.input_text())).unwrap();
+        let rows = [[0.866_025, -0.5, 0.5], [0.5, 1.0, 0.133_975], [-0.5, 0.133_975, 1.0]];
+        for (j, col) in [Vec3::X, Vec3::Y, Vec3::Z].into_iter().enumerate() {
+            let got = t.vector(col);
+            for i in 0..3 {
+                assert!((got[i] - rows[i][j]).abs() < 1e-5, "row {i} col {j}: {}", got[i]);
+            }
+        }
+        let warnings = env.warnings.borrow();
+        assert!(warnings.len() == 1 && warnings[0].starts_with("t.xml:2:1: <rotate> axis (0, 1, 1) is not of unit length"), "{warnings:?}");
     }
 
     #[test]

@@ -464,3 +464,52 @@ fn anisotropic_sphere_highlight_follows_mitsubas_tangent() {
         }
     }
 }
+
+/// A reconstruction filter blurs an edge as it should: the left half of the view is an emitter of radiance
+/// 1 (noiseless: every sample sees 1 or 0), so a pixel column at distance δ from the edge develops to the
+/// lit share of the filter's weight, ∫_lit w(x) dx / ∫ w(x) dx, computed here by quadrature from the
+/// filter itself. The box filter leaves the edge sharp.
+#[test]
+fn filters_blur_an_edge_by_their_weights() {
+    for (rfilter, filter) in [
+        (r#"<rfilter type="gaussian"/>"#, gonio::film::Filter::gaussian(0.5)),
+        ("", gonio::film::Filter::gaussian(0.5)), // Mitsuba's default
+        (r#"<rfilter type="tent"><float name="radius" value="1.5"/></rfilter>"#, gonio::film::Filter::tent(1.5)),
+        (r#"<rfilter type="box"/>"#, gonio::film::Filter::BOX),
+    ] {
+        let (w, h) = (16u32, 8u32);
+        let s = scene(&format!(
+            r#"<scene version="3.0.0"><integrator type="direct"/>
+            <sensor type="perspective"><float name="fov" value="30"/>
+                <transform name="to_world"><lookat origin="0, 0, 5" target="0, 0, 0" up="0, 1, 0"/></transform>
+                <sampler type="independent"><integer name="sample_count" value="256"/></sampler>
+                <film type="hdrfilm"><integer name="width" value="{w}"/><integer name="height" value="{h}"/>{rfilter}</film></sensor>
+            <shape type="rectangle"><transform name="to_world"><scale value="100"/><translate x="-100"/></transform>
+                <emitter type="area"><rgb name="radiance" value="1"/></emitter></shape></scene>"#
+        ));
+        assert_eq!(s.film.filter, filter, "{rfilter}");
+        let img = run(&s);
+        let column = |c: u32| (0..h).map(|y| f64::from(img.data[3 * (y * w + c) as usize])).sum::<f64>() / f64::from(h);
+        // Camera +x is the image's left; world −x is lit, which is the image's right half here.
+        let lit_right = column(w - 1) > 0.5;
+        for c in 0..w {
+            // Distance of the column's centre from the edge (the image's centre line), positive on the lit side.
+            let delta = (f64::from(c) + 0.5 - f64::from(w) / 2.0) * if lit_right { 1.0 } else { -1.0 };
+            // The lit share of the filter's weight around this centre: samples at x lit where x > 0 (edge
+            // at 0), weighted by w(centre − x).
+            let (mut lit, mut all) = (0.0, 0.0);
+            let r = f64::from(filter.radius());
+            let n = 4000;
+            for i in 0..n {
+                let x = delta - r + 2.0 * r * (f64::from(i) + 0.5) / f64::from(n);
+                let wgt = f64::from(filter.eval((delta - x) as f32));
+                all += wgt;
+                if x > 0.0 {
+                    lit += wgt;
+                }
+            }
+            let want = lit / all;
+            assert!((column(c) - want).abs() < 0.02, "{rfilter}: column {c}: {} vs {want}", column(c));
+        }
+    }
+}

@@ -26,9 +26,11 @@ Example
 
 from __future__ import annotations
 
-import enum
-import json
-from typing import Any, Mapping, Optional, Sequence, Union
+# The helpers below are imported under private names: ``import gonio`` leaves only gonio's API in the
+# package's namespace (``dir(gonio)``), not ``enum``, ``json`` or typing's names.
+import enum as _enum
+import json as _json
+from typing import Any as _Any, Mapping as _Mapping, Optional as _Optional, Sequence as _Sequence, Union as _Union
 
 from . import _gonio, verify
 from ._gonio import (
@@ -78,7 +80,7 @@ __all__ = [
 ]
 
 
-class BsdfFlags(enum.IntFlag):
+class BsdfFlags(_enum.IntFlag):
     """The lobes of a model (``Bsdf.flags``) or of one sample (``BsdfSample.flags``)."""
 
     NONE = 0
@@ -89,7 +91,7 @@ class BsdfFlags(enum.IntFlag):
     DELTA = _gonio.FLAG_DELTA
 
 
-Spec = Union[str, bytes, Mapping[str, Any]]
+Spec = _Union[str, bytes, _Mapping[str, _Any]]
 
 
 def load_bsdf(spec: Spec, *, source: str = "<string>") -> Bsdf:
@@ -109,9 +111,9 @@ def load_bsdf(spec: Spec, *, source: str = "<string>") -> Bsdf:
     """
     if isinstance(spec, bytes):
         spec = spec.decode("utf-8")
-    if isinstance(spec, Mapping):
+    if isinstance(spec, _Mapping):
         try:
-            text = json.dumps(spec, default=_to_json)
+            text = _json.dumps(spec, default=_to_json)
         except (TypeError, ValueError) as e:
             raise SpecError(f"$: the description cannot be written as JSON: {e}") from None
         return _gonio.from_json(text)
@@ -122,7 +124,7 @@ def load_bsdf(spec: Spec, *, source: str = "<string>") -> Bsdf:
     raise TypeError(f"load_bsdf expects a dict, a JSON string or an XML string, got {type(spec).__name__}")
 
 
-def _to_json(value: Any) -> Any:
+def _to_json(value: _Any) -> _Any:
     """Let numpy values and tuples inside a dict spec be written as JSON numbers and lists."""
     if hasattr(value, "tolist"):
         return value.tolist()
@@ -134,7 +136,7 @@ def _to_json(value: Any) -> Any:
 # ---------------------------------------------------------------------------------------------------------
 # Plot data (gonio::plot, the numbers `gonio plot` draws) and gonio.plot (matplotlib, optional).
 
-ModelLike = Union[Bsdf, str, bytes, Mapping[str, Any]]
+ModelLike = _Union[Bsdf, str, bytes, _Mapping[str, _Any]]
 
 
 def _as_bsdf(model: ModelLike) -> Bsdf:
@@ -185,8 +187,8 @@ def albedo_data(bsdf: ModelLike, *, angles: int = 30, samples: int = 16_384, see
     return _gonio.albedo_data(_as_bsdf(bsdf), angles=angles, samples=samples, seed=seed)
 
 
-def plot(bsdfs: Any, kind: str = "polar", theta_o: Optional[float] = None, *, log: bool = False, channel: str = "lum",
-         labels: Optional[Sequence[str]] = None, phi_d: float = 90.0, angles: int = 30, samples: int = 16_384) -> Any:
+def plot(bsdfs: _Any, kind: str = "polar", theta_o: _Optional[float] = None, *, log: bool = False, channel: str = "lum",
+         labels: _Optional[_Sequence[str]] = None, phi_d: float = 90.0, angles: int = 30, samples: int = 16_384) -> _Any:
     """Draw one or more models with matplotlib, from the same numbers as ``gonio plot``; returns the figure.
 
     ``bsdfs`` is one model or a list (``Bsdf`` objects or anything ``load_bsdf`` accepts); ``kind`` is
@@ -205,3 +207,7 @@ def plot(bsdfs: Any, kind: str = "polar", theta_o: Optional[float] = None, *, lo
     except ImportError as e:  # matplotlib (or one of its parts) is missing
         raise ImportError(f"gonio.plot needs matplotlib, which could not be imported ({e}); install it with `pip install matplotlib`") from e
     return _plot.plot(bsdfs, kind, theta_o, log=log, channel=channel, labels=labels, phi_d=phi_d, angles=angles, samples=samples)
+
+
+# `from __future__ import annotations` binds the name `annotations` here; it is not part of gonio's API.
+del annotations

@@ -37,14 +37,30 @@ pub(crate) fn mix(seed: u64, sample: u64) -> u64 {
 }
 
 /// The start of a camera sample's path: its own PCG32 stream, `Pcg32::new(mix(seed, k), pixel index)`, and
-/// the camera ray through a uniformly jittered point of its pixel (the box filter), drawn from that stream.
+/// the camera ray through a uniformly jittered point of its pixel, drawn from that stream (the film then
+/// weights the sample by its reconstruction filter).
 #[inline]
 #[must_use]
 pub fn start(scene: &Scene, seed: u64, s: CameraSample) -> (Ray, Pcg32) {
-    let mut rng = Pcg32::new(mix(seed, u64::from(s.k)), pixel_index(scene, s));
-    let (ux, uy) = (rng.next_f32(), rng.next_f32());
-    let (x, y) = film_point(scene, s.x as f32, s.y as f32, ux, uy);
+    let (offset, rng) = stream_and_offset(scene, seed, s);
+    let (x, y) = film_point(scene, s.x as f32, s.y as f32, offset.x, offset.y);
     (scene.camera.ray(glam::Vec2::new(x, y)), rng)
+}
+
+/// Where in its pixel camera sample `s` lies: (ux, uy) ∈ [0, 1)², the first two numbers of its stream
+/// (as [`start`] draws them), for the film to splat it with its reconstruction filter.
+#[inline]
+#[must_use]
+pub fn pixel_offset(scene: &Scene, seed: u64, s: CameraSample) -> glam::Vec2 {
+    stream_and_offset(scene, seed, s).0
+}
+
+/// A camera sample's generator and the pixel offset drawn first from it.
+#[inline(always)]
+fn stream_and_offset(scene: &Scene, seed: u64, s: CameraSample) -> (glam::Vec2, Pcg32) {
+    let mut rng = Pcg32::new(mix(seed, u64::from(s.k)), pixel_index(scene, s));
+    let offset = glam::Vec2::new(rng.next_f32(), rng.next_f32());
+    (offset, rng)
 }
 
 /// The stream of a camera sample's generator: its pixel's row-major index.

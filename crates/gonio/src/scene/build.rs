@@ -5,7 +5,7 @@
 use super::mitsuba_xml::SceneDescription;
 use super::{IntegratorKind, Material, SamplerSpec, Scene};
 use crate::bsdf::{Bsdf, Diffuse};
-use crate::camera::PerspectiveCamera;
+use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::film::FilmSpec;
 use crate::geometry::builtin_meshes::{cube, rectangle};
@@ -22,7 +22,7 @@ const SHAPES: &str = "sphere, rectangle, cube, disk, obj, ply, serialized";
 impl Scene {
     /// Build every plugin of a parsed scene.
     pub fn build(desc: SceneDescription) -> Result<Scene> {
-        let mut warnings = Vec::new();
+        let mut warnings = desc.warnings.clone();
         let mut shapes = Vec::new();
         let mut materials = Vec::new();
         let mut shape_lights = Vec::new();
@@ -64,21 +64,35 @@ impl Scene {
         }
         let sensor = desc.sensor.as_ref().ok_or_else(|| Error::spec(&desc.source, "the scene has no <sensor>"))?;
         let film = match sensor.nested_of("film").as_slice() {
-            [] => FilmSpec { width: 768, height: 576 },
+            [] => FilmSpec::mitsuba_default(),
             [f] => FilmSpec::from_props(f, &mut warnings)?,
             [_, second, ..] => return Err(Error::spec(second.at(), "a sensor takes one <film>")),
         };
         let sampler = match sensor.nested_of("sampler").as_slice() {
             [] => SamplerSpec { sample_count: 4, seed: 0 },
-            [s] => sampler_from_props(s)?,
+            [s] => sampler_from_props(s, &mut warnings)?,
             [_, second, ..] => return Err(Error::spec(second.at(), "a sensor takes one <sampler>")),
         };
-        let camera = PerspectiveCamera::from_props(sensor, film.width, film.height)?;
+        let camera = Camera::from_props(sensor, film.width, film.height)?;
         sensor.finish()?;
         let integrator = match &desc.integrator {
             Some(p) => integrator_from_props(p)?,
             None => IntegratorKind::Path { max_depth: -1, rr_depth: 5, hide_emitters: false },
         };
+        if let (IntegratorKind::Direct { emitter_samples: n @ 2.., .. }, Some(p)) = (integrator, &desc.integrator) {
+            if lights.iter().any(Light::is_delta) {
+                // Mitsuba 3's `direct` gives a delta light's sample the MIS weight 1 instead of 1/n
+                // (`src/integrators/direct.cpp`: `select(ds.delta, 1, mis_weight(…) * m_weight_lum)`), so
+                // with n emitter samples point, spot and directional lights count n times (3.9.1 renders
+                // `scenes/hello.xml` 4.0× brighter with emitter_samples = 4 than with 1). gonio averages the
+                // n samples, the estimate the file asks for.
+                warnings.push(format!(
+                    "{}: `direct` with emitter_samples = {n} and a point, spot or directional light: Mitsuba 3 counts each of \
+                     that light's samples at full weight ({n}× brighter); gonio averages them",
+                    p.at()
+                ));
+            }
+        }
         Ok(Scene::assemble(shapes, materials, shape_lights, lights, camera, film, sampler, integrator, warnings))
     }
 }
@@ -154,14 +168,54 @@ fn light_from_props(e: &Props) -> Result<Light> {
     Ok(light)
 }
 
-fn sampler_from_props(s: &Props) -> Result<SamplerSpec> {
-    if s.plugin_type() != "independent" {
-        return Err(Error::spec(s.at(), format!("unsupported sampler `{}` (gonio has: independent)", s.plugin_type())));
+/// The sampler: `independent`, or one of Mitsuba's stratified samplers, whose sample count gonio rounds
+/// as Mitsuba 3.9.1 does (so a file renders with the spp Mitsuba uses) but whose samples it draws
+/// independently, with a warning: the same expected image, with the independent sampler's noise.
+fn sampler_from_props(s: &Props, warnings: &mut Vec<String>) -> Result<SamplerSpec> {
+    let kind = s.plugin_type();
+    if !matches!(kind, "independent" | "stratified" | "multijitter" | "orthogonal" | "ldsampler") {
+        return Err(Error::spec(
+            s.at(),
+            format!("unsupported sampler `{kind}` (gonio has: independent; stratified, multijitter, orthogonal and ldsampler sampled independently)"),
+        ));
     }
-    let sample_count = s.integer_in("sample_count", 4, 1, i64::from(u32::MAX))? as u32;
+    let requested = s.integer_in("sample_count", 4, 1, 1 << 24)? as u32;
     let seed = s.integer_in("seed", 0, 0, i64::MAX)? as u64;
+    if matches!(kind, "stratified" | "multijitter" | "orthogonal") {
+        let _ = s.bool("jitter", true)?;
+    }
+    if kind == "orthogonal" {
+        // Mitsuba builds orthogonal arrays of strength 2 only.
+        let _ = s.integer_in("strength", 2, 2, 2)?;
+    }
+    let sample_count = mitsuba_sample_count(kind, requested);
+    if kind != "independent" {
+        warnings.push(format!(
+            "{}: sampler `{kind}` is sampled independently by gonio ({sample_count} spp, as Mitsuba rounds {requested}): \
+             the same expected image, with more noise than Mitsuba's",
+            s.at()
+        ));
+    }
     s.finish()?;
     Ok(SamplerSpec { sample_count, seed })
+}
+
+/// The sample count Mitsuba 3.9.1's samplers use for a requested `n` (`Sampler::sample_count()` after
+/// loading): `stratified` ⌈√n⌉², `multijitter` a × ⌈n / a⌉ with a = ⌈√n⌉, `ldsampler` the next power of two,
+/// `orthogonal` p² for the smallest prime p with p² ≥ n (Bose's construction of strength 2).
+fn mitsuba_sample_count(kind: &str, n: u32) -> u32 {
+    let root = (1..=n).find(|r| r * r >= n).unwrap_or(1);
+    match kind {
+        "stratified" => root * root,
+        "multijitter" => root * n.div_ceil(root),
+        "ldsampler" => n.next_power_of_two(),
+        "orthogonal" => {
+            let is_prime = |p: u32| p >= 2 && (2..p).take_while(|d| d * d <= p).all(|d| p % d != 0);
+            let p = (root..).find(|&p| is_prime(p)).unwrap_or(root);
+            p * p
+        }
+        _ => n,
+    }
 }
 
 fn integrator_from_props(p: &Props) -> Result<IntegratorKind> {
@@ -198,6 +252,32 @@ mod tests {
     use super::*;
     use crate::scene::mitsuba_xml;
     use std::path::Path;
+
+    /// Sample counts as Mitsuba 3.9.1 reports them after loading (`mi.load_dict({"type": …, "sample_count":
+    /// n}).sample_count()`): stratified 10 → 16, multijitter 10 → 12, ldsampler 10 → 16, orthogonal 10 and
+    /// 16 → 25.
+    #[test]
+    fn sample_counts_round_as_mitsubas() {
+        for (kind, n, want) in [
+            ("stratified", 10, 16),
+            ("stratified", 16, 16),
+            ("multijitter", 10, 12),
+            ("multijitter", 16, 16),
+            ("ldsampler", 10, 16),
+            ("ldsampler", 16, 16),
+            ("orthogonal", 10, 25),
+            ("orthogonal", 16, 25),
+            ("independent", 10, 10),
+        ] {
+            assert_eq!(mitsuba_sample_count(kind, n), want, "{kind} {n}");
+        }
+        let p = Props::from_json(r#"{"type": "stratified", "sample_count": 10, "jitter": false}"#).unwrap();
+        let mut warnings = Vec::new();
+        assert_eq!(sampler_from_props(&p, &mut warnings).unwrap().sample_count, 16);
+        assert!(warnings[0].contains("sampler `stratified` is sampled independently by gonio (16 spp"), "{warnings:?}");
+        let p = Props::from_json(r#"{"type": "sobol"}"#).unwrap();
+        assert!(sampler_from_props(&p, &mut warnings).unwrap_err().to_string().contains("unsupported sampler `sobol`"));
+    }
 
     /// A shape without a `<bsdf>` is a `diffuse` of reflectance 0.5, or 0 where it emits (as in Mitsuba 3);
     /// a `<bsdf>` given to an emitting shape is kept.

@@ -1,5 +1,16 @@
 //! The Mitsuba 3 XML scene format, document level: `<scene version>`, `<default>` parameters with
 //! `$name` substitution and command-line overrides, `<path>` search paths, `<include>`, ids for `<ref>`.
+//!
+//! Mitsuba 3's rules, which real scenes rely on:
+//! - **Files** (meshes, textures, `<include>`s) are searched in the `<path>` folders (the latest first),
+//!   then in the *main* scene file's folder, also from inside an included fragment (Mitsuba's file
+//!   resolver holds the main file's folder, not the fragment's; `cbox-rgb.xml` includes
+//!   `fragments/shapes.xml`, which names `meshes/cbox_luminaire.obj` beside `cbox-rgb.xml`). gonio
+//!   searches the fragment's own folder last, after those.
+//! - **`<path value>`** is taken relative to the file it is in, or else resolved as a file is.
+//! - **`<ref id>`** may name a plugin declared later in the scene (an area emitter declared after the shapes
+//!   that use it, a top-level `<sampler id>` used by the sensor): references are resolved once the whole
+//!   scene is read.
 //! Plugin elements are read by [`Props::from_xml_element_in`]; [`super::Scene::build`] turns the result
 //! into a renderable scene.
 //!
@@ -14,6 +25,7 @@
 use crate::error::{Error, Result};
 use crate::props::Props;
 use crate::xml::{xml_at, XmlEnv, XmlSource};
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 /// A parsed scene: the top-level plugins, not yet built.
@@ -25,6 +37,8 @@ pub struct SceneDescription {
     pub emitters: Vec<Props>,
     /// Where the scene came from (for messages).
     pub source: String,
+    /// Things accepted but worth a note, found while reading (see [`XmlEnv::warnings`]).
+    pub warnings: Vec<String>,
 }
 
 /// Parse a scene file; `overrides` are `-D name=value` pairs that take precedence over `<default>`s.
@@ -32,7 +46,7 @@ pub fn load_file(path: &Path, overrides: &[(String, String)]) -> Result<SceneDes
     let mut loader = Loader::new(overrides);
     loader.desc.source = path.display().to_string();
     loader.file(path, None)?;
-    Ok(loader.desc)
+    loader.finish()
 }
 
 /// Parse a scene from text; `source` names it in messages, `dir` resolves relative file names.
@@ -40,13 +54,15 @@ pub fn load_str(text: &str, source: &str, dir: &Path, overrides: &[(String, Stri
     let mut loader = Loader::new(overrides);
     loader.desc.source = source.to_string();
     loader.document(text, source, dir)?;
-    Ok(loader.desc)
+    loader.finish()
 }
 
 struct Loader {
     env: XmlEnv,
     /// `<path>` directories, most recent first (Mitsuba prepends them).
     paths: Vec<PathBuf>,
+    /// The main scene file's folder (set by the first document read).
+    main_dir: Option<PathBuf>,
     desc: SceneDescription,
     /// Files being included, to reject include cycles.
     stack: Vec<PathBuf>,
@@ -65,7 +81,25 @@ impl Loader {
     fn new(overrides: &[(String, String)]) -> Self {
         let mut env = XmlEnv::default();
         env.params.extend(overrides.iter().cloned());
-        Loader { env, paths: Vec::new(), desc: SceneDescription::default(), stack: Vec::new(), included: 0, plugins: 0 }
+        env.forward_refs = true;
+        Loader { env, paths: Vec::new(), main_dir: None, desc: SceneDescription::default(), stack: Vec::new(), included: 0, plugins: 0 }
+    }
+
+    /// Resolve the references to plugins declared after them, now that every id is known.
+    fn finish(mut self) -> Result<SceneDescription> {
+        let mut resolver = RefResolver { declared: &self.env.refs, done: HashMap::new(), active: Vec::new() };
+        let desc = &mut self.desc;
+        let tops = desc.integrator.iter_mut().chain(desc.sensor.iter_mut()).chain(desc.shapes.iter_mut()).chain(desc.emitters.iter_mut());
+        for p in tops.filter(|p| p.has_forward_refs()) {
+            let before = p.plugin_count();
+            p.resolve_refs(&mut |id, at| resolver.get(id, at))?;
+            self.plugins += p.plugin_count() - before;
+            if self.plugins > MAX_PLUGINS {
+                return Err(Error::spec(p.at(), format!("more than {MAX_PLUGINS} plugins in the scene once references are expanded")));
+            }
+        }
+        self.desc.warnings = self.env.warnings.take();
+        Ok(self.desc)
     }
 
     fn file(&mut self, path: &Path, included_at: Option<&str>) -> Result<()> {
@@ -85,10 +119,14 @@ impl Loader {
         result
     }
 
-    /// The directories a relative file name in a file of directory `dir` is searched in.
+    /// The directories a relative file name in a file of directory `dir` is searched in: the `<path>`s,
+    /// the main file's folder, then `dir` (module docs).
     fn search_paths(&self, dir: &Path) -> Vec<PathBuf> {
         let mut all = self.paths.clone();
-        all.push(dir.to_path_buf());
+        all.extend(self.main_dir.iter().cloned());
+        if self.main_dir.as_deref() != Some(dir) {
+            all.push(dir.to_path_buf());
+        }
         all
     }
 
@@ -105,6 +143,9 @@ impl Loader {
     fn document(&mut self, text: &str, source: &str, dir: &Path) -> Result<()> {
         let doc = crate::xml::parse_document(text, source)?;
         let source = &XmlSource::new(source, text);
+        if self.main_dir.is_none() {
+            self.main_dir = Some(dir.to_path_buf());
+        }
         let root = doc.root_element();
         let at = xml_at(source, root);
         if !root.has_tag_name("scene") {
@@ -126,10 +167,17 @@ impl Loader {
                 }
                 "path" => {
                     let value = self.env.required(node, "value", source)?;
-                    let p = dir.join(value);
-                    if !p.is_dir() {
-                        return Err(Error::spec(at, format!("<path>: `{}` is not a directory", p.display())));
-                    }
+                    // Relative to this file, else resolved as a file name is (Mitsuba 3 does the same).
+                    let here = dir.join(&value);
+                    let p = if here.is_dir() {
+                        here
+                    } else {
+                        let found = self.env.search_paths.iter().map(|d| d.join(&value)).find(|p| p.is_dir());
+                        found.ok_or_else(|| {
+                            let dirs: Vec<String> = self.env.search_paths.iter().map(|d| d.display().to_string()).collect();
+                            Error::spec(at, format!("<path>: no directory `{value}` (searched: {})", dirs.join(", ")))
+                        })?
+                    };
                     self.paths.insert(0, p);
                 }
                 "include" => {
@@ -149,14 +197,23 @@ impl Loader {
                     }
                     *slot = Some(props);
                 }
-                tag @ ("shape" | "emitter" | "bsdf" | "texture") => {
+                tag @ ("shape" | "emitter" | "bsdf" | "texture" | "sampler" | "film" | "rfilter") => {
                     let props = self.plugin(node, source, &at)?;
                     if let Some(id) = props.id() {
                         self.env.refs.insert(id.to_string(), props.clone());
                     }
                     match tag {
                         "shape" => self.desc.shapes.push(props),
+                        // An `area` emitter at the top level is a declaration for the shapes that
+                        // `<ref>` it (Mitsuba 3 scenes do this), not a light of its own.
+                        "emitter" if props.plugin_type() == "area" && props.id().is_some() => {}
                         "emitter" => self.desc.emitters.push(props),
+                        "sampler" | "film" | "rfilter" if props.id().is_none() => {
+                            return Err(Error::spec(
+                                at,
+                                format!("a top-level <{tag}> is used by a <ref id=\"…\"> in the sensor: give it an id"),
+                            ))
+                        }
                         _ => {}
                     }
                 }
@@ -164,6 +221,35 @@ impl Loader {
             }
         }
         Ok(())
+    }
+}
+
+/// The plugins declared with an id, each resolved once (its own forward references replaced) when first
+/// asked for; a cycle of references is an error.
+struct RefResolver<'a> {
+    declared: &'a HashMap<String, Props>,
+    done: HashMap<String, Props>,
+    active: Vec<String>,
+}
+
+impl RefResolver<'_> {
+    fn get(&mut self, id: &str, at: &str) -> Result<Props> {
+        if let Some(p) = self.done.get(id) {
+            return Ok(p.clone());
+        }
+        if self.active.iter().any(|a| a == id) {
+            return Err(Error::spec(at, format!("<ref id=\"{id}\">: the plugin refers to itself (through {})", self.active.join(" → "))));
+        }
+        let mut p = self
+            .declared
+            .get(id)
+            .cloned()
+            .ok_or_else(|| Error::spec(at, format!("<ref id=\"{id}\">: no plugin with this id is declared in the scene")))?;
+        self.active.push(id.to_string());
+        p.resolve_refs(&mut |id, at| self.get(id, at))?;
+        self.active.pop();
+        self.done.insert(id.to_string(), p.clone());
+        Ok(p)
     }
 }
 
@@ -313,6 +399,55 @@ mod tests {
         let e = result.unwrap_err().to_string();
         assert!(e.starts_with("big.xml:50001:66: <float name=\"radius\">: expected a number, got \"wide\""), "{e}");
         assert_eq!(work.builds, 1);
+    }
+
+    /// Mitsuba 3's rules (module docs): a fragment's files, `<include>`s and `<path>`s resolve against the
+    /// main file's folder; `<ref>`s may name plugins declared later (an area emitter after its shape, a
+    /// top-level sampler after the sensor).
+    #[test]
+    fn fragments_resolve_against_the_main_folder_and_refs_may_come_later() {
+        let dir = scratch("fragments");
+        for sub in ["scenes/include", "scenes/meshes", "common/more"] {
+            std::fs::create_dir_all(dir.join(sub)).unwrap();
+        }
+        std::fs::write(dir.join("scenes/meshes/tri.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+        std::fs::write(dir.join("common/more/light.xml"), format!("{SCENE}<emitter type=\"point\"/></scene>")).unwrap();
+        // `../common` is not beside the fragment (scenes/common) but beside the main file's folder.
+        std::fs::write(
+            dir.join("scenes/include/shapes.xml"),
+            format!(
+                "{SCENE}<path value=\"../common\"/><include filename=\"more/light.xml\"/>\n\
+                 <shape type=\"obj\"><string name=\"filename\" value=\"meshes/tri.obj\"/><ref id=\"glow\"/></shape></scene>"
+            ),
+        )
+        .unwrap();
+        std::fs::write(
+            dir.join("scenes/main.xml"),
+            format!(
+                "{SCENE}<sensor type=\"perspective\"><ref id=\"spp7\"/></sensor>\n<include filename=\"include/shapes.xml\"/>\n\
+                 <emitter type=\"area\" id=\"glow\"><rgb name=\"radiance\" value=\"2\"/></emitter>\n\
+                 <sampler type=\"independent\" id=\"spp7\"><integer name=\"sample_count\" value=\"7\"/></sampler></scene>"
+            ),
+        )
+        .unwrap();
+        let scene = crate::scene::Scene::build(load_file(&dir.join("scenes/main.xml"), &[]).unwrap()).unwrap();
+        assert_eq!(scene.sampler.sample_count, 7);
+        assert_eq!(scene.lights.len(), 2, "the area light on the triangle and the included point light");
+        assert!(matches!(scene.lights[0], crate::light::Light::Area(ref a) if a.radiance == crate::spectrum::Rgb::splat(2.0)));
+
+        // An id declared nowhere, and references that go round in a circle, are errors at the <ref>.
+        let e = refused(&format!("{SCENE}\n<shape type=\"sphere\">\n  <ref id=\"nowhere\"/></shape></scene>"), &dir);
+        assert!(e.starts_with("h.xml:3:3: <ref id=\"nowhere\">: no plugin with this id is declared"), "{e}");
+        let e = refused(
+            &format!(
+                "{SCENE}<shape type=\"sphere\"><ref id=\"a\"/></shape>\n<bsdf type=\"twosided\" id=\"a\"><ref id=\"b\"/></bsdf>\n\
+                 <bsdf type=\"twosided\" id=\"b\"><ref id=\"a\"/></bsdf></scene>"
+            ),
+            &dir,
+        );
+        assert!(e.contains("the plugin refers to itself (through a → b)"), "{e}");
+        let e = refused(&format!("{SCENE}\n<sampler type=\"independent\"/></scene>"), &dir);
+        assert!(e.starts_with("h.xml:2:1: a top-level <sampler> is used by a <ref"), "{e}");
     }
 
     #[test]

@@ -12,7 +12,7 @@ pub mod surfaces;
 
 pub use material::Material;
 
-use crate::camera::PerspectiveCamera;
+use crate::camera::Camera;
 use crate::error::Result;
 use crate::film::FilmSpec;
 use crate::geometry::bvh::{bits, PacketLeaves, PacketRays, LANES};
@@ -59,7 +59,7 @@ pub struct Scene {
     /// ([`Mesh::flat_triangles8`](crate::geometry::mesh::Mesh::flat_triangles8)), for the path tracer's
     /// next-event estimation.
     pub light_triangles: Vec<Option<FlatTriangles8>>,
-    pub camera: PerspectiveCamera,
+    pub camera: Camera,
     pub film: FilmSpec,
     pub sampler: SamplerSpec,
     pub integrator: IntegratorKind,
@@ -409,7 +409,7 @@ impl Scene {
         materials: Vec<Material>,
         shape_lights: Vec<Option<u32>>,
         lights: Vec<Light>,
-        camera: PerspectiveCamera,
+        camera: Camera,
         film: FilmSpec,
         sampler: SamplerSpec,
         integrator: IntegratorKind,
