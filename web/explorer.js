@@ -73,6 +73,7 @@ const DEFAULT_STATE = {
  */
 export function mount(root, api, options = {}) {
   const app = new Explorer(root, api, options);
+  root.gxExplorer = app; // for scripts and tests: the state and the numbers drawn
   app.start();
   return app;
 }
@@ -355,8 +356,8 @@ class Explorer {
     const selected = this.layer;
     try {
       const kinds = ['polar', 'lobe', 'albedo'];
-      const all = await Promise.all(shown.map(({ l }) => Promise.all(kinds.map((k) => this.plotData(l.spec, k)))));
-      const slice = await this.plotData(selected.spec, 'slice');
+      const [slice, all] = await Promise.all([this.plotData(selected.spec, 'slice'),
+        Promise.all(shown.map(({ l }) => Promise.all(kinds.map((k) => this.plotData(l.spec, k)))))]);
       if (token !== this.tokens.plots) return;
       this.data = { shown, polar: all.map((a) => a[0]), lobe: all.map((a) => a[1]), albedo: all.map((a) => a[2]), slice, selected };
       this.showError(null);

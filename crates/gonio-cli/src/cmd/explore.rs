@@ -260,6 +260,7 @@ fn answer(explorer: &Explorer, target: &str) -> Reply {
         "/" | "/index.html" => page("text/html; charset=utf-8", INDEX_HTML),
         "/explorer.js" => page("text/javascript; charset=utf-8", EXPLORER_JS),
         "/explorer.css" => page("text/css; charset=utf-8", EXPLORER_CSS),
+        "/favicon.ico" => Reply { status: 204, content_type: "image/x-icon", body: Vec::new() },
         _ => explorer.handle(path, query),
     }
 }
@@ -267,6 +268,7 @@ fn answer(explorer: &Explorer, target: &str) -> Reply {
 fn reason(status: u16) -> &'static str {
     match status {
         200 => "OK",
+        204 => "No Content",
         400 => "Bad Request",
         404 => "Not Found",
         405 => "Method Not Allowed",

@@ -36,12 +36,14 @@ mod views;
 
 use crate::bsdf::Bsdf;
 use crate::error::{Error, Result};
+use crate::image::{read_image, Image};
+use crate::preview::Lighting;
 use serde_json::{json, Value};
 use std::collections::HashMap;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Mutex, OnceLock};
 
 pub use views::{PlotKind, PlotRequest};
 
@@ -88,8 +90,9 @@ pub struct Explorer {
     data_dir: Option<PathBuf>,
     /// Measured files offered besides those in `data_dir` (given on the command line), canonical.
     extra_files: Vec<PathBuf>,
-    /// The environment map of `light=env` (else the built-in sky).
+    /// The environment map of `light=env` (else the built-in sky), and its image once read.
     environment: Option<PathBuf>,
+    environment_image: OnceLock<std::result::Result<Arc<Image>, String>>,
     /// The models shown first (JSON specs).
     initial: Vec<String>,
     /// Models built from recent specs (measured data takes long to read): (spec, model), newest last.
@@ -107,7 +110,15 @@ impl Explorer {
     #[must_use]
     pub fn new(data_dir: Option<PathBuf>, extra_files: Vec<PathBuf>, environment: Option<PathBuf>, initial: Vec<String>) -> Self {
         let extra_files = extra_files.iter().filter_map(|p| p.canonicalize().ok()).collect();
-        Explorer { data_dir, extra_files, environment, initial, cache: Mutex::new(Vec::new()), sphere: Mutex::new(None) }
+        Explorer {
+            data_dir,
+            extra_files,
+            environment,
+            environment_image: OnceLock::new(),
+            initial,
+            cache: Mutex::new(Vec::new()),
+            sphere: Mutex::new(None),
+        }
     }
 
     /// Answer `path` with the URL-encoded `query` (`a=1&b=2`, without the `?`). Never panics.
@@ -145,7 +156,8 @@ impl Explorer {
                 if let Some(previous) = self.sphere.lock().unwrap_or_else(|e| e.into_inner()).replace(cancel.clone()) {
                     previous.store(true, Ordering::Relaxed);
                 }
-                let png = views::sphere(&bsdf, q, self.environment.as_deref(), &cancel)?;
+                let env = if q.get("light").map_or(true, |l| l == "env") { self.environment_lighting()? } else { Lighting::GradientSky };
+                let png = views::sphere(&bsdf, q, env, &cancel)?;
                 if cancel.load(Ordering::Relaxed) {
                     return Ok(Reply::json(409, &json!({"error": "superseded by a newer render"})));
                 }
@@ -177,6 +189,16 @@ impl Explorer {
             }
             _ => Reply::json(404, &json!({"error": format!("no such page: {path}")})),
         })
+    }
+
+    /// The lighting of `light=env`: the environment map, read once (else the built-in sky).
+    fn environment_lighting(&self) -> Result<Lighting> {
+        let Some(path) = &self.environment else { return Ok(Lighting::GradientSky) };
+        let image = self.environment_image.get_or_init(|| read_image(path).map(Arc::new).map_err(|e| e.to_string()));
+        match image {
+            Ok(image) => Ok(Lighting::EnvironmentImage { image: image.clone(), name: path.display().to_string() }),
+            Err(message) => Err(Error::spec("light", message.clone())),
+        }
     }
 
     /// The measured files offered: those in the data folder (by name), then those given (by path).
