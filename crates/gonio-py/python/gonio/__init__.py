@@ -31,6 +31,7 @@ import json
 from typing import Any, Mapping, Optional, Sequence, Union
 
 from . import _gonio, verify
+from .explorer import explore
 from ._gonio import (
     AlbedoData,
     Bsdf,
@@ -64,6 +65,7 @@ __all__ = [
     "__version__",
     "albedo_data",
     "examples",
+    "explore",
     "load_bsdf",
     "load_dict",
     "load_scene",
