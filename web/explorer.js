@@ -89,6 +89,7 @@ class Explorer {
     this.tokens = { plots: 0, sphere: 0, verify: 0 };
     this.view = { yaw: -0.6, pitch: 0.5 };
     this.state = structuredClone(DEFAULT_STATE);
+    this.data = {}; // per panel: the models shown and their numbers
   }
 
   async start() {
@@ -167,7 +168,7 @@ class Explorer {
         h('button', { onclick: () => this.exportModel('xml') }, 'Mitsuba XML'),
         h('button', { onclick: () => this.exportModel('json') }, 'JSON'),
         this.options.onState ? null : h('button', { onclick: () => navigator.clipboard && navigator.clipboard.writeText(location.href) }, 'copy link')));
-    this.el.polar = s('svg', { viewBox: '0 0 640 330', class: 'gx-svg' });
+    this.el.polar = s('svg', { viewBox: '0 0 640 205', class: 'gx-svg' });
     this.el.albedo = s('svg', { viewBox: '0 0 420 300', class: 'gx-svg' });
     this.el.lobe = h('canvas', { width: 420, height: 330, class: 'gx-canvas' });
     this.el.slice = h('canvas', { width: 420, height: 330, class: 'gx-canvas' });
@@ -349,24 +350,33 @@ class Explorer {
     return body;
   }
 
-  refreshPlots = debounce(async () => {
+  // Each panel is drawn as soon as its numbers arrive (a measured model's albedo takes seconds); the
+  // polar, 3-D and slice panels together set dataset.plotToken/plotMs, the albedo albedoToken/albedoMs.
+  refreshPlots = debounce(() => {
     const token = ++this.tokens.plots;
     const started = performance.now();
     const shown = this.shown();
     const selected = this.layer;
-    try {
-      const kinds = ['polar', 'lobe', 'albedo'];
-      const [slice, all] = await Promise.all([this.plotData(selected.spec, 'slice'),
-        Promise.all(shown.map(({ l }) => Promise.all(kinds.map((k) => this.plotData(l.spec, k)))))]);
+    const fail = (err) => { if (token === this.tokens.plots) this.showError(err.error ? err : { error: String(err) }); };
+    const fetchAll = (kind) => Promise.all(shown.map(({ l }) => this.plotData(l.spec, kind)));
+    const panels = [
+      fetchAll('polar').then((list) => { if (token === this.tokens.plots) { this.data.polar = { shown, list }; this.drawPolar(); } }),
+      fetchAll('lobe').then((list) => { if (token === this.tokens.plots) { this.data.lobe = { shown, list }; this.drawLobe(); } }),
+      this.plotData(selected.spec, 'slice').then((d) => { if (token === this.tokens.plots) { this.data.slice = { selected, d }; this.drawSlice(); } }),
+    ];
+    Promise.all(panels).then(() => {
       if (token !== this.tokens.plots) return;
-      this.data = { shown, polar: all.map((a) => a[0]), lobe: all.map((a) => a[1]), albedo: all.map((a) => a[2]), slice, selected };
       this.showError(null);
-      this.draw();
       this.root.dataset.plotMs = Math.round(performance.now() - started);
       this.root.dataset.plotToken = token;
-    } catch (err) {
-      if (token === this.tokens.plots) this.showError(err.error ? err : { error: String(err) });
-    }
+    }, fail);
+    fetchAll('albedo').then((list) => {
+      if (token !== this.tokens.plots) return;
+      this.data.albedo = { shown, list };
+      this.drawAlbedo();
+      this.root.dataset.albedoMs = Math.round(performance.now() - started);
+      this.root.dataset.albedoToken = token;
+    }, fail);
   }, 40);
 
   refreshSphereSoon = debounce(() => this.refreshSphere(), 40);
@@ -390,7 +400,7 @@ class Explorer {
       this.el.sphere.src = url;
       if (old.startsWith('blob:')) setTimeout(() => URL.revokeObjectURL(old), 1000);
       const ms = Math.round(performance.now() - started);
-      if (k === 0) this.root.dataset.sphereFirstMs = ms;
+      if (k === 0) Object.assign(this.root.dataset, { sphereFirstMs: ms, sphereToken: token });
       this.el.sphereNote.textContent = `${pass.size}² px, ${pass.spp} spp, ${ms} ms`;
     }
   }
@@ -444,11 +454,10 @@ class Explorer {
 
   // ---------- drawing (numbers from the server only) ----------
   draw() {
-    if (!this.data) return;
-    this.drawPolar();
-    this.drawLobe();
-    this.drawSlice();
-    this.drawAlbedo();
+    if (this.data.polar) this.drawPolar();
+    if (this.data.lobe) this.drawLobe();
+    if (this.data.slice) this.drawSlice();
+    if (this.data.albedo) this.drawAlbedo();
   }
 
   radius(v, max) {
@@ -458,16 +467,20 @@ class Explorer {
 
   drawPolar() {
     const svg = this.el.polar;
-    svg.replaceChildren(s('rect', { width: 640, height: 330, fill: 'white' }));
-    const { shown, polar } = this.data;
+    const { shown, list: polar } = this.data.polar;
+    // Models that transmit are drawn on the full circle, others on the upper half.
     const full = polar.some((p) => p.transmission);
+    const base = full ? 345 : 205;
+    const height = base + 14 * shown.length + 4;
+    svg.setAttribute('viewBox', `0 0 640 ${height}`);
+    svg.replaceChildren(s('rect', { width: 640, height, fill: 'white' }));
     let max = 0;
     for (const p of polar) for (const v of [...p.incidence, ...p.perpendicular]) if (v > max) max = v;
-    const R = 140;
+    const R = 145;
     const panels = [['incidence', 'plane of incidence', 160], ['perpendicular', 'perpendicular plane', 480]];
     const to = this.state.theta_o * Math.PI / 180;
     for (const [key, title, cx] of panels) {
-      const cy = full ? 170 : 300;
+      const cy = 175;
       const g = s('g');
       g.append(s('path', { d: full ? `M${cx - R},${cy} a${R},${R} 0 1,1 ${2 * R},0 a${R},${R} 0 1,1 ${-2 * R},0` : `M${cx - R},${cy} A${R},${R} 0 0,1 ${cx + R},${cy} Z`, fill: 'none', stroke: '#bbb' }));
       g.append(s('line', { x1: cx, y1: cy, x2: cx, y2: cy - R, stroke: '#ddd' }));
@@ -488,15 +501,15 @@ class Explorer {
       g.append(t);
       svg.append(g);
     }
-    const scale = s('text', { x: 8, y: 326, class: 'gx-label' });
+    const scale = s('text', { x: 8, y: base - 6, class: 'gx-label' });
     scale.textContent = this.state.log ? `log scale: 4 decades below the maximum ${max.toPrecision(3)} sr⁻¹` : `max f·cos θi = ${max.toPrecision(3)} sr⁻¹ (${this.state.channel})`;
     svg.append(scale);
-    this.legend(svg, 460, 300);
+    this.legend(svg, shown, 8, base + 10);
   }
 
-  legend(svg, x, y) {
-    this.data.shown.forEach(({ l }, k) => {
-      const yy = y - 14 * (this.data.shown.length - 1 - k);
+  legend(svg, shown, x, y) {
+    shown.forEach(({ l }, k) => {
+      const yy = y + 14 * k;
       svg.append(s('line', { x1: x, y1: yy - 4, x2: x + 16, y2: yy - 4, stroke: l.colour, 'stroke-width': 2 }));
       const t = s('text', { x: x + 20, y: yy, class: 'gx-label' });
       t.textContent = this.label(l);
@@ -509,7 +522,7 @@ class Explorer {
     const g = c.getContext('2d');
     g.fillStyle = '#fff';
     g.fillRect(0, 0, c.width, c.height);
-    const { shown, lobe } = this.data;
+    const { shown, list: lobe } = this.data.lobe;
     let max = 0;
     for (const d of lobe) for (const v of d.values) if (v > max) max = v;
     const { yaw, pitch } = this.view;
@@ -554,7 +567,7 @@ class Explorer {
       this.view.yaw += (e.clientX - last[0]) * 0.01;
       this.view.pitch = Math.max(-1.5, Math.min(1.5, this.view.pitch + (e.clientY - last[1]) * 0.01));
       last = [e.clientX, e.clientY];
-      if (this.data) this.drawLobe();
+      if (this.data.lobe) this.drawLobe();
     });
     c.addEventListener('pointerup', () => { last = null; });
   }
@@ -585,7 +598,7 @@ class Explorer {
     const g = c.getContext('2d');
     g.fillStyle = '#fff';
     g.fillRect(0, 0, c.width, c.height);
-    const d = this.data.slice;
+    const { d, selected } = this.data.slice;
     const nh = d.theta_h.length;
     const nd = d.theta_d.length;
     let max = 0;
@@ -613,7 +626,7 @@ class Explorer {
     g.rotate(-Math.PI / 2);
     g.fillText('θd → (0° … 90°)', 0, 0);
     g.restore();
-    g.fillText(`${this.label(this.data.selected)}`, 330, 24);
+    g.fillText(`${this.label(selected)}`, 330, 24);
     g.fillText(`max ${max.toPrecision(3)} sr⁻¹`, 330, 42);
     g.fillText('log, 4 decades', 330, 60);
     for (let k = 0; k <= 10; k++) { g.fillStyle = `rgb(${heat(k / 10).join(',')})`; g.fillRect(330, 280 - k * 20, 16, 20); }
@@ -622,7 +635,7 @@ class Explorer {
   drawAlbedo() {
     const svg = this.el.albedo;
     svg.replaceChildren(s('rect', { width: 420, height: 300, fill: 'white' }));
-    const { shown, albedo } = this.data;
+    const { shown, list: albedo } = this.data.albedo;
     let max = 1.05;
     for (const a of albedo) for (const v of a.albedo) if (v > max) max = v * 1.05;
     const X = (t) => 50 + (t / 90) * 340;
