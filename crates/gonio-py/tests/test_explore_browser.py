@@ -58,16 +58,18 @@ def shot(page, name):
         page.screenshot(path=str(Path(SHOTS) / f"explorer_{name}.png"))
 
 
+KEYS = ("plotToken", "albedoToken", "sphereToken")
+
+
 def tokens(page):
-    """The counters of the plots and the sphere images drawn so far."""
-    return page.evaluate("[document.querySelector('.gx').dataset.plotToken, document.querySelector('.gx').dataset.sphereToken]")
+    """The counters of the plots (polar, 3-D, slice), the albedo and the sphere images drawn so far."""
+    return page.evaluate(f"{list(KEYS)}.map(k => document.querySelector('.gx').dataset[k])")
 
 
-def settle(page, before):
-    """Wait for the plots and the first sphere image asked for after `before` (from `tokens`)."""
-    plot, sphere = before
-    page.wait_for_function(f"document.querySelector('.gx').dataset.plotToken != '{plot}'", timeout=30000)
-    page.wait_for_function(f"document.querySelector('.gx').dataset.sphereToken != '{sphere}'", timeout=30000)
+def settle(page, before, timeout=60000):
+    """Wait for the plots, the albedo and the first sphere image asked for after `before` (from `tokens`)."""
+    for key, value in zip(KEYS, before):
+        page.wait_for_function(f"document.querySelector('.gx').dataset.{key} != '{value}'", timeout=timeout)
 
 
 def state(page):
