@@ -178,3 +178,22 @@ def test_widget_entry_point_runs_the_same_explorer(page, server):
     assert result["type"] == "diffuse"
     assert result["polar"] == 721
     assert result["spec"] == {"type": "diffuse", "reflectance": 0.5}, "the widget reports the selected model to Python"
+
+
+def test_url_encodes_the_state(page, server):
+    """A shared address shows the same models and view."""
+    import json
+    from urllib.parse import quote
+
+    state = {"layers": [{"spec": {"type": "diffuse", "reflectance": [0.2, 0.5, 0.8]}, "colour": "#2ca02c", "visible": True},
+                        {"spec": {"type": "roughplastic", "alpha": 0.05}, "colour": "#d62728", "visible": True}],
+             "sel": 1, "theta_o": 50, "light": "furnace"}
+    context = page.context.browser.new_context(viewport={"width": 1400, "height": 1000})
+    other = context.new_page()
+    other.goto(server + "#" + quote(json.dumps(state)))
+    other.wait_for_function("document.querySelector('.gx') && document.querySelector('.gx').dataset.plotToken", timeout=30000)
+    app = other.evaluate("(({ state, data }) => ({ state, n: data.polar.list.length, theta: data.polar.list[0].theta_o }))(document.querySelector('.gx').gxExplorer)")
+    assert [l["spec"]["type"] for l in app["state"]["layers"]] == ["diffuse", "roughplastic"]
+    assert (app["state"]["sel"], app["state"]["theta_o"], app["state"]["light"], app["n"], app["theta"]) == (1, 50, "furnace", 2, 50)
+    assert other.input_value("[data-param=alpha] input[type=number]") == "0.05", "the form shows the selected model"
+    context.close()
