@@ -21,7 +21,7 @@ CARGO  ?= cargo
 GONIO_CPU ?= native
 export RUSTFLAGS ?= -C target-cpu=$(GONIO_CPU)
 
-.PHONY: all build cli venv python demo check-all test test-portable test-rust test-python bench gallery fit-table fuzz fmt lint clean
+.PHONY: all build cli venv python demo check-all test test-portable test-rust test-python browser bench gallery fit-table fuzz fmt lint clean
 
 all: build
 
@@ -66,7 +66,7 @@ demo: build
 check-all: cli
 	./target/release/gonio check --all
 
-test: build
+test: build browser
 	$(CARGO) test --release -p gonio -p gonio-cli
 	$(VPY) -m pytest -q -rxX crates/gonio-py/tests
 	$(MAKE) test-portable
@@ -83,6 +83,12 @@ test-rust:
 
 test-python:
 	$(VPY) -m pytest -q -rxX crates/gonio-py/tests
+
+# The explorer's browser test (crates/gonio-py/tests/test_explore_browser.py) drives Debian's Chromium with
+# Playwright (requirements-dev.txt; Playwright's own browser download is not used). Best effort: where apt
+# cannot install it the test skips and says so.
+browser:
+	-command -v chromium >/dev/null 2>&1 || (apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium)
 
 # Benchmarks, run by hand (never part of `make test`): criterion micro-benchmarks, then gonio against
 # Mitsuba 3 (scalar_rgb, llvm_ad_rgb) on ../shared/scenes with the scaling tables (bench/render_vs_mitsuba.py),

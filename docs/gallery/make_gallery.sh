@@ -208,6 +208,33 @@ else
     md "**Not generated here**: $RGL is not in this checkout." ""
 fi
 
+md "## 12. The explorer" ""
+md "\`gonio explore\` in headless Chromium, driven by the browser test (crates/gonio-py/tests/test_explore_browser.py," \
+    "which saves these screenshots when GONIO_SCREENSHOTS is set; see [docs/explorer.md](../explorer.md))." ""
+SHOTS=(explorer_1_sharp.png "roughconductor with a small α: the sharp lobe peaks at the mirror direction"
+    explorer_2_rough.png "the α slider moved: a rough lobe, the sphere re-rendered"
+    explorer_3_bad_value.png "α = 20 typed in: the CLI's message next to the field"
+    explorer_4_measured_and_fit.png "a measured RGL material (paper_white) and its fitted Lambertian + GGX twin, overlaid")
+if [ -z "${ONLY:-}" ] || [[ explorer == $ONLY* ]] || [[ 12 == $ONLY* ]]; then
+    rm -f "$OUT"/explorer_*.png
+    if ! GONIO_SCREENSHOTS=$OUT ${PYTHON:-.venv/bin/python} -m pytest -q -rs crates/gonio-py/tests/test_explore_browser.py >"$OUT/.err" 2>&1; then
+        echo "make_gallery: !!! FAILED the explorer's browser test:" >&2
+        sed 's/^/make_gallery: !!!   /' "$OUT/.err" >&2
+        FAILED+=("12")
+    fi
+    rm -f "$OUT/.err"
+fi
+for ((k = 0; k < ${#SHOTS[@]}; k += 2)); do
+    if [ -f "$OUT/${SHOTS[k]}" ]; then
+        md "![${SHOTS[k + 1]}](${SHOTS[k]})" "" "${SHOTS[k + 1]}." ""
+    else
+        echo "make_gallery: !!! SKIPPED ${SHOTS[k]}: no browser or Playwright here (the test says why)" >&2
+        SKIPPED+=("${SHOTS[k]}")
+        md "**${SHOTS[k]}: not generated** — no headless Chromium or Playwright on this machine." ""
+    fi
+done
+md '```sh' "GONIO_SCREENSHOTS=docs/gallery .venv/bin/python -m pytest crates/gonio-py/tests/test_explore_browser.py" '```' ""
+
 mv "$README" "$OUT/README.md"
 ELAPSED=$(($(date +%s) - START))
 echo "make_gallery: done in ${ELAPSED} s" >&2

@@ -37,6 +37,8 @@ enum Command {
     Plot(cmd::plot::Args),
     /// Render lit spheres of BSDFs with the path tracer (side by side, or a sweep of one parameter).
     Preview(cmd::preview::Args),
+    /// Look at BSDFs interactively in the browser: a local web page with live plots, a lit sphere and checks.
+    Explore(cmd::explore::Args),
 }
 
 fn main() -> ExitCode {
@@ -49,6 +51,7 @@ fn main() -> ExitCode {
         Command::Fit(args) => cmd::fit::run(args),
         Command::Plot(args) => cmd::plot::run(args),
         Command::Preview(args) => cmd::preview::run(args),
+        Command::Explore(args) => cmd::explore::run(args),
     };
     match result {
         Ok(code) => code,

@@ -22,6 +22,7 @@ use rayon::prelude::*;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
 mod batch;
+mod explore;
 mod image;
 mod plot;
 mod scene;
@@ -486,6 +487,7 @@ fn _gonio(m: &Bound<'_, PyModule>) -> PyResult<()> {
     scene::register(m)?;
     image::register(m)?;
     plot::register(m)?;
+    explore::register(m)?;
     for (name, bit) in [
         ("FLAG_REFLECTION", BsdfFlags::REFLECTION),
         ("FLAG_TRANSMISSION", BsdfFlags::TRANSMISSION),

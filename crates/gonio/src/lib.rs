@@ -21,6 +21,7 @@
 pub mod bsdf;
 pub mod camera;
 pub mod error;
+pub mod explore;
 pub mod film;
 pub mod fit;
 pub mod fresnel;

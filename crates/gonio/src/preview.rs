@@ -5,6 +5,7 @@
 //! | lighting                 | what it is                                                                |
 //! |--------------------------|---------------------------------------------------------------------------|
 //! | [`Lighting::Environment`] | a lat-long image (EXR/HDR/PNG) as an importance-sampled `envmap`          |
+//! | [`Lighting::EnvironmentImage`] | the same, from an image already read (an interactive view reads it once) |
 //! | [`Lighting::GradientSky`] | the built-in sky of [`gradient_sky`]: blue zenith, pale horizon, brown ground, a small sun |
 //! | [`Lighting::Constant`]    | uniform radiance L from every direction (L = 1: the white furnace)        |
 //! | [`Lighting::Directional`] | a directional light of irradiance π (a white Lambertian surface facing it has radiance 1) plus a uniform ambient (the CLI uses [`AMBIENT`]) |
@@ -44,6 +45,7 @@ use glam::Vec3;
 use std::f32::consts::PI;
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
 
 /// Radiance of the uniform ambient that accompanies a directional light (the unlit side is not pure black).
 pub const AMBIENT: f32 = 0.04;
@@ -59,6 +61,8 @@ const FILL: f32 = 0.9;
 pub enum Lighting {
     /// A lat-long environment image (linear radiance), as Mitsuba's `envmap`.
     Environment(PathBuf),
+    /// The same, already read (shared by the renders of an interactive view; `name` names it in errors).
+    EnvironmentImage { image: Arc<Image>, name: String },
     /// The built-in sky of [`gradient_sky`].
     GradientSky,
     /// Uniform radiance from every direction.
@@ -123,6 +127,9 @@ pub fn preview_scene(material: Material, lighting: &Lighting, size: u32) -> Resu
         Lighting::Environment(path) => {
             let image = read_image(path)?;
             lights.push(Light::EnvMap(EnvMap::new(&image, 1.0, Transform::IDENTITY, &path.display().to_string())?));
+        }
+        Lighting::EnvironmentImage { image, name } => {
+            lights.push(Light::EnvMap(EnvMap::new(image, 1.0, Transform::IDENTITY, name)?));
         }
         Lighting::GradientSky => {
             lights.push(Light::EnvMap(EnvMap::new(&gradient_sky(512, 256), 1.0, Transform::IDENTITY, "the built-in sky")?));

@@ -1,5 +1,6 @@
 pub mod albedo;
 pub mod check;
+pub mod explore;
 pub mod fit;
 pub mod measure;
 pub mod plot;

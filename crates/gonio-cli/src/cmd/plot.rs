@@ -15,7 +15,9 @@
 use crate::figure::{self, raster, svg::Svg};
 use crate::spec::load_bsdf;
 use gonio::bsdf::{BsdfFlags, BsdfModel};
-use gonio::plot::{albedo_data, lobe_data, slice_data, Channel};
+use gonio::plot::{
+    albedo_data, lobe_data, slice_data, Channel, ALBEDO_ANGLES, ALBEDO_SAMPLES, GRID_PHI, GRID_THETA, POLAR_SAMPLES, SLICE_RES,
+};
 use gonio::{Bsdf, Error};
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
@@ -61,23 +63,16 @@ pub struct Args {
     #[arg(long = "phi-d", value_name = "DEG", default_value_t = 90.0, allow_negative_numbers = true)]
     phi_d: f64,
     /// Number of viewing angles of the albedo curve.
-    #[arg(long, default_value_t = 30)]
+    #[arg(long, default_value_t = ALBEDO_ANGLES)]
     angles: usize,
     /// Samples per albedo value.
-    #[arg(long, default_value_t = 16_384)]
+    #[arg(long, default_value_t = ALBEDO_SAMPLES)]
     samples: usize,
 }
 
 fn parse_channel(s: &str) -> Result<Channel, String> {
     Channel::parse(s).ok_or_else(|| format!("unknown channel `{s}`; expected r, g, b or lum"))
 }
-
-/// Angles per plane of the polar plot (half-degree steps) and the 3-D grid (θ, φ).
-const POLAR_SAMPLES: usize = 721;
-const GRID_THETA: usize = 31;
-const GRID_PHI: usize = 72;
-/// The slice at MERL's resolution.
-const SLICE_RES: usize = 90;
 
 /// The output formats, from the extension.
 #[derive(Clone, Copy, PartialEq, Eq)]

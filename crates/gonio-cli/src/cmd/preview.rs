@@ -201,6 +201,7 @@ pub fn run(args: Args) -> Result<ExitCode, Error> {
     if !args.quiet {
         let light = match &lighting {
             Lighting::Environment(p) => format!("environment {}", p.display()),
+            Lighting::EnvironmentImage { name, .. } => format!("environment {name}"),
             Lighting::GradientSky => "the built-in sky".into(),
             Lighting::Constant(_) => "a uniform white environment".into(),
             Lighting::Directional { towards_light, .. } => format!("a directional light from {towards_light}"),

@@ -33,6 +33,7 @@ import json as _json
 from typing import Any as _Any, Mapping as _Mapping, Optional as _Optional, Sequence as _Sequence, Union as _Union
 
 from . import _gonio, verify
+from .explorer import explore
 from ._gonio import (
     AlbedoData,
     Bsdf,
@@ -66,6 +67,7 @@ __all__ = [
     "__version__",
     "albedo_data",
     "examples",
+    "explore",
     "load_bsdf",
     "load_dict",
     "load_scene",

@@ -220,3 +220,7 @@ def plot(
 ) -> Any:
     """Draw models with matplotlib (kind: "polar", "3d", "slice" or "albedo"), from the same numbers as
     `gonio plot`; returns the matplotlib Figure. Raises ImportError naming matplotlib when it is missing."""
+
+def explore(*models: Any, data: Optional[PathLike] = None, environment: Optional[PathLike] = None, threads: int = 2) -> Any:
+    """The explorer as a Jupyter widget (anywidget); ``widget.bsdf`` is the selected model as edited."""
+    ...

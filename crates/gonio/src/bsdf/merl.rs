@@ -6,7 +6,7 @@
 //! | parameter       | type    | default       | meaning                                               |
 //! |-----------------|---------|---------------|-------------------------------------------------------|
 //! | `filename`      | string  | —             | a MERL `.binary` file (34,992,012 bytes)               |
-//! | `interpolation` | string  | `"trilinear"` | `trilinear` between cell centres, or `nearest` (MERL's reader) |
+//! | `interpolation` | `trilinear` \| `nearest` | `trilinear` | between cell centres, or the nearest cell (MERL's reader) |
 //! | (nested bsdf)   | bsdf    | —             | instead of `filename`: tabulate this model in memory (one point per cell, at its centre) |
 //!
 //! f is read from the table; it is reciprocal bit for bit and never negative (cells that were not

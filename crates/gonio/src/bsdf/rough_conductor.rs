@@ -3,7 +3,7 @@
 //!
 //! | parameter              | type            | default      | meaning                                          |
 //! |------------------------|-----------------|--------------|--------------------------------------------------|
-//! | `distribution`         | string          | `"beckmann"` | `beckmann` or `ggx` (as in Mitsuba)               |
+//! | `distribution`         | `beckmann` \| `ggx` | `beckmann` | the microfacet distribution (as in Mitsuba)   |
 //! | `alpha`                | float [1e-4, 10]| 0.1          | roughness (RMS slope for Beckmann); isotropic     |
 //! | `alpha_u`, `alpha_v`   | float [1e-4, 10]| `alpha`      | roughness along the tangent and bitangent (anisotropic; instead of `alpha`) |
 //! | `material`             | string          | `"none"`     | named metal (`Au`, `Cu`, …); `none` reflects 100 % |

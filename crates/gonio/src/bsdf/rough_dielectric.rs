@@ -4,7 +4,7 @@
 //!
 //! | parameter                | type            | default      | meaning                                          |
 //! |--------------------------|-----------------|--------------|--------------------------------------------------|
-//! | `distribution`           | string          | `"beckmann"` | `beckmann` or `ggx` (as in Mitsuba)               |
+//! | `distribution`           | `beckmann` \| `ggx` | `beckmann` | the microfacet distribution (as in Mitsuba)   |
 //! | `alpha`                  | float [1e-4, 10]| 0.1          | roughness (RMS slope for Beckmann); isotropic     |
 //! | `alpha_u`, `alpha_v`     | float [1e-4, 10]| `alpha`      | anisotropic roughness (instead of `alpha`)        |
 //! | `int_ior`                | float or name   | `bk7` (1.5046) | index below the surface (z < 0)                 |

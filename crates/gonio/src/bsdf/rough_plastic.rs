@@ -5,7 +5,7 @@
 //!
 //! | parameter              | type          | default                | meaning                                         |
 //! |------------------------|---------------|------------------------|-------------------------------------------------|
-//! | `distribution`         | string        | `"beckmann"`           | `beckmann` or `ggx`                              |
+//! | `distribution`         | `beckmann` \| `ggx` | `beckmann`       | the microfacet distribution                      |
 //! | `alpha`                | float [1e-4, 10] | 0.1                 | roughness of the coating (isotropic only)        |
 //! | `diffuse_reflectance`  | rgb [0,1]     | 0.5                    | albedo ρ of the Lambertian base                  |
 //! | `specular_reflectance` | rgb [0,1]     | 1                      | multiplier on the glossy reflection (not physical) |

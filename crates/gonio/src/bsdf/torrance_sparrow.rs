@@ -6,11 +6,11 @@
 //!
 //! | parameter              | type             | default     | meaning                                          |
 //! |------------------------|------------------|-------------|--------------------------------------------------|
-//! | `distribution`         | string           | `"blinn"`   | `blinn`, `beckmann` or `ggx`                      |
+//! | `distribution`         | `blinn` \| `beckmann` \| `ggx` | `blinn` | the microfacet distribution            |
 //! | `exponent`             | float [0, 1e8]   | —           | Blinn exponent e (instead of `alpha`; any distribution: α = √(2/(e+2))) |
 //! | `alpha`                | float [1e-4, 10] | 0.1 (e ≈ 198) | roughness                                       |
 //! | `alpha_u`, `alpha_v`   | float [1e-4, 10] | `alpha`     | anisotropic roughness (Beckmann and GGX only)     |
-//! | `shadowing`            | string           | `"vcavity"` | `vcavity`, `smith` (separable), `smith_correlated`, `none` |
+//! | `shadowing`            | `vcavity` \| `smith` \| `smith_correlated` \| `none` | `vcavity` | masking–shadowing: V-cavity, Smith separable or correlated, or none |
 //! | `material`             | string           | `"none"`    | named metal for F; `none` gives F = 1             |
 //! | `eta`, `k`             | rgb ≥ 0          | preset      | complex index η + i k (instead of `material`)     |
 //! | `specular_reflectance` | rgb [0,1]        | 1           | multiplier (not physical)                          |

@@ -183,6 +183,13 @@ pub fn write_image_with_notes(path: &Path, img: &Image, notes: &[(&str, String)]
     write_atomically(path, &bytes)
 }
 
+/// `img` encoded as an 8-bit sRGB PNG file in memory (as [`write_image`] writes `.png`).
+pub fn encode_png(img: &Image) -> Result<Vec<u8>> {
+    let path = Path::new("<PNG in memory>");
+    img.check_shape(path)?;
+    guard(path, || ldr::encode_png(path, img))
+}
+
 /// The text notes of an EXR file's header (its string attributes other than the required ones), sorted
 /// by name; empty for other formats.
 pub fn read_notes(path: &Path) -> Result<Vec<(String, String)>> {

@@ -37,6 +37,16 @@ pub use lobe::{check_theta_o, incidence_direction, lobe_data, perpendicular_dire
 pub use slice::{slice_data, SliceData};
 
 use crate::math::Vec3;
+
+/// The default resolutions of the plots, shared by `gonio plot` and the explorer (one source of numbers):
+/// angles per plane of the polar plot (half-degree steps), the 3-D grid (θ, φ), the slice (MERL's θh × θd)
+/// and the albedo curve (viewing angles, samples per angle).
+pub const POLAR_SAMPLES: usize = 721;
+pub const GRID_THETA: usize = 31;
+pub const GRID_PHI: usize = 72;
+pub const SLICE_RES: usize = 90;
+pub const ALBEDO_ANGLES: usize = 30;
+pub const ALBEDO_SAMPLES: usize = 16_384;
 use crate::spectrum::Rgb;
 
 /// Which number of an RGB value a plot shows.
