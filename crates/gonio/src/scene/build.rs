@@ -179,7 +179,7 @@ fn sampler_from_props(s: &Props, warnings: &mut Vec<String>) -> Result<SamplerSp
             format!("unsupported sampler `{kind}` (gonio has: independent; stratified, multijitter, orthogonal and ldsampler sampled independently)"),
         ));
     }
-    let requested = s.integer_in("sample_count", 4, 1, 1 << 24)? as u32;
+    let requested = s.integer_in("sample_count", 4, 1, i64::from(u32::MAX))? as u32;
     let seed = s.integer_in("seed", 0, 0, i64::MAX)? as u64;
     if matches!(kind, "stratified" | "multijitter" | "orthogonal") {
         let _ = s.bool("jitter", true)?;
@@ -188,7 +188,12 @@ fn sampler_from_props(s: &Props, warnings: &mut Vec<String>) -> Result<SamplerSp
         // Mitsuba builds orthogonal arrays of strength 2 only.
         let _ = s.integer_in("strength", 2, 2, 2)?;
     }
-    let sample_count = mitsuba_sample_count(kind, requested);
+    let sample_count = u32::try_from(mitsuba_sample_count(kind, requested)).map_err(|_| {
+        Error::spec(
+            s.at_param("sample_count"),
+            format!("`{kind}` rounds `sample_count` {requested} up to more than {} samples per pixel", u32::MAX),
+        )
+    })?;
     if kind != "independent" {
         warnings.push(format!(
             "{}: sampler `{kind}` is sampled independently by gonio ({sample_count} spp, as Mitsuba rounds {requested}): \
@@ -203,14 +208,16 @@ fn sampler_from_props(s: &Props, warnings: &mut Vec<String>) -> Result<SamplerSp
 /// The sample count Mitsuba 3.9.1's samplers use for a requested `n` (`Sampler::sample_count()` after
 /// loading): `stratified` ⌈√n⌉², `multijitter` a × ⌈n / a⌉ with a = ⌈√n⌉, `ldsampler` the next power of two,
 /// `orthogonal` p² for the smallest prime p with p² ≥ n (Bose's construction of strength 2).
-fn mitsuba_sample_count(kind: &str, n: u32) -> u32 {
+/// In u64: the rounded count of a `u32` request may not fit a `u32`.
+fn mitsuba_sample_count(kind: &str, n: u32) -> u64 {
+    let n = u64::from(n);
     let root = (1..=n).find(|r| r * r >= n).unwrap_or(1);
     match kind {
         "stratified" => root * root,
         "multijitter" => root * n.div_ceil(root),
         "ldsampler" => n.next_power_of_two(),
         "orthogonal" => {
-            let is_prime = |p: u32| p >= 2 && (2..p).take_while(|d| d * d <= p).all(|d| p % d != 0);
+            let is_prime = |p: u64| p >= 2 && (2..p).take_while(|d| d * d <= p).all(|d| p % d != 0);
             let p = (root..).find(|&p| is_prime(p)).unwrap_or(root);
             p * p
         }
@@ -268,6 +275,8 @@ mod tests {
             ("orthogonal", 10, 25),
             ("orthogonal", 16, 25),
             ("independent", 10, 10),
+            ("independent", u32::MAX, u64::from(u32::MAX)),
+            ("stratified", u32::MAX, 65_536 * 65_536),
         ] {
             assert_eq!(mitsuba_sample_count(kind, n), want, "{kind} {n}");
         }
