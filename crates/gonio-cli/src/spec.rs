@@ -20,6 +20,16 @@ pub fn in_json_file(arg: &str, e: Error) -> Error {
     }
 }
 
+/// The plugin that reads a measured file, by its extension (`.binary`: `merl`; `.bsdf`: Mitsuba's
+/// `measured`, RGL's format), or `None` for any other file.
+pub fn measured_plugin(path: &Path) -> Option<&'static str> {
+    match path.extension().and_then(|e| e.to_str()) {
+        Some("binary") => Some("merl"),
+        Some("bsdf") => Some("measured"),
+        _ => None,
+    }
+}
+
 /// The plugin description named by a command-line argument, not yet built (it may hold textures, which
 /// `gonio::scene::Material` evaluates; a plain `Bsdf` takes none).
 pub fn load_props(arg: &str) -> Result<Props, Error> {
@@ -31,13 +41,7 @@ pub fn load_props(arg: &str) -> Result<Props, Error> {
         return Props::from_xml_bsdf(trimmed, "<argument>");
     }
     let path = Path::new(arg);
-    // Measured data: by extension, through the plugin registry (`merl`, and Mitsuba's `measured`).
-    let plugin = match path.extension().and_then(|e| e.to_str()) {
-        Some("binary") => Some("merl"),
-        Some("bsdf") => Some("measured"),
-        _ => None,
-    };
-    if let Some(plugin) = plugin {
+    if let Some(plugin) = measured_plugin(path) {
         return Props::from_json(&serde_json::json!({"type": plugin, "filename": arg}).to_string());
     }
     let text = std::fs::read_to_string(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;

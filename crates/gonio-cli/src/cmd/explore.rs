@@ -14,7 +14,7 @@
 //! answered 4xx; a panic in a computation is answered 500 by [`Explorer::handle`]: no request stops the
 //! server.
 
-use crate::spec::load_props;
+use crate::spec::{load_props, measured_plugin};
 use crate::stdout::outln;
 use gonio::explore::{Explorer, Reply};
 use gonio::Error;
@@ -71,12 +71,7 @@ fn initial_spec(arg: &str) -> Result<(String, Option<PathBuf>), Error> {
         return Ok((trimmed.to_string(), None));
     }
     let path = Path::new(arg);
-    let plugin = match path.extension().and_then(|e| e.to_str()) {
-        Some("binary") => Some("merl"),
-        Some("bsdf") => Some("measured"),
-        _ => None,
-    };
-    if let Some(plugin) = plugin {
+    if let Some(plugin) = measured_plugin(path) {
         let absolute = path.canonicalize().map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
         let spec = serde_json::json!({"type": plugin, "filename": absolute.display().to_string()}).to_string();
         return Ok((spec, Some(absolute)));
