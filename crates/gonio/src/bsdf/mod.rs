@@ -562,29 +562,39 @@ pub trait Examples {
     const VIOLATIONS: &'static [(&'static str, &'static str)] = &[];
 }
 
-/// Runs `$call` (one model's batch loop, chosen by one `match`) compiled twice: for the baseline target and,
-/// on x86-64 CPUs that have them (detected at run time, so one wheel runs everywhere), with AVX2 and FMA,
-/// whose 8-wide registers the kernels' lanes fill ([`lanes`]). The `match` and the loops it inlines are the
-/// body of a function compiled with those features (`$arg: $ty` are its parameters, named as in `$call`):
-/// a closure would not do, as it is compiled once, for the baseline, and merely called from the feature
-/// function (2026-11: that was the case before, and the AVX2 build held no 256-bit instruction). Both builds
-/// round alike: Rust never fuses a multiply and an add on its own, and `mul_add` is the same exact operation
-/// in hardware and in libm, so the results are the same bit for bit on every path (test
-/// `batches_equal_single_calls`).
+/// Runs `$call` (one model's batch loop, the model chosen by one `match`) compiled twice: for the baseline
+/// target and, on x86-64 CPUs that have them (detected at run time, so one wheel runs everywhere), with AVX2
+/// and FMA, whose 8-wide registers the kernels' lanes fill ([`lanes`]). Each is a function generic over the
+/// model, so every model's loop is its own function, compiled with those features (`$arg: $ty` are its
+/// parameters, named as in `$call`): a closure would not do, as it is compiled once, for the baseline, and
+/// merely called from the feature function (2026-11: that was the case before, and the AVX2 build held no
+/// 256-bit instruction). They are kept out of line: one function holding every model's loops (the `match`
+/// inside the feature function, as this was until 2026-12-04) kept LLVM's loop passes on it for 40
+/// CPU-minutes in the test build. Both builds round alike: Rust never fuses a multiply and an add on its
+/// own, and `mul_add` is the same exact operation in hardware and in libm, so the results are the same bit
+/// for bit on every path (test `batches_equal_single_calls`).
 macro_rules! simd_batch {
     ($self:ident, $m:ident => $call:expr; $($arg:ident: $ty:ty),* => $ret:ty) => {{
         #[cfg(target_arch = "x86_64")]
-        {
-            #[target_feature(enable = "avx2,fma")]
-            unsafe fn with_avx2(b: &Bsdf, $($arg: $ty),*) -> $ret {
-                dispatch!(b, $m => $call)
-            }
-            if std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma") {
-                // SAFETY: the CPU has the features the function is compiled for (checked just above).
-                return unsafe { with_avx2($self, $($arg),*) };
-            }
+        #[target_feature(enable = "avx2,fma")]
+        #[inline(never)]
+        unsafe fn with_avx2<M: BsdfModel>($m: &M, $($arg: $ty),*) -> $ret {
+            $call
         }
-        dispatch!($self, $m => $call)
+        #[inline(never)]
+        fn baseline<M: BsdfModel>($m: &M, $($arg: $ty),*) -> $ret {
+            $call
+        }
+        dispatch!($self, $m => {
+            #[cfg(target_arch = "x86_64")]
+            {
+                if crate::math::avx2::detected() {
+                    // SAFETY: the CPU has the features the function is compiled for (checked just above).
+                    return unsafe { with_avx2($m, $($arg),*) };
+                }
+            }
+            baseline($m, $($arg),*)
+        })
     }};
 }
 

@@ -23,6 +23,7 @@
 
 use super::{emitter_hit, mix, start_lanes, BsdfSampled, CameraSample};
 use crate::bsdf::diffuse::{diffuse_f, diffuse_pdf, diffuse_sample};
+use crate::bsdf::lanes::LaneSample;
 use crate::bsdf::{Bsdf, BsdfModel};
 use crate::geometry::bvh::{bits, groups};
 use crate::geometry::mesh::uniform_triangle_point;
@@ -200,6 +201,27 @@ fn power_heuristic_1(f: Float8, g: Float8) -> Float8 {
 /// with the build before), with 5, 7 and 8 within a percent of that in instructions (8 the most); the Cornell box
 /// (16 % escape) the same within 0.3 %. Images are the same: each path draws from its own stream.
 const MIN_READY: u32 = 6;
+
+/// A model's lane dispatch ([`Bsdf::f_lanes_where`] and friends), out of line: inlined, every model's kernel
+/// (and each composite's copy of them) became part of [`radiance`], and LLVM's SROA pass spent 3.5 minutes
+/// on that one function in every build (2026-12-04). One call per group of lanes per bounce costs nothing
+/// measurable. `Float8` is the build's base lane type, so these compile with the features its code needs.
+#[inline(never)]
+fn f_where(model: &Bsdf, wo: V3<Float8>, wi: V3<Float8>, m: Mask8) -> [Float8; 3] {
+    model.f_lanes_where(wo, wi, m)
+}
+
+/// See [`f_where`].
+#[inline(never)]
+fn pdf_where(model: &Bsdf, wo: V3<Float8>, wi: V3<Float8>, m: Mask8) -> Float8 {
+    model.pdf_lanes_where(wo, wi, m)
+}
+
+/// See [`f_where`].
+#[inline(never)]
+fn sample_where(model: &Bsdf, wo: V3<Float8>, uc: Float8, ux: Float8, uy: Float8, m: Mask8) -> LaneSample<Float8> {
+    model.sample_lanes_where(wo, uc, ux, uy, m)
+}
 
 /// Trace the rays of lanes `lanes` into `hit` (their lanes of it; the others keep theirs), add the emission
 /// they find, and end the paths that escaped or reached the longest length.
@@ -504,11 +526,11 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
                 }
                 let m = Mask8::from_bitmask(lanes);
                 let model = model_of(first);
-                let fk = model.f_lanes_where(wo, wi_local, m);
+                let fk = f_where(model, wo, wi_local, m);
                 for c in 0..3 {
                     f[c] = Float8::select(m, fk[c], f[c]);
                 }
-                let pdf = Float8::select(Mask8::from_bitmask(delta), Float8::splat(0.0), model.pdf_lanes_where(wo, wi_local, m));
+                let pdf = Float8::select(Mask8::from_bitmask(delta), Float8::splat(0.0), pdf_where(model, wo, wi_local, m));
                 bsdf_pdf = Float8::select(m, pdf, bsdf_pdf);
             }
             // Shadow rays where the sample carries light.
@@ -546,7 +568,7 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
         let mut s_delta = 0u32;
         for &(lanes, first) in groups_of {
             let m = Mask8::from_bitmask(lanes);
-            let s = model_of(first).sample_lanes_where(wo, uc, ux, uy, m);
+            let s = sample_where(model_of(first), wo, uc, ux, uy, m);
             s_wi = V3::select(m, s.wi, s_wi);
             for (w, k) in s_weight.iter_mut().zip(s.weight) {
                 *w = Float8::select(m, k, *w);
