@@ -891,7 +891,11 @@ mod tests {
         for n in [9, 100, 5000, 40_000] {
             let boxes = random_boxes(&mut rng, n);
             let prims = |alone: bool| -> Vec<BuildPrim> {
-                boxes.iter().enumerate().map(|(i, b)| BuildPrim { bounds: *b, centroid: b.centroid(), index: i as u32, alone: alone && i % 3 == 0 }).collect()
+                boxes
+                    .iter()
+                    .enumerate()
+                    .map(|(i, b)| BuildPrim { bounds: *b, centroid: b.centroid(), index: i as u32, alone: alone && i % 3 == 0 })
+                    .collect()
             };
             for alone in [false, true] {
                 let serial = Builder::build(&mut prims(alone), usize::MAX);
