@@ -23,6 +23,7 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 
 mod batch;
 mod explore;
+mod fit;
 mod image;
 mod plot;
 mod scene;
@@ -488,6 +489,7 @@ fn _gonio(m: &Bound<'_, PyModule>) -> PyResult<()> {
     image::register(m)?;
     plot::register(m)?;
     explore::register(m)?;
+    fit::register(m)?;
     for (name, bit) in [
         ("FLAG_REFLECTION", BsdfFlags::REFLECTION),
         ("FLAG_TRANSMISSION", BsdfFlags::TRANSMISSION),

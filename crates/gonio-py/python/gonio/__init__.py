@@ -43,12 +43,15 @@ from ._gonio import (
     SceneError,
     SliceData,
     SpecError,
+    develop,
     examples,
+    fit_models,
     load_dict,
     load_scene,
     look_at,
     plugins,
     read_image,
+    scene_files,
     write_image,
 )
 
@@ -66,8 +69,11 @@ __all__ = [
     "SpecError",
     "__version__",
     "albedo_data",
+    "develop",
     "examples",
     "explore",
+    "fit",
+    "fit_models",
     "load_bsdf",
     "load_dict",
     "load_scene",
@@ -76,6 +82,7 @@ __all__ = [
     "plot",
     "plugins",
     "read_image",
+    "scene_files",
     "slice_data",
     "verify",
     "write_image",
@@ -133,6 +140,18 @@ def _to_json(value: _Any) -> _Any:
     if isinstance(value, (tuple, set)):
         return list(value)
     raise TypeError(f"{type(value).__name__} is not a number, string, list or dict")
+
+
+def fit(target: _Any, models: _Sequence[str], strata: int = 12) -> _Any:
+    """Fit each of ``models`` (names from ``fit_models()``) to ``target`` — a ``Bsdf``, a measured file's path
+    (MERL ``.binary``, RGL ``.bsdf``) or anything ``load_bsdf`` takes — as ``gonio fit`` does (the metric of
+    Ngan et al. 2005, Levenberg–Marquardt from several starts). Returns per model a dict: ``model``,
+    ``values``, ``spec`` (JSON text), ``error``, ``relative_error``, ``per_angle``, ``seconds``, and ``xml``,
+    the file ``gonio fit -o`` writes. ``gonio.distributed.fit`` runs many on a Ray cluster."""
+    source = "<bsdf>"
+    if isinstance(target, str) and _gonio.measured_plugin(target):
+        source, target = target, {"type": _gonio.measured_plugin(target), "filename": target}
+    return _gonio.fit(_as_bsdf(target), list(models), strata=strata, source=source)
 
 
 # ---------------------------------------------------------------------------------------------------------

@@ -2,7 +2,7 @@
 
 import enum
 import os
-from typing import Any, List, Mapping, Optional, Sequence, Tuple, Union
+from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -116,6 +116,25 @@ class Scene:
         stderr when it is a terminal (tqdm's widget in Jupyter). The GIL is released; Ctrl-C stops the
         render promptly and raises KeyboardInterrupt.
         """
+    def render_samples(
+        self, first: int, count: int, seed: Optional[int] = None, threads: Optional[int] = None, progress: bool = False
+    ) -> Dict[str, Any]:
+        """The unnormalised sums of the samples first … first + count − 1 of every pixel: `sum` (H, W, 3)
+        float64, `weight` (H, W) float64 or None (box filter), `first`, `spp`, `nonfinite`, `seconds`.
+        Parts of disjoint ranges add up; `develop(sum, weight, spp)` makes the image (docs/distributed.md)."""
+
+def develop(sum: npt.NDArray[np.float64], weight: Optional[npt.NDArray[np.float64]], spp: int) -> npt.NDArray[np.float32]:
+    """The image of summed samples holding `spp` samples per pixel (the development `Scene.render` uses)."""
+
+def scene_files(path: PathLike, **defines: Any) -> List[str]:
+    """The files a Mitsuba 3 XML scene is read from: the file, its includes, then every asset it names."""
+
+def fit(target: Any, models: Sequence[str], strata: int = 12) -> List[Dict[str, Any]]:
+    """Fit each model (`fit_models()`) to `target` (a Bsdf, a measured file's path, or a spec), as `gonio fit`:
+    per model a dict with `model`, `values`, `spec`, `error`, `relative_error`, `per_angle`, `seconds`, `xml`."""
+
+def fit_models() -> List[Tuple[str, str]]:
+    """(name, description) of every model `fit` knows, as `gonio fit --list`."""
 
 def load_scene(path: PathLike, **defines: Any) -> Scene:
     """Load a Mitsuba 3 XML scene; `defines` override `<default>` parameters like `-D name=value`.
