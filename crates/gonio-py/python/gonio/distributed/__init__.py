@@ -83,11 +83,13 @@ def connect(address: Optional[str] = None) -> None:
                 return
             except ConnectionError:
                 pass
+        # On 127.0.0.1: a local instance serves this machine only.
         ray.init(
             address="local",
             object_store_memory=LOCAL_OBJECT_STORE,
             include_dashboard=False,
             log_to_driver=False,
+            _node_ip_address="127.0.0.1",
         )
         return
     ray.init(address=address, log_to_driver=False)
