@@ -87,7 +87,7 @@ def main() -> int:
     load = os.getloadavg()[0]
     # Ray's files in a folder of this run's own (nothing else on the machine finds this cluster).
     temp = tempfile.mkdtemp(prefix="gonio-ray-bench-")
-    os.environ["RAY_TMPDIR"] = temp
+    os.environ["RAY_TMPDIR"] = os.environ["TMPDIR"] = temp
     c = Cluster(initialize_head=True, head_node_args={"num_cpus": 0, "object_store_memory": STORE, "include_dashboard": False,
                                                       "node_ip_address": "127.0.0.1"})
     c.add_node(num_cpus=1, object_store_memory=STORE, node_ip_address="127.0.0.1")

@@ -41,9 +41,11 @@ STORE = 80 * 1024 * 1024  # per node
 def cluster():
     # Ray's files (sessions, logs, sockets, the address file `ray.init()` looks for) in a folder of this
     # test's own, short enough for Unix socket paths, so nothing else on the machine finds this cluster.
-    temp = tempfile.mkdtemp(prefix="gonio-ray-")
-    saved = os.environ.get("RAY_TMPDIR")
-    os.environ["RAY_TMPDIR"] = temp
+    # The workers' temporary files (the scenes they unpack) go there too (TMPDIR): a worker Ray stops
+    # with a signal does not remove its own.
+    temp = tempfile.mkdtemp(prefix="gonio-ray-test-")
+    saved = {k: os.environ.get(k) for k in ("RAY_TMPDIR", "TMPDIR")}
+    os.environ["RAY_TMPDIR"] = os.environ["TMPDIR"] = temp
     c = Cluster(
         initialize_head=True,
         head_node_args={"num_cpus": 0, "object_store_memory": STORE, "include_dashboard": False, "node_ip_address": "127.0.0.1"},
@@ -55,10 +57,11 @@ def cluster():
     yield c
     ray.shutdown()
     c.shutdown()
-    if saved is None:
-        os.environ.pop("RAY_TMPDIR", None)
-    else:
-        os.environ["RAY_TMPDIR"] = saved
+    for k, v in saved.items():
+        if v is None:
+            os.environ.pop(k, None)
+        else:
+            os.environ[k] = v
     shutil.rmtree(temp, ignore_errors=True)
 
 
