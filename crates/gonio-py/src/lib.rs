@@ -26,6 +26,7 @@ mod explore;
 mod fit;
 mod image;
 mod plot;
+mod preview;
 mod scene;
 mod verify;
 
@@ -488,6 +489,7 @@ fn _gonio(m: &Bound<'_, PyModule>) -> PyResult<()> {
     scene::register(m)?;
     image::register(m)?;
     plot::register(m)?;
+    preview::register(m)?;
     explore::register(m)?;
     fit::register(m)?;
     for (name, bit) in [

@@ -198,3 +198,83 @@ def test_cli_render_on_ray(cluster, tmp_path):
     bad = {**os.environ, "GONIO_PYTHON": str(tmp_path / "no-python")}
     p = subprocess.run([str(CLI), "render", str(SCENE), "--ray", "auto"], capture_output=True, text=True, env=bad)
     assert p.returncode == 2 and "GONIO_PYTHON" in p.stderr and "cannot be started" in p.stderr, p.stderr
+
+
+# Previews: one task per grid point; the images are gonio.preview's, bit for bit.
+CONDUCTOR = {"type": "roughconductor", "alpha": 0.2}
+GRID = {"alpha": [0.05, 0.3], "material": ["Au", "Cu"]}
+SPHERE = {"size": 24, "spp": 4, "seed": 3}
+
+
+def test_preview_sweep_equals_the_local_preview(cluster, tmp_path):
+    local = gonio.preview(CONDUCTOR, GRID, light=(1, 1, 1), **SPHERE)
+    r = distributed.preview(CONDUCTOR, GRID, light=(1, 1, 1), **SPHERE, output=tmp_path / "sheet.exr",
+                            output_dir=tmp_path / "spheres", progress=False)
+    assert r.labels == local.labels == ["alpha=0.05, material=Au", "alpha=0.05, material=Cu",
+                                        "alpha=0.3, material=Au", "alpha=0.3, material=Cu"]
+    assert r.points == local.points and r.points[1] == {"alpha": 0.05, "material": "Cu"}
+    assert r.columns == local.columns == 2
+    for a, b in zip(r.images, local.images):
+        assert a.shape == (24, 24, 3) and np.array_equal(a, b)
+    # The grid reaches the model: no two spheres are alike, and each is the sphere of its own spec.
+    assert all(not np.array_equal(r.images[i], r.images[j]) for i in range(4) for j in range(i))
+    alone = gonio.preview({"type": "roughconductor", "alpha": 0.3, "material": "Cu"}, light=(1, 1, 1), **SPHERE)
+    assert alone.labels == [""] and np.array_equal(alone.images[0], r.images[3])
+    # The contact sheet: 2 × 2 spheres with a one-pixel gap; one file per sphere.
+    sheet = gonio.read_image(str(tmp_path / "sheet.exr"))
+    assert sheet.shape == (49, 49, 3) and np.array_equal(sheet, local.sheet())
+    assert np.array_equal(sheet[25:, 25:], r.images[3]) and np.array_equal(sheet[:24, 25:], r.images[1])
+    files = sorted(p.name for p in (tmp_path / "spheres").iterdir())
+    assert files == ["000_alpha=0.05_material=Au.exr", "001_alpha=0.05_material=Cu.exr",
+                     "002_alpha=0.3_material=Au.exr", "003_alpha=0.3_material=Cu.exr"]
+    assert np.array_equal(gonio.read_image(str(tmp_path / "spheres" / files[2])), r.images[2])
+
+
+def test_preview_with_an_environment_file(cluster, tmp_path):
+    # The file is read on the driver and sent as its image; locally it is read from the file.
+    sky = np.random.default_rng(1).uniform(0, 2, (16, 32, 3)).astype(np.float32)
+    gonio.write_image(str(tmp_path / "sky.exr"), sky)
+    xml = '<bsdf type="roughplastic"><float name="alpha" value="0.1"/></bsdf>'
+    local = gonio.preview(xml, {"alpha": [0.1, 0.4]}, env=tmp_path / "sky.exr", size=16, spp=2)
+    r = distributed.preview(xml, {"alpha": [0.1, 0.4]}, env=str(tmp_path / "sky.exr"), size=16, spp=2, progress=False)
+    assert all(np.array_equal(a, b) for a, b in zip(r.images, local.images))
+    assert np.array_equal(gonio.preview(xml, {"alpha": [0.4]}, env=sky, size=16, spp=2).images[0], r.images[1])
+
+
+def test_preview_bad_grid_names_the_parameter(cluster):
+    def error(grid, kind=gonio.SpecError, spec=CONDUCTOR):
+        with pytest.raises(kind) as e:
+            distributed.preview(spec, grid, size=8, spp=1, progress=False)
+        return str(e.value)
+
+    assert "parameter `alpha`: expected a list of values (one sphere each), got a number 0.1" in error({"alpha": 0.1})
+    assert "parameter `material`: expected a list of values" in error({"material": "Au"})
+    assert "parameter `alpha`: expected at least one value" in error({"alpha": []})
+    e = error({"alpha": [0.1, -1]})
+    assert e.startswith("grid alpha=-1: ") and "alpha" in e, e
+    e = error({"alhpa": [0.1]})
+    assert "grid alhpa=0.1: unknown parameter `alhpa` for `roughconductor`" in e and "alpha" in e, e
+    e = error({"material": ["Au", "Xx"]})
+    assert e.startswith("grid point material=Xx: ") and "unknown conductor material `Xx`" in e, e
+    assert "`type` is not a parameter a grid can vary" in error({"type": ["diffuse"]})
+    assert "dict of parameter name" in error([("alpha", [0.1])], TypeError)
+    with pytest.raises(ValueError, match=r"`size` must be an integer in \[1, 4096\], got 0"):
+        distributed.preview(CONDUCTOR, GRID, size=0, progress=False)
+
+
+@pytest.mark.skipif(not CLI.exists(), reason="target/release/gonio not built (make build builds it)")
+def test_cli_preview_on_ray(cluster, tmp_path):
+    env = {**os.environ, "GONIO_PYTHON": sys.executable}
+    args = [str(CLI), "preview", json.dumps(CONDUCTOR), "--grid", "alpha=0.05,0.3", "--grid", "material=Au,Cu", "--light", "1,1,1",
+            "--size", "24", "--spp", "4", "--seed", "3", "--exposure", "-1", "-q"]
+    p = subprocess.run(args + ["-o", str(tmp_path / "here.exr")], capture_output=True, text=True, timeout=60)
+    assert p.returncode == 0, p.stderr
+    p = subprocess.run(args + ["-o", str(tmp_path / "ray.exr"), "--ray", cluster.address], capture_output=True, text=True, env=env,
+                       timeout=120)
+    assert p.returncode == 0, p.stderr
+    here, there = gonio.read_image(str(tmp_path / "here.exr")), gonio.read_image(str(tmp_path / "ray.exr"))
+    assert np.array_equal(here, there)
+    assert np.array_equal(here, gonio.preview(CONDUCTOR, GRID, light=(1, 1, 1), **SPHERE).sheet(exposure=-1))
+    p = subprocess.run(args[:3] + ["--grid", "alpha=0.1,-1", "-o", str(tmp_path / "bad.exr"), "--ray", cluster.address],
+                       capture_output=True, text=True, env=env, timeout=60)
+    assert p.returncode == 2 and "grid alpha=-1" in p.stderr, p.stderr

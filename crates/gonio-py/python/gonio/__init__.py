@@ -2,7 +2,8 @@
 
 Reflection models (BSDFs) with ``f``, ``sample`` and ``pdf``, described with Mitsuba 3's plugin names and
 parameters, evaluated in Rust over numpy arrays; Mitsuba 3 scenes (XML files or scene dictionaries)
-rendered to numpy arrays; images read and written as EXR, PNG or HDR.
+rendered to numpy arrays; lit-sphere previews and parameter sweeps of a material (``preview``); images read
+and written as EXR, PNG or HDR.
 
 Conventions
 -----------
@@ -34,6 +35,7 @@ from typing import Any as _Any, Mapping as _Mapping, Optional as _Optional, Sequ
 
 from . import _gonio, verify
 from .explorer import explore
+from ._preview import PreviewResult, preview
 from ._gonio import (
     AlbedoData,
     Bsdf,
@@ -63,6 +65,7 @@ __all__ = [
     "BsdfFlags",
     "BsdfSample",
     "LobeData",
+    "PreviewResult",
     "Scene",
     "SceneError",
     "SliceData",
@@ -81,6 +84,7 @@ __all__ = [
     "look_at",
     "plot",
     "plugins",
+    "preview",
     "read_image",
     "scene_files",
     "slice_data",

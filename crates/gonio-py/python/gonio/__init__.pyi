@@ -243,3 +243,45 @@ def plot(
 def explore(*models: Any, data: Optional[PathLike] = None, environment: Optional[PathLike] = None, threads: int = 2) -> Any:
     """The explorer as a Jupyter widget (anywidget); ``widget.bsdf`` is the selected model as edited."""
     ...
+
+# Lit-sphere previews (`gonio preview`): one sphere per point of a parameter grid.
+
+class PreviewResult:
+    """The spheres of a preview, one per grid point in row-major order (the last parameter varies fastest)."""
+
+    images: List[npt.NDArray[np.float32]]
+    """(size, size, 3) float32 linear RGB per grid point."""
+    points: List[Dict[str, Any]]
+    """Each image's parameter values, as given in `grid`."""
+    labels: List[str]
+    """`"alpha=0.05, material=Au"` per image ("" without a grid)."""
+    columns: int
+    """Columns of the contact sheet: the number of values of the last parameter (1 without a grid)."""
+    nonfinite: int
+    seconds: float
+    def sheet(self, exposure: float = 0.0) -> npt.NDArray[np.float32]:
+        """The contact sheet (rows of `columns` spheres scaled by 2^exposure, thin dark gaps), as `gonio preview` writes."""
+    def write(
+        self, output: Optional[PathLike] = None, output_dir: Optional[PathLike] = None, exposure: float = 0.0, ext: str = "exr"
+    ) -> List["os.PathLike[str]"]:
+        """Write the contact sheet to `output` and/or each sphere to `output_dir/<index>_<label>.<ext>`."""
+
+def preview(
+    spec: Union[Bsdf, Spec],
+    grid: Optional[Mapping[str, Sequence[Any]]] = None,
+    *,
+    env: Union[None, PathLike, npt.NDArray[np.float32]] = None,
+    light: Optional[Sequence[float]] = None,
+    size: int = 128,
+    spp: int = 64,
+    seed: int = 0,
+    threads: Optional[int] = None,
+    output: Optional[PathLike] = None,
+    output_dir: Optional[PathLike] = None,
+    exposure: float = 0.0,
+    source: str = "<string>",
+) -> PreviewResult:
+    """Lit spheres of a material, one per point of `grid` (e.g. `{"alpha": [0.05, 0.3], "material": ["Au", "Cu"]}`:
+    the product, row-major). `env`: None/"gradient" (the built-in sky), "constant", an image file or array;
+    or `light`, a direction towards a directional light. Raises SpecError/TypeError naming a bad grid
+    parameter before any render. `gonio.distributed.preview` gives the same images on a Ray cluster."""

@@ -7,6 +7,8 @@
 - ``fit(files, models=[...])``: one task per measured file × model; a table, and the best fit of each file
   as a Mitsuba ``<bsdf>`` file.
 - ``check(specs)`` / ``check_all()``: the verification harness of ``gonio check``, one task per model.
+- ``preview(spec, grid={...})``: a parameter sweep of lit spheres, one task per grid point; the images
+  equal ``gonio.preview``'s bit for bit.
 
 ``address`` chooses the cluster: ``None`` (the one this process is connected to, else ``ray.init()``'s
 autodetection, else a new local instance), ``"auto"`` (an existing cluster, e.g. one ``ray start --head``
@@ -42,9 +44,11 @@ from typing import Any, Callable, Dict, Iterator, List, Mapping, Optional, Seque
 import numpy as np
 
 from .. import _gonio, _progress, load_bsdf, load_dict, load_scene, write_image
+from .._preview import Grid, PreviewResult, Settings, Sweep
 
 __all__ = [
     "FitRow",
+    "PreviewResult",
     "RenderResult",
     "TaskError",
     "check",
@@ -52,6 +56,7 @@ __all__ = [
     "connect",
     "fit",
     "fit_table",
+    "preview",
     "render",
 ]
 
@@ -497,3 +502,61 @@ def check_all(samples: int = 1_000_000, sweep: int = 1_000_000, seed: int = 0, a
     rows = check(specs + [s for s, _ in bad], samples, sweep, seed, family, [None] * len(specs) + [k for _, k in bad],
                  address, num_cpus, progress)
     return rows[: len(specs)], rows[len(specs):]
+
+
+# ---------------------------------------------------------------------------------------------------------
+# Previews: a parameter sweep of lit spheres
+
+
+@ray.remote(max_retries=3, retry_exceptions=False)
+def _preview_task(boxed: List[Any], point: int) -> Dict[str, Any]:
+    sweep, lighting, settings = ray.get(boxed[0])
+    start = time.perf_counter()
+    image, nonfinite = sweep.render(point, lighting, settings, threads=_threads())
+    return {"image": image, "nonfinite": nonfinite, "seconds": time.perf_counter() - start,
+            "node": ray.get_runtime_context().get_node_id()}
+
+
+def preview(
+    spec: Any,
+    grid: Grid = None,
+    *,
+    env: Any = None,
+    light: Optional[Sequence[float]] = None,
+    size: int = 128,
+    spp: int = 64,
+    seed: int = 0,
+    output: Optional[Union[str, os.PathLike]] = None,
+    output_dir: Optional[Union[str, os.PathLike]] = None,
+    exposure: float = 0.0,
+    source: str = "<string>",
+    address: Optional[str] = None,
+    num_cpus: int = 1,
+    progress: bool = True,
+) -> PreviewResult:
+    """``gonio.preview`` on a Ray cluster: one task per grid point (sphere), with ``num_cpus`` threads
+    each; the arguments and the result are ``gonio.preview``'s, and so are the images, bit for bit.
+
+    The spec, grid and lighting are checked here (every point's material is built: a bad grid raises
+    ``SpecError`` or ``TypeError`` naming the parameter before anything is sent) and put in the object
+    store once; an environment file is read here and sent as its image. A task that fails raises
+    ``TaskError`` naming its grid point; Ctrl-C cancels the tasks still running.
+    """
+    start = time.perf_counter()
+    settings = Settings(size, spp, seed, exposure)
+    sweep = Sweep.of(spec, grid, source)
+    lighting = _gonio.PreviewLighting(env, None if light is None else tuple(light))
+    if num_cpus < 1:
+        raise ValueError(f"`num_cpus` must be at least 1, got {num_cpus}")
+    connect(address)
+    ref = ray.put((sweep, lighting, settings))
+    refs = [_preview_task.options(num_cpus=num_cpus).remote([ref], i) for i in range(len(sweep.labels))]
+    labels = [f"{source}, grid point {label}" if label else source for label in sweep.labels]
+    results = _run_batch(labels, refs, f"gonio preview (Ray, {len(refs)} tasks)", progress)
+    for r in results:
+        if isinstance(r, TaskError):
+            raise r
+    result = PreviewResult([r["image"] for r in results], sweep.points, sweep.labels, sweep.columns,
+                           sum(r["nonfinite"] for r in results), time.perf_counter() - start)
+    result.write(output, output_dir, exposure)
+    return result

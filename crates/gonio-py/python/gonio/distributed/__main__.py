@@ -3,6 +3,7 @@
     python -m gonio.distributed render SCENE.xml -o out.exr --spp 256 --address auto
     python -m gonio.distributed fit a.bsdf b.bsdf --model ggx --model roughplastic -o fits/ --address auto
     python -m gonio.distributed check --all --address auto
+    python -m gonio.distributed preview '{"type": "roughconductor"}' --grid alpha=0.05,0.3 --grid material=Au,Cu -o s.png
 
 Exit codes as ``gonio``'s: 0 success, 1 a check or fit failed, 2 bad input, 130 interrupted.
 """
@@ -13,10 +14,10 @@ import argparse
 import json
 import sys
 from pathlib import Path
-from typing import List, Optional
+from typing import Any, Dict, List, Optional, Tuple
 
-from . import check, check_all, fit, fit_table, render, TaskError
-from .. import SceneError, SpecError, write_image
+from . import check, check_all, fit, fit_table, preview, render, TaskError
+from .. import SceneError, SpecError, _gonio, write_image
 
 
 def _defines(pairs: List[str]) -> dict:
@@ -93,6 +94,41 @@ def _check(a: argparse.Namespace) -> int:
     return 0 if not failed and not missed else 1
 
 
+def _spec_arg(arg: str) -> Tuple[Any, str]:
+    """A BSDF argument as ``gonio preview`` takes it: JSON or XML text, or a file (JSON, XML, or measured
+    data, read where the spec names it: on every node), and the name of its source."""
+    if arg.lstrip().startswith(("{", "<")):
+        return arg, "<argument>"
+    plugin = _gonio.measured_plugin(arg)
+    if plugin:
+        return {"type": plugin, "filename": arg}, arg
+    return Path(arg).read_text(), arg
+
+
+def _preview(a: argparse.Namespace) -> int:
+    grid: Dict[str, Any] = {}
+    for g in a.grid:
+        name, values = json.loads(_gonio._parse_grid_option(g))
+        if name in grid:
+            raise ValueError(f"--grid {name} is given twice")
+        grid[name] = values
+    light = None
+    if a.light is not None:
+        try:
+            light = tuple(float(v) for v in a.light.split(","))
+        except ValueError:
+            raise ValueError(f"--light expects a direction X,Y,Z of three numbers, got `{a.light}`") from None
+    spec, source = _spec_arg(a.bsdf)
+    r = preview(spec, grid, env=a.env, light=light, size=a.size, spp=a.spp, seed=a.seed, output=a.output,
+                exposure=a.exposure, source=source, address=a.address, num_cpus=a.cpus_per_task, progress=not a.quiet)
+    if r.nonfinite:
+        print(f"gonio: warning: dropped {r.nonfinite} non-finite samples (counted as black)", file=sys.stderr)
+    if not a.quiet:
+        print(f"gonio: {len(r.images)} sphere(s), {a.size}×{a.size} px, {a.spp} spp in {len(r.images)} Ray tasks, "
+              f"{r.seconds:.2f} s → {a.output}", file=sys.stderr)
+    return 0
+
+
 def main(argv: Optional[List[str]] = None) -> int:
     p = argparse.ArgumentParser(prog="python -m gonio.distributed", description="gonio's renders, fits and checks on a Ray cluster")
     p.add_argument("--address", default=None, help="`auto` (an existing cluster), `local` (start one here) or a cluster address")
@@ -121,13 +157,25 @@ def main(argv: Optional[List[str]] = None) -> int:
     c.add_argument("--seed", type=int, default=0)
     c.add_argument("--cpus-per-task", type=int, default=1)
     c.add_argument("-q", "--quiet", action="store_true")
-    for s in (r, f, c):
+    v = sub.add_parser("preview", help="lit spheres of one BSDF swept over a grid, one task per sphere")
+    v.add_argument("bsdf")
+    v.add_argument("-o", "--output", required=True)
+    v.add_argument("--grid", action="append", default=[], metavar="NAME=V1,V2,...")
+    v.add_argument("--env", help="gradient, constant or an environment image (read here)")
+    v.add_argument("--light", metavar="X,Y,Z")
+    v.add_argument("--spp", type=int, default=64)
+    v.add_argument("--size", type=int, default=256)
+    v.add_argument("--seed", type=int, default=0)
+    v.add_argument("--exposure", type=float, default=0.0)
+    v.add_argument("--cpus-per-task", type=int, default=1)
+    v.add_argument("-q", "--quiet", action="store_true")
+    for s in (r, f, c, v):
         s.add_argument("--address", default=argparse.SUPPRESS, help=argparse.SUPPRESS)
     a = p.parse_args(argv)
     if a.command == "check" and bool(a.all) == bool(a.specs):
         p.error("check takes either --all or specs")
     try:
-        return {"render": _render, "fit": _fit, "check": _check}[a.command](a)
+        return {"render": _render, "fit": _fit, "check": _check, "preview": _preview}[a.command](a)
     except KeyboardInterrupt:
         print("gonio: interrupted", file=sys.stderr)
         return 130
