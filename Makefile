@@ -94,7 +94,8 @@ browser:
 # Mitsuba 3 (scalar_rgb, llvm_ad_rgb) on ../shared/scenes with the scaling tables (bench/render_vs_mitsuba.py),
 # the benchmark suite (bench/suite.py: bench/scenes/, time and MSE ratios against llvm_ad_rgb, their
 # geometric mean and worst scene), and the Python package's batched f/pdf/sample against Mitsuba's
-# (bench/python_bsdf_vs_mitsuba.py).
+# (bench/python_bsdf_vs_mitsuba.py), and gonio.distributed's scaling on a local two-node Ray cluster
+# (bench/distributed.py: render and fit efficiency over one node, overhead per task; docs/distributed.md).
 # gonio is timed as `make build` builds it (target/release/gonio, for this machine's CPU, as Mitsuba's
 # llvm_ad_rgb JIT-compiles its kernels for it).
 bench: cli python
@@ -102,6 +103,7 @@ bench: cli python
 	GONIO_BIN=target/release/gonio $(VPY) bench/render_vs_mitsuba.py
 	$(VPY) bench/suite.py --gonio target/release/gonio --json bench/.cache/suite.json
 	$(VPY) bench/python_bsdf_vs_mitsuba.py
+	$(VPY) bench/distributed.py
 
 # The gallery: every picture with the command that made it (docs/gallery/make_gallery.sh; REFIT=1 re-runs
 # `gonio fit` for the measured materials instead of using docs/gallery/fits/*.xml).

@@ -8,6 +8,7 @@
 
 mod cmd;
 mod figure;
+mod ray;
 mod spec;
 mod stdout;
 

@@ -20,15 +20,7 @@ pub fn in_json_file(arg: &str, e: Error) -> Error {
     }
 }
 
-/// The plugin that reads a measured file, by its extension (`.binary`: `merl`; `.bsdf`: Mitsuba's
-/// `measured`, RGL's format), or `None` for any other file.
-pub fn measured_plugin(path: &Path) -> Option<&'static str> {
-    match path.extension().and_then(|e| e.to_str()) {
-        Some("binary") => Some("merl"),
-        Some("bsdf") => Some("measured"),
-        _ => None,
-    }
-}
+pub use gonio::measured::plugin_for_file as measured_plugin;
 
 /// The plugin description named by a command-line argument, not yet built (it may hold textures, which
 /// `gonio::scene::Material` evaluates; a plain `Bsdf` takes none).

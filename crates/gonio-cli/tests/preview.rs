@@ -96,6 +96,11 @@ fn grid_and_several_bsdfs_are_laid_out_in_rows_and_columns() {
     assert_eq!(img.get(16, 5), Rgb::splat(0.02), "the gap");
     ok(&gonio(&["preview", a, b, "--env", "constant", "--size", "16", "--spp", "1", "-o", e]));
     assert_eq!(read_image(&exr).unwrap().width, 33);
+    // Two parameters: their product, a column per value of the last and a row per value of the first.
+    let grid = ["--grid", "alpha=0.05,0.2,0.6", "--grid", "distribution=ggx,beckmann"];
+    ok(&gonio(&[&["preview", a][..], &grid, &["--env", "constant", "--size", "16", "--spp", "1", "-o", e]].concat()));
+    let img = read_image(&exr).unwrap();
+    assert_eq!((img.width, img.height), (33, 50));
 }
 
 #[test]
@@ -110,6 +115,8 @@ fn bad_input_is_one_line_and_exit_code_two() {
         (&["preview", d, "--grid", "reflectance", "-o", p], "NAME=V1,V2"),
         (&["preview", d, "--grid", "reflectance=0.1,,0.2", "-o", p], "empty value"),
         (&["preview", d, "--grid", "reflectance=0.5,2", "-o", p], "[0, 1]"),
+        (&["preview", d, "--grid", "reflectance=0.5", "--grid", "reflectance=0.2", "-o", p], "`reflectance` is given twice"),
+        (&["preview", d, d, "--grid", "reflectance=0.5", "--ray", "auto", "-o", p], "--ray sweeps one BSDF"),
         (&["preview", d, "--light", "1,2", "-o", p], "X,Y,Z"),
         (&["preview", d, "--light", "0,0,0", "-o", p], "non-zero"),
         (&["preview", d, "--env", "/no/such/sky.hdr", "-o", p], "/no/such/sky.hdr"),

@@ -23,8 +23,10 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 
 mod batch;
 mod explore;
+mod fit;
 mod image;
 mod plot;
+mod preview;
 mod scene;
 mod verify;
 
@@ -487,7 +489,9 @@ fn _gonio(m: &Bound<'_, PyModule>) -> PyResult<()> {
     scene::register(m)?;
     image::register(m)?;
     plot::register(m)?;
+    preview::register(m)?;
     explore::register(m)?;
+    fit::register(m)?;
     for (name, bit) in [
         ("FLAG_REFLECTION", BsdfFlags::REFLECTION),
         ("FLAG_TRANSMISSION", BsdfFlags::TRANSMISSION),

@@ -9,7 +9,7 @@
 use crate::{panic_error, run_released};
 use gonio::math::{Transform, Vec3};
 use gonio::scene::{mitsuba_dict, IntegratorKind, Scene};
-use numpy::{PyArray1, PyArrayMethods};
+use numpy::{PyArray1, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::create_exception;
 use pyo3::exceptions::{PyFileNotFoundError, PyIsADirectoryError, PyOSError, PyPermissionError, PyValueError};
 use pyo3::prelude::*;
@@ -113,6 +113,90 @@ pub(crate) struct PyScene {
 }
 
 impl PyScene {
+    fn seed_or_default(&self, seed: Option<i64>) -> PyResult<u64> {
+        match seed {
+            None => Ok(self.scene.sampler.seed),
+            Some(s) => u64::try_from(s).map_err(|_| PyValueError::new_err(format!("`seed` must be non-negative, got {s}"))),
+        }
+    }
+
+    /// Run `job` (a render of `spp` samples per pixel) on a worker thread with its own pool of `threads`,
+    /// while this thread waits without the GIL, redrawing the progress bar and running Python's signal
+    /// handlers (module docs). Any error here (Ctrl-C, or raised by the bar) cancels the job and joins the
+    /// worker before it is returned.
+    fn run<T: Send + 'static>(
+        &self,
+        py: Python<'_>,
+        spp: u32,
+        threads: Option<i64>,
+        progress: bool,
+        job: impl FnOnce(&Scene, &AtomicBool, &(dyn Fn(u64) + Sync)) -> T + Send + 'static,
+    ) -> PyResult<T> {
+        let mut pool = rayon::ThreadPoolBuilder::new();
+        if let Some(n) = threads {
+            let n = usize::try_from(n)
+                .ok()
+                .filter(|&n| n >= 1)
+                .ok_or_else(|| PyValueError::new_err(format!("`threads` must be at least 1, got {n}")))?;
+            pool = pool.num_threads(n);
+        }
+        let pool = pool.build().map_err(|e| PyOSError::new_err(format!("cannot start render threads: {e}")))?;
+        let (w, h) = (self.scene.film.width, self.scene.film.height);
+        let total = u64::from(w) * u64::from(h) * u64::from(spp);
+        let bar = if progress {
+            let b = py.import("gonio._progress")?.getattr("bar")?.call1((total, "gonio render"))?;
+            (!b.is_none()).then_some(b)
+        } else {
+            None
+        };
+
+        let cancel = Arc::new(AtomicBool::new(false));
+        let done = Arc::new(AtomicU64::new(0));
+        let (tx, rx) = mpsc::channel();
+        let worker = {
+            let (scene, cancel, done) = (self.scene.clone(), cancel.clone(), done.clone());
+            std::thread::Builder::new()
+                .name("gonio-render".into())
+                .spawn(move || {
+                    let out =
+                        catch_unwind(AssertUnwindSafe(|| pool.install(|| job(&scene, &cancel, &|d| done.store(d, Ordering::Relaxed)))));
+                    // The receiver is gone only if the caller stopped waiting; nothing to report then.
+                    let _ = tx.send(out);
+                })
+                .map_err(|e| PyOSError::new_err(format!("cannot start the render thread: {e}")))?
+        };
+        let mut rx = rx;
+        let waited: PyResult<_> = (|| loop {
+            // The receiver is `Send` but not `Sync`: move it into the GIL-free closure and back.
+            let (got, back) = py.allow_threads(move || (rx.recv_timeout(POLL), rx));
+            rx = back;
+            match got {
+                Ok(out) => return Ok(out),
+                Err(mpsc::RecvTimeoutError::Timeout) => {}
+                Err(mpsc::RecvTimeoutError::Disconnected) => {
+                    return Err(pyo3::exceptions::PyRuntimeError::new_err(
+                        "internal error in gonio: the render thread ended without a result",
+                    ))
+                }
+            }
+            py.check_signals()?;
+            if let Some(b) = &bar {
+                b.call_method1("update", (done.load(Ordering::Relaxed),))?;
+            }
+        })();
+        if waited.is_err() {
+            cancel.store(true, Ordering::SeqCst);
+        }
+        let _ = py.allow_threads(|| worker.join());
+        let closed = match &bar {
+            Some(b) => b.call_method1("close", (done.load(Ordering::Relaxed),)).map(drop),
+            None => Ok(()),
+        };
+        let out = waited?;
+        closed?;
+        out.map_err(panic_error)
+    }
+
     fn new(py: Python<'_>, scene: Scene, source: String) -> PyResult<PyScene> {
         if !scene.warnings.is_empty() {
             let warn = py.import("warnings")?.getattr("warn")?;
@@ -152,84 +236,60 @@ impl PyScene {
                 .filter(|&s| s >= 1)
                 .ok_or_else(|| PyValueError::new_err(format!("`spp` must be an integer in [1, 2³²), got {s}")))?,
         };
-        let seed = match seed {
-            None => self.scene.sampler.seed,
-            Some(s) => u64::try_from(s).map_err(|_| PyValueError::new_err(format!("`seed` must be non-negative, got {s}")))?,
-        };
-        let mut pool = rayon::ThreadPoolBuilder::new();
-        if let Some(n) = threads {
-            let n = usize::try_from(n)
-                .ok()
-                .filter(|&n| n >= 1)
-                .ok_or_else(|| PyValueError::new_err(format!("`threads` must be at least 1, got {n}")))?;
-            pool = pool.num_threads(n);
-        }
-        let pool = pool.build().map_err(|e| PyOSError::new_err(format!("cannot start render threads: {e}")))?;
+        let seed = self.seed_or_default(seed)?;
+        let out =
+            self.run(py, spp, threads, progress, move |scene, cancel, progress| gonio::render::render(scene, spp, seed, cancel, progress))?;
+        warn_nonfinite(py, out.nonfinite)?;
         let (w, h) = (self.scene.film.width, self.scene.film.height);
-        let total = u64::from(w) * u64::from(h) * u64::from(spp);
-        let bar = if progress {
-            let b = py.import("gonio._progress")?.getattr("bar")?.call1((total, "gonio render"))?;
-            (!b.is_none()).then_some(b)
-        } else {
-            None
-        };
-
-        let cancel = Arc::new(AtomicBool::new(false));
-        let done = Arc::new(AtomicU64::new(0));
-        let (tx, rx) = mpsc::channel();
-        let worker = {
-            let (scene, cancel, done) = (self.scene.clone(), cancel.clone(), done.clone());
-            std::thread::Builder::new()
-                .name("gonio-render".into())
-                .spawn(move || {
-                    let out = catch_unwind(AssertUnwindSafe(|| {
-                        pool.install(|| gonio::render::render(&scene, spp, seed, &cancel, &|d| done.store(d, Ordering::Relaxed)))
-                    }));
-                    // The receiver is gone only if the caller stopped waiting; nothing to report then.
-                    let _ = tx.send(out);
-                })
-                .map_err(|e| PyOSError::new_err(format!("cannot start the render thread: {e}")))?
-        };
-        // Wait for the worker, redrawing the bar and running Python's signal handlers. Any error here
-        // (Ctrl-C from `check_signals`, or raised inside the bar's Python code) cancels the render and
-        // joins the worker before it is returned, so no render keeps running behind the caller's back.
-        let mut rx = rx;
-        let waited: PyResult<_> = (|| loop {
-            // The receiver is `Send` but not `Sync`: move it into the GIL-free closure and back.
-            let (got, back) = py.allow_threads(move || (rx.recv_timeout(POLL), rx));
-            rx = back;
-            match got {
-                Ok(out) => return Ok(out),
-                Err(mpsc::RecvTimeoutError::Timeout) => {}
-                Err(mpsc::RecvTimeoutError::Disconnected) => {
-                    return Err(pyo3::exceptions::PyRuntimeError::new_err(
-                        "internal error in gonio: the render thread ended without a result",
-                    ))
-                }
-            }
-            py.check_signals()?;
-            if let Some(b) = &bar {
-                b.call_method1("update", (done.load(Ordering::Relaxed),))?;
-            }
-        })();
-        if waited.is_err() {
-            cancel.store(true, Ordering::SeqCst);
-        }
-        let _ = py.allow_threads(|| worker.join());
-        let closed = match &bar {
-            Some(b) => b.call_method1("close", (done.load(Ordering::Relaxed),)).map(drop),
-            None => Ok(()),
-        };
-        let out = waited?;
-        closed?;
-        let out = out.map_err(panic_error)?;
-        if out.nonfinite > 0 {
-            let warn = py.import("warnings")?.getattr("warn")?;
-            let message = format!("{} non-finite samples dropped (counted as black)", out.nonfinite);
-            warn.call1((message, py.get_type::<pyo3::exceptions::PyRuntimeWarning>(), 2))?;
-        }
         let image = PyArray1::from_vec(py, out.data).reshape([h as usize, w as usize, 3])?;
         Ok(image.into_any())
+    }
+
+    /// Render the samples with indices `first … first + count − 1` of every pixel and return their sums,
+    /// not divided: a part of a render that adds up with the parts of other ranges (what
+    /// `gonio.distributed.render` runs on each machine). Returns a dict:
+    ///
+    /// - `sum`: float64 array (height, width, 3), the per-pixel sums of the (filter-weighted) samples
+    /// - `weight`: float64 array (height, width) of summed filter weights, or `None` for the box filter
+    /// - `first`, `spp`: the range summed (`spp` < `count` only when interrupted: then Ctrl-C raises
+    ///   `KeyboardInterrupt` as `render` does, so a returned part is always whole)
+    /// - `nonfinite`: samples that were NaN or infinite, dropped (counted as black); `seconds`
+    ///
+    /// Sample k of a pixel is the same in any range, so parts of disjoint ranges added (float64 `+`)
+    /// and developed with `gonio.develop(sum, weight, spp)` give `render(spp, seed)`: bit for bit for the
+    /// range 0 … spp − 1, and to the last bit of the float32 image for any split (docs/distributed.md).
+    #[pyo3(signature = (first, count, seed = None, threads = None, progress = false))]
+    fn render_samples<'py>(
+        &self,
+        py: Python<'py>,
+        first: i64,
+        count: i64,
+        seed: Option<i64>,
+        threads: Option<i64>,
+        progress: bool,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let range =
+            u32::try_from(first).ok().zip(u32::try_from(count).ok()).and_then(|(a, n)| Some(a..a.checked_add(n)?)).ok_or_else(|| {
+                PyValueError::new_err(format!("`first` and `count` must be ≥ 0 with first + count < 2³², got {first} and {count}"))
+            })?;
+        let seed = self.seed_or_default(seed)?;
+        let spp = range.end - range.start;
+        let part = self.run(py, spp, threads, progress, move |scene, cancel, progress| {
+            gonio::render::render_samples(scene, seed, range, cancel, progress)
+        })?;
+        let (w, h) = (part.film.width as usize, part.film.height as usize);
+        let sum: Vec<f64> = part.film.sums().iter().flatten().copied().collect();
+        let out = PyDict::new(py);
+        out.set_item("sum", PyArray1::from_vec(py, sum).reshape([h, w, 3])?)?;
+        match part.film.weights() {
+            Some(wt) => out.set_item("weight", PyArray1::from_slice(py, wt).reshape([h, w])?)?,
+            None => out.set_item("weight", py.None())?,
+        }
+        out.set_item("first", part.first)?;
+        out.set_item("spp", part.spp_done)?;
+        out.set_item("nonfinite", part.nonfinite)?;
+        out.set_item("seconds", part.seconds)?;
+        Ok(out)
     }
 
     /// Image width in pixels (the film's `width`).
@@ -305,16 +365,69 @@ impl PyScene {
     }
 }
 
-/// Load a Mitsuba 3 XML scene file. `defines` override its `<default name=… value=…>` parameters, as
-/// `-D name=value` does on the command line (values are converted with `str`).
+fn warn_nonfinite(py: Python<'_>, nonfinite: u64) -> PyResult<()> {
+    if nonfinite > 0 {
+        let warn = py.import("warnings")?.getattr("warn")?;
+        let message = format!("{nonfinite} non-finite samples dropped (counted as black)");
+        warn.call1((message, py.get_type::<pyo3::exceptions::PyRuntimeWarning>(), 2))?;
+    }
+    Ok(())
+}
+
+/// The image of summed samples (`Scene.render_samples`' `sum` and `weight`, several parts added) holding
+/// `spp` samples per pixel: the box filter's means, or weighted sums over summed weights, as float32
+/// (height, width, 3) — the same development as `Scene.render`'s. `weight` is `None` for the box filter.
+#[pyfunction]
+#[pyo3(signature = (sum, weight, spp))]
+fn develop<'py>(
+    py: Python<'py>,
+    sum: numpy::PyReadonlyArray3<'py, f64>,
+    weight: Option<numpy::PyReadonlyArray2<'py, f64>>,
+    spp: u32,
+) -> PyResult<Bound<'py, PyAny>> {
+    let shape = sum.shape();
+    let (h, w) = (shape[0], shape[1]);
+    if shape[2] != 3 {
+        return Err(PyValueError::new_err(format!("develop: `sum` must have shape (height, width, 3), got {shape:?}")));
+    }
+    if let Some(wt) = &weight {
+        if wt.shape() != [h, w] {
+            return Err(PyValueError::new_err(format!("develop: `weight` must have shape ({h}, {w}), got {:?}", wt.shape())));
+        }
+    }
+    let too_big = || PyValueError::new_err(format!("develop: a {w}×{h} image is larger than a film may be"));
+    let (w32, h32) = (u32::try_from(w).map_err(|_| too_big())?, u32::try_from(h).map_err(|_| too_big())?);
+    let sum = sum.as_array().iter().copied().collect::<Vec<f64>>();
+    let weight = weight.map(|wt| wt.as_array().iter().copied().collect::<Vec<f64>>());
+    let film = gonio::film::Film::from_sums(w32, h32, &sum, weight.as_deref()).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    Ok(PyArray1::from_vec(py, film.mean(spp)).reshape([h, w, 3])?.into_any())
+}
+
+/// The files a Mitsuba 3 XML scene is read from: the scene file, its `<include>`s, then every asset it
+/// names (meshes, images, measured data, spectra), each once. `defines` as for `load_scene`.
 #[pyfunction]
 #[pyo3(signature = (path, **defines))]
-fn load_scene(py: Python<'_>, path: PathBuf, defines: Option<&Bound<'_, PyDict>>) -> PyResult<PyScene> {
+fn scene_files(py: Python<'_>, path: PathBuf, defines: Option<&Bound<'_, PyDict>>) -> PyResult<Vec<PathBuf>> {
+    let overrides = overrides(defines)?;
+    let desc = run_released(py, || gonio::scene::mitsuba_xml::load_file(&path, &overrides))?.map_err(scene_error)?;
+    Ok(desc.files)
+}
+
+fn overrides(defines: Option<&Bound<'_, PyDict>>) -> PyResult<Vec<(String, String)>> {
     let mut overrides = Vec::new();
     for (k, v) in defines.map(|d| d.iter().collect::<Vec<_>>()).unwrap_or_default() {
         let value = if v.is_instance_of::<PyBool>() { v.extract::<bool>()?.to_string() } else { v.str()?.to_string() };
         overrides.push((k.extract::<String>()?, value));
     }
+    Ok(overrides)
+}
+
+/// Load a Mitsuba 3 XML scene file. `defines` override its `<default name=… value=…>` parameters, as
+/// `-D name=value` does on the command line (values are converted with `str`).
+#[pyfunction]
+#[pyo3(signature = (path, **defines))]
+fn load_scene(py: Python<'_>, path: PathBuf, defines: Option<&Bound<'_, PyDict>>) -> PyResult<PyScene> {
+    let overrides = overrides(defines)?;
     let source = path.display().to_string();
     let scene = run_released(py, || Scene::load(&path, &overrides))?.map_err(scene_error)?;
     PyScene::new(py, scene, source)
@@ -373,5 +486,7 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(load_scene, m)?)?;
     m.add_function(wrap_pyfunction!(load_dict, m)?)?;
     m.add_function(wrap_pyfunction!(look_at, m)?)?;
+    m.add_function(wrap_pyfunction!(develop, m)?)?;
+    m.add_function(wrap_pyfunction!(scene_files, m)?)?;
     Ok(())
 }

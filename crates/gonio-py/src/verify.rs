@@ -437,18 +437,43 @@ impl PyReport {
 /// `sample` with `f` and `pdf` (< 1e-4), reciprocity (< 1e-5), albedo and white furnace on each side
 /// (≤ 1 + 1e-3), and the NaN/Inf sweep (0 bad queries). `samples` is per chi-square test, `sweep` the number
 /// of sweep queries; the other sizes are those of `gonio check`, so the same `seed` gives the same figures
-/// as `gonio check --json --seed SEED`. The report is named after the model's spec.
+/// as `gonio check --json --seed SEED`. The report is named after the model's spec. `family` is the
+/// number of chi-square tests the significance is shared among (Šidák): by default this model's
+/// (`chi2_tests(bsdf)`); `gonio check --all` uses the sum over every model it checks.
 #[pyfunction]
-#[pyo3(signature = (bsdf, samples = 1_000_000, sweep = 1_000_000, seed = 0))]
+#[pyo3(signature = (bsdf, samples = 1_000_000, sweep = 1_000_000, seed = 0, family = None))]
 #[pyo3(name = "check")]
-fn py_check(py: Python<'_>, bsdf: &PyBsdf, samples: i64, sweep: i64, seed: i64) -> PyResult<PyReport> {
+fn py_check(py: Python<'_>, bsdf: &PyBsdf, samples: i64, sweep: i64, seed: i64, family: Option<i64>) -> PyResult<PyReport> {
     let samples = at_least_one("samples", samples)?;
     let sweep = at_least_one("sweep", sweep)?;
     let seed = seed_value(seed)?;
-    let cfg = CheckConfig { chi2_samples: samples, sweep_queries: sweep, seed, ..CheckConfig::default() };
+    let family = family.map(|f| at_least_one("family", f)).transpose()?;
+    let cfg = CheckConfig { chi2_samples: samples, sweep_queries: sweep, seed, sidak_family: family, ..CheckConfig::default() };
     let (inner, name) = (&bsdf.bsdf, bsdf.spec.as_str());
     let report = run_released(py, || verify::check_named(inner, name, &cfg))?;
     Ok(PyReport { report })
+}
+
+/// How many chi-square tests `check` runs on `bsdf` (its test directions, on each side it scatters from).
+#[pyfunction]
+#[pyo3(name = "chi2_tests")]
+fn py_chi2_tests(bsdf: &PyBsdf) -> usize {
+    verify::test_directions(&bsdf.bsdf).len()
+}
+
+/// Whether `report` shows the violation `row` that a non-physical model is kept to teach (a row whose
+/// check starts with `row` fails, and every other row passes): `None` when it does, else what went wrong.
+#[pyfunction]
+#[pyo3(name = "expect_violation")]
+fn py_expect_violation(report: &PyReport, row: &str) -> Option<String> {
+    verify::expect_violation(&report.report, row).err()
+}
+
+/// The non-physical example specs `gonio check --all` also runs, each with the check row it must fail.
+#[pyfunction]
+#[pyo3(name = "violations")]
+fn py_violations() -> Vec<(&'static str, &'static str)> {
+    gonio::Bsdf::violations()
 }
 
 /// Add the `verify` submodule to `_gonio`.
@@ -466,5 +491,8 @@ pub(crate) fn register(parent: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(py_scatters_from_below, &m)?)?;
     m.add_function(wrap_pyfunction!(py_sweep, &m)?)?;
     m.add_function(wrap_pyfunction!(py_check, &m)?)?;
+    m.add_function(wrap_pyfunction!(py_chi2_tests, &m)?)?;
+    m.add_function(wrap_pyfunction!(py_expect_violation, &m)?)?;
+    m.add_function(wrap_pyfunction!(py_violations, &m)?)?;
     parent.add_submodule(&m)
 }

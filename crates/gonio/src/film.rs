@@ -236,6 +236,44 @@ impl Film {
         Film { width, height, sum: vec![[0.0; 3]; n], weight: vec![0.0; n] }
     }
 
+    /// A film from sums read back (e.g. a part of a render sent between processes): `sum` has 3 values
+    /// per pixel, row-major; `weight` one per pixel for a weighted film, `None` for the box filter.
+    ///
+    /// # Errors
+    /// When a length does not match the size.
+    pub fn from_sums(width: u32, height: u32, sum: &[f64], weight: Option<&[f64]>) -> Result<Film> {
+        let n = width as usize * height as usize;
+        if sum.len() != 3 * n || weight.is_some_and(|w| w.len() != n) {
+            return Err(Error::spec(
+                "film",
+                format!(
+                    "a {width}×{height} film needs {} sums and {n} weights (or none), got {} and {}",
+                    3 * n,
+                    sum.len(),
+                    weight.map_or_else(|| "none".to_string(), |w| w.len().to_string())
+                ),
+            ));
+        }
+        Ok(Film {
+            width,
+            height,
+            sum: sum.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
+            weight: weight.map(<[f64]>::to_vec).unwrap_or_default(),
+        })
+    }
+
+    /// The per-pixel sums, row-major (see [`Film::from_sums`]).
+    #[must_use]
+    pub fn sums(&self) -> &[[f64; 3]] {
+        &self.sum
+    }
+
+    /// The summed filter weights per pixel; `None` for the box filter.
+    #[must_use]
+    pub fn weights(&self) -> Option<&[f64]> {
+        (!self.weight.is_empty()).then_some(self.weight.as_slice())
+    }
+
     /// Add one sample to pixel `index` (box filter); returns false (and adds nothing) when it is not finite.
     #[inline]
     pub fn add(&mut self, index: usize, v: Rgb) -> bool {

@@ -14,6 +14,9 @@
 //! transport is linear in the emitters): in one scene the integrator would pick one of the two lights per
 //! sample, and the dim ambient would cost half the samples of the bright light — binary noise on the lit side.
 //!
+//! [`Sweep`] renders one material over a grid of its parameters (`gonio preview --grid`, `gonio.preview`,
+//! `gonio.distributed.preview`), and [`contact_sheet`] lays the spheres out.
+//!
 //! ## Geometry
 //! World +y is up, +x to the right of the image, +z towards the camera (the camera sits at (0, 0, 5) and
 //! looks at the origin; the sphere of radius 1 fills the central ~90 % of the frame). The sphere is turned
@@ -47,6 +50,9 @@ use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
+mod sweep;
+pub use sweep::{GridAxis, Sweep, MAX_POINTS};
+
 /// Radiance of the uniform ambient that accompanies a directional light (the unlit side is not pure black).
 pub const AMBIENT: f32 = 0.04;
 
@@ -70,6 +76,26 @@ pub enum Lighting {
     /// A directional light shining from `towards_light` (world space, need not be unit), plus a uniform
     /// `ambient` radiance (0 for none).
     Directional { towards_light: Vec3, ambient: f32 },
+}
+
+impl Lighting {
+    /// The lighting named as `gonio preview --env` names it: `gradient` (the built-in sky), `constant`
+    /// (uniform radiance 1: the white furnace), else a lat-long image file.
+    #[must_use]
+    pub fn environment(name: &str) -> Lighting {
+        match name {
+            "gradient" => Lighting::GradientSky,
+            "constant" => Lighting::Constant(Rgb::ONE),
+            path => Lighting::Environment(PathBuf::from(path)),
+        }
+    }
+
+    /// A directional light shining from `towards_light` with the dim uniform [`AMBIENT`] (`gonio preview
+    /// --light`).
+    #[must_use]
+    pub fn sun(towards_light: Vec3) -> Lighting {
+        Lighting::Directional { towards_light, ambient: AMBIENT }
+    }
 }
 
 /// The sun of the built-in sky: its direction (towards it), angular radius and radiance.
@@ -183,7 +209,7 @@ pub struct PreviewImage {
 /// the module docs). `cancel` stops the render between tiles.
 ///
 /// # Errors
-/// Those of `material` and [`preview_scene`].
+/// Those of `material` and [`preview_scene`]; `spp` 0.
 pub fn render_preview(
     material: &dyn Fn() -> Result<Material>,
     lighting: &Lighting,
@@ -192,6 +218,9 @@ pub fn render_preview(
     seed: u64,
     cancel: &AtomicBool,
 ) -> Result<PreviewImage> {
+    if spp == 0 {
+        return Err(Error::spec("preview", "the samples per pixel must be at least 1"));
+    }
     let parts = match lighting {
         Lighting::Directional { towards_light, ambient } if *ambient > 0.0 => {
             vec![Lighting::Directional { towards_light: *towards_light, ambient: 0.0 }, Lighting::Constant(Rgb::splat(*ambient))]
@@ -244,6 +273,26 @@ pub fn tile(tiles: &[Image], columns: usize, gap: usize, gap_colour: Rgb) -> Res
         }
     }
     Ok(out)
+}
+
+/// Colour of the gaps between the spheres of a contact sheet (a dark grey, apart from a black background).
+const SHEET_GAP: Rgb = Rgb::new(0.02, 0.02, 0.02);
+
+/// A contact sheet: the lit spheres `tiles` (all the same size) in rows of `columns`, scaled by
+/// 2^`exposure`, separated by gaps of 1/64 of a sphere's width (at least a pixel). One tile is that image,
+/// scaled. What `gonio preview` writes, and `gonio.preview(…).sheet()`.
+///
+/// # Errors
+/// Those of [`tile`]; an exposure outside [−30, 30].
+pub fn contact_sheet(tiles: &[Image], columns: usize, exposure: f32) -> Result<Image> {
+    if !(exposure.is_finite() && exposure.abs() <= 30.0) {
+        return Err(Error::spec("preview", format!("the exposure must be in [-30, 30], got {exposure}")));
+    }
+    let scale = exposure.exp2();
+    let scaled: Vec<Image> =
+        tiles.iter().map(|t| Image { width: t.width, height: t.height, data: t.data.iter().map(|v| v * scale).collect() }).collect();
+    let gap = scaled.first().map_or(1, |t| (t.width / 64).max(1));
+    tile(&scaled, columns, gap, SHEET_GAP)
 }
 
 #[cfg(test)]

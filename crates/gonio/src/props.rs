@@ -44,6 +44,15 @@ pub const MAX_NESTING: usize = 64;
 pub const MAX_PARAMETERS: usize = 1024;
 
 impl Value {
+    /// A parameter value from JSON, read as in a plugin description (module docs); `at` locates it in
+    /// messages. A `{"type": "ref"}` is an error here (it needs a scene).
+    ///
+    /// # Errors
+    /// A value of no kind in the table, or a malformed colour or nested plugin.
+    pub fn from_json(v: &serde_json::Value, at: &str) -> Result<Value> {
+        json_value(v, at, None)
+    }
+
     fn kind(&self) -> &'static str {
         match self {
             Value::Number(_) => "a number",

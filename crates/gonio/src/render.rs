@@ -15,6 +15,7 @@ use crate::integrator::{self, CameraSample};
 use crate::scene::Scene;
 use crate::spectrum::Rgb;
 use rayon::prelude::*;
+use std::ops::Range;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::Instant;
 
@@ -36,9 +37,46 @@ pub struct RenderOutput {
     pub seconds: f64,
 }
 
+/// The unnormalised sums of the samples with indices in a range: one part of a render. Parts of disjoint
+/// ranges add up ([`Film::add_tile`] at (0, 0)) to the sums of their union, so a render can be split over
+/// processes or machines (`gonio.distributed`) and developed once with [`Film::mean`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct SampleSums {
+    /// Per-pixel sums (and, for filters other than the box, summed weights).
+    pub film: Film,
+    /// The first sample index of the range.
+    pub first: u32,
+    /// Samples per pixel summed: the indices `first .. first + spp_done` (fewer than asked when cancelled).
+    pub spp_done: u32,
+    /// Samples that were NaN or infinite, dropped (counted as black).
+    pub nonfinite: u64,
+    pub cancelled: bool,
+    pub seconds: f64,
+}
+
 /// Render `spp` samples per pixel with `seed`. `progress(samples_done)` is called after every tile
 /// (samples = pixel samples over the whole image); `cancel` stops the render between tiles.
+/// The image is [`render_samples`] of `0..spp`, developed.
 pub fn render(scene: &Scene, spp: u32, seed: u64, cancel: &AtomicBool, progress: &(dyn Fn(u64) + Sync)) -> RenderOutput {
+    let part = render_samples(scene, seed, 0..spp, cancel, progress);
+    RenderOutput {
+        width: part.film.width,
+        height: part.film.height,
+        data: part.film.mean(part.spp_done),
+        spp_done: part.spp_done,
+        spp_requested: spp,
+        nonfinite: part.nonfinite,
+        cancelled: part.cancelled,
+        seconds: part.seconds,
+    }
+}
+
+/// Sum the samples with indices in `samples` of every pixel, unnormalised (see [`SampleSums`]). Sample `k`
+/// of a pixel is the same whichever range it is rendered in; within the range, passes of growing size
+/// (1, 2, 4, 8, then 16 samples) are summed per tile from zero and added to the film in order, so
+/// `render_samples(0..spp)` is exactly [`render`]'s sums. Sums of other splits of `0..spp` differ from
+/// them only in the order their f64 terms are added (docs/distributed.md).
+pub fn render_samples(scene: &Scene, seed: u64, samples: Range<u32>, cancel: &AtomicBool, progress: &(dyn Fn(u64) + Sync)) -> SampleSums {
     let start = Instant::now();
     let (w, h) = (scene.film.width, scene.film.height);
     let filter = &scene.film.filter;
@@ -47,12 +85,13 @@ pub fn render(scene: &Scene, spp: u32, seed: u64, cancel: &AtomicBool, progress:
     let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE)).flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE))).collect();
     let nonfinite = AtomicU64::new(0);
     let done = AtomicU64::new(0);
+    let spp = samples.end.saturating_sub(samples.start);
     let mut spp_done = 0u32;
     // Passes grow so that early ones show a picture quickly and later ones keep the threads busy.
     let mut pass = 1u32;
     while spp_done < spp && !cancel.load(Ordering::Relaxed) {
         let n = pass.min(spp - spp_done);
-        let first = spp_done;
+        let first = samples.start + spp_done;
         let results: Vec<Option<Film>> = tiles
             .par_iter()
             .map(|&(x0, y0)| {
@@ -113,12 +152,10 @@ pub fn render(scene: &Scene, spp: u32, seed: u64, cancel: &AtomicBool, progress:
         spp_done += n;
         pass = (pass * 2).min(16);
     }
-    RenderOutput {
-        width: w,
-        height: h,
-        data: film.mean(spp_done),
+    SampleSums {
+        film,
+        first: samples.start,
         spp_done,
-        spp_requested: spp,
         nonfinite: nonfinite.load(Ordering::Relaxed),
         cancelled: spp_done < spp,
         seconds: start.elapsed().as_secs_f64(),

@@ -24,6 +24,9 @@ pub struct XmlEnv {
     pub forward_refs: bool,
     /// Things accepted but worth a note (e.g. a `<rotate>` axis that is not of unit length).
     pub warnings: std::cell::RefCell<Vec<String>>,
+    /// Every file [`XmlEnv::resolve_file`] found, in order (a scene's assets: meshes, images, measured
+    /// data, spectra), so that a scene can be shipped with them (`gonio.distributed`).
+    pub files: std::cell::RefCell<Vec<PathBuf>>,
     /// Bytes produced by `$name` substitution so far (checked against [`MAX_SUBSTITUTED_TOTAL`]).
     substituted: Cell<usize>,
 }
@@ -256,13 +259,20 @@ impl XmlEnv {
     /// A file name resolved against the search paths (an absolute name is taken as is).
     pub fn resolve_file(&self, name: &str, at: &str) -> Result<PathBuf> {
         let p = Path::new(name);
-        if p.is_absolute() {
-            return if p.exists() { Ok(p.to_path_buf()) } else { Err(Error::spec(at, format!("file `{name}` does not exist"))) };
-        }
-        self.search_paths.iter().map(|dir| dir.join(p)).find(|c| c.exists()).ok_or_else(|| {
-            let dirs: Vec<String> = self.search_paths.iter().map(|d| d.display().to_string()).collect();
-            Error::spec(at, format!("file `{name}` not found (searched: {})", dirs.join(", ")))
-        })
+        let found = if p.is_absolute() {
+            if p.exists() {
+                Ok(p.to_path_buf())
+            } else {
+                Err(Error::spec(at, format!("file `{name}` does not exist")))
+            }
+        } else {
+            self.search_paths.iter().map(|dir| dir.join(p)).find(|c| c.exists()).ok_or_else(|| {
+                let dirs: Vec<String> = self.search_paths.iter().map(|d| d.display().to_string()).collect();
+                Error::spec(at, format!("file `{name}` not found (searched: {})", dirs.join(", ")))
+            })
+        }?;
+        self.files.borrow_mut().push(found.clone());
+        Ok(found)
     }
 }
 

@@ -32,12 +32,28 @@ pub struct Args {
     /// Random seed.
     #[arg(long, default_value_t = 0)]
     seed: u64,
+    /// With --all: check on a Ray cluster, one task per model: `auto`, `local` or its address (see
+    /// `gonio render --ray`; docs/distributed.md). Histograms of failed tests are not written.
+    #[arg(long, value_name = "ADDRESS", requires = "all", conflicts_with = "sweep_only")]
+    ray: Option<String>,
     /// Folder for the observed/expected histograms of failed chi-square tests.
     #[arg(long, default_value = "gonio-check-histograms")]
     histograms: PathBuf,
 }
 
 pub fn run(args: Args) -> Result<ExitCode, Error> {
+    if let Some(address) = &args.ray {
+        let mut a: Vec<std::ffi::OsString> = vec!["check".into(), "--all".into()];
+        for (name, value) in
+            [("--samples", args.samples.to_string()), ("--sweep", args.sweep.to_string()), ("--seed", args.seed.to_string())]
+        {
+            a.extend([name.into(), value.into()]);
+        }
+        if args.json {
+            a.push("--json".into());
+        }
+        return crate::ray::delegate(address, a);
+    }
     let load = |s: &'static str| Bsdf::from_json(s).map(|b| (s.to_string(), b));
     let models: Vec<(String, Bsdf)> = if args.all {
         Bsdf::examples().into_iter().map(load).collect::<Result<_, _>>()?

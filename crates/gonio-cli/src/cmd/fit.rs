@@ -4,20 +4,22 @@
 
 use crate::spec::load_bsdf;
 use crate::stdout::outln;
-use gonio::fit::{fit, model, pairs, spec_to_xml, MODELS};
+use gonio::fit::{fit, fit_file, model, pairs, MODELS};
 use gonio::Error;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// The BSDF to fit to: a MERL .binary, an RGL .bsdf file, JSON, or an XML file with one <bsdf>.
+    /// The BSDF to fit to: a MERL .binary, an RGL .bsdf file, JSON, or an XML file with one <bsdf>
+    /// (several files with --ray).
     #[arg(required_unless_present = "list")]
-    measured: Option<String>,
+    measured: Vec<String>,
     /// The analytic model (repeat to fit several; the best goes to --output): see --list.
     #[arg(long = "model", required_unless_present = "list")]
     models: Vec<String>,
-    /// The Mitsuba XML file to write the best fit to (written atomically).
+    /// The Mitsuba XML file to write the best fit to (written atomically); with --ray a folder, where the
+    /// best fit of each file goes to <file stem>.xml.
     #[arg(short, long)]
     output: Option<PathBuf>,
     /// Strata per axis of the direction set (θh, θd; 2× for φd): more pairs, slower and finer.
@@ -26,6 +28,10 @@ pub struct Args {
     /// List the models and exit.
     #[arg(long)]
     list: bool,
+    /// Fit on a Ray cluster, one task per file and model: `auto`, `local` or its address (see
+    /// `gonio render --ray`; docs/distributed.md).
+    #[arg(long, value_name = "ADDRESS")]
+    ray: Option<String>,
 }
 
 pub fn run(args: Args) -> Result<ExitCode, Error> {
@@ -37,7 +43,22 @@ pub fn run(args: Args) -> Result<ExitCode, Error> {
     }
     // Resolve every model name before the (slow) fits, so a typo fails at once.
     let models = args.models.iter().map(|name| model(name)).collect::<Result<Vec<_>, _>>()?;
-    let measured = args.measured.unwrap_or_default();
+    if let Some(address) = &args.ray {
+        let mut a: Vec<std::ffi::OsString> = vec!["fit".into()];
+        a.extend(args.measured.iter().map(Into::into));
+        for m in &args.models {
+            a.extend(["--model".into(), m.into()]);
+        }
+        a.extend(["--strata".into(), args.strata.to_string().into()]);
+        if let Some(out) = &args.output {
+            a.extend(["-o".into(), out.clone().into_os_string()]);
+        }
+        return crate::ray::delegate(address, a);
+    }
+    let [measured] = <[String; 1]>::try_from(args.measured).map_err(|files| Error::Spec {
+        at: "command line".into(),
+        message: format!("fit one measured file at a time (got {}), or several with --ray", files.len()),
+    })?;
     let target = load_bsdf(&measured)?;
     let set = pairs(&target, args.strata as usize);
     let mut best: Option<gonio::fit::Fit> = None;
@@ -65,15 +86,7 @@ pub fn run(args: Args) -> Result<ExitCode, Error> {
         }
     }
     if let (Some(path), Some(best)) = (&args.output, &best) {
-        // XML comments may not contain "--": hyphens in the source's name become U+2010.
-        let comment = format!(
-            "<!-- fitted by gonio to {}: model {}, relative error {:.4} (Ngan et al. 2005 metric, {} direction pairs) -->\n",
-            measured.replace('-', "\u{2010}"),
-            best.model,
-            best.relative_error,
-            set.len()
-        );
-        gonio::image::write_atomically(path, (comment + &spec_to_xml(&best.spec, None, 0)).as_bytes())?;
+        gonio::image::write_atomically(path, fit_file(best, &measured, set.len()).as_bytes())?;
         outln!("wrote the best fit ({}) to {}", best.model, path.display());
     }
     Ok(ExitCode::SUCCESS)

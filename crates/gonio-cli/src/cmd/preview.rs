@@ -1,17 +1,16 @@
 //! `gonio preview BSDF... -o sphere.png`: lit spheres rendered by the path tracer (see `gonio::preview`).
 //!
-//! Several BSDFs are laid out side by side; `--grid name=v1,v2,…` renders one sphere per value of one
-//! parameter (a row per BSDF). Lighting: `--env FILE.hdr|FILE.exr|gradient|constant`, or `--light X,Y,Z`
+//! Several BSDFs are laid out side by side; `--grid name=v1,v2,…` renders one sphere per value of a
+//! parameter (repeated: per point of the product, `gonio::preview::Sweep`; a row per BSDF and per
+//! combination of all but the last parameter). `--ray ADDRESS` renders the sweep on a Ray cluster. Lighting: `--env FILE.hdr|FILE.exr|gradient|constant`, or `--light X,Y,Z`
 //! (a directional light from that direction: +x right, +y up, +z towards the viewer, plus a dim ambient).
 //! Without either: `../shared/data/envmaps/venice_sunset_1k.hdr` when it exists, else the built-in sky.
 
 use crate::spec::{in_json_file, load_props};
 use glam::Vec3;
 use gonio::image::write_image;
-use gonio::preview::{render_preview, tile, Lighting, AMBIENT};
-use gonio::props::{Props, Value};
-use gonio::scene::Material;
-use gonio::{Error, Rgb};
+use gonio::preview::{contact_sheet, GridAxis, Lighting, Sweep};
+use gonio::Error;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::atomic::AtomicBool;
@@ -43,9 +42,11 @@ pub struct Args {
     /// Width and height of each sphere's image in pixels.
     #[arg(long, default_value_t = 256)]
     size: u32,
-    /// One sphere per value of a top-level parameter, e.g. `alpha=0.01,0.05,0.1,0.3,0.6`.
+    /// One sphere per value of a top-level parameter, e.g. `alpha=0.01,0.05,0.1,0.3,0.6`; repeat it to
+    /// sweep the product of several (`--grid alpha=0.05,0.3 --grid material=Au,Cu`: a column per value of
+    /// the last, a row per combination of the others).
     #[arg(long, value_name = "NAME=V1,V2,...")]
-    grid: Option<String>,
+    grid: Vec<String>,
     /// Scale the image by 2^EV before writing (e.g. -1 shows a furnace's energy gain below white).
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     exposure: f32,
@@ -58,32 +59,14 @@ pub struct Args {
     /// No summary line.
     #[arg(short, long)]
     quiet: bool,
+    /// Render on a Ray cluster, one task per sphere of the grid: `auto`, `local` or its address (see
+    /// `gonio render --ray`; docs/distributed.md); --threads is then the CPUs of each task.
+    #[arg(long, value_name = "ADDRESS")]
+    ray: Option<String>,
 }
 
 fn arg_error(message: String) -> Error {
     Error::Spec { at: "command line".into(), message }
-}
-
-/// A `--grid` value: a number, a boolean, or else a string (e.g. a distribution name).
-fn grid_value(text: &str) -> Value {
-    match text {
-        "true" => Value::Bool(true),
-        "false" => Value::Bool(false),
-        _ => text.parse::<f64>().map_or_else(|_| Value::String(text.to_string()), Value::Number),
-    }
-}
-
-fn parse_grid(arg: &str) -> Result<(String, Vec<String>), Error> {
-    let (name, values) = arg.split_once('=').ok_or_else(|| arg_error(format!("--grid expects NAME=V1,V2,..., got `{arg}`")))?;
-    let name = name.trim();
-    if name.is_empty() || name.contains('.') {
-        return Err(arg_error(format!("--grid takes a top-level parameter name (no nesting), got `{name}`")));
-    }
-    let values: Vec<String> = values.split(',').map(|v| v.trim().to_string()).collect();
-    if values.iter().any(String::is_empty) {
-        return Err(arg_error(format!("--grid `{arg}` has an empty value")));
-    }
-    Ok((name.to_string(), values))
 }
 
 fn parse_direction(arg: &str) -> Result<Vec3, Error> {
@@ -104,59 +87,75 @@ fn parse_direction(arg: &str) -> Result<Vec3, Error> {
     }
 }
 
+/// The environment `--env` names, or the default; a file that does not exist is an error here.
+fn environment(args: &Args) -> Result<Lighting, Error> {
+    let name = match args.env.as_deref() {
+        Some(name) => name,
+        None if Path::new(DEFAULT_ENV).is_file() => DEFAULT_ENV,
+        None => "gradient",
+    };
+    let lighting = Lighting::environment(name);
+    if let Lighting::Environment(path) = &lighting {
+        if !path.is_file() {
+            return Err(Error::Io {
+                path: path.clone(),
+                source: std::io::Error::new(std::io::ErrorKind::NotFound, "no such environment map (or give `gradient` or `constant`)"),
+            });
+        }
+    }
+    Ok(lighting)
+}
+
 fn lighting(args: &Args) -> Result<Lighting, Error> {
-    if let Some(l) = &args.light {
-        return Ok(Lighting::Directional { towards_light: parse_direction(l)?, ambient: AMBIENT });
+    match &args.light {
+        Some(l) => Ok(Lighting::sun(parse_direction(l)?)),
+        None => environment(args),
     }
-    Ok(match args.env.as_deref() {
-        Some("gradient") => Lighting::GradientSky,
-        Some("constant") => Lighting::Constant(Rgb::ONE),
-        Some(path) => {
-            let path = Path::new(path);
-            if !path.is_file() {
-                return Err(Error::Io {
-                    path: path.to_path_buf(),
-                    source: std::io::Error::new(std::io::ErrorKind::NotFound, "no such environment map (or give `gradient` or `constant`)"),
-                });
-            }
-            Lighting::Environment(path.to_path_buf())
-        }
-        None if Path::new(DEFAULT_ENV).is_file() => Lighting::Environment(PathBuf::from(DEFAULT_ENV)),
-        None => Lighting::GradientSky,
-    })
 }
 
-/// One sphere to render: the BSDF argument it came from (for messages) and its description.
-struct Sphere<'a> {
-    arg: &'a str,
-    props: Props,
+/// The sweep of each BSDF argument over the grid, each point built once here, so that every error shows
+/// before the first render.
+fn sweeps(args: &Args) -> Result<Vec<(&str, Sweep)>, Error> {
+    let axes = args.grid.iter().map(|g| GridAxis::parse(g)).collect::<Result<Vec<_>, _>>()?;
+    args.bsdfs
+        .iter()
+        .map(|arg| {
+            let sweep = Sweep::new(load_props(arg)?, axes.clone())?;
+            sweep.check().map_err(|e| in_json_file(arg, e))?;
+            Ok((arg.as_str(), sweep))
+        })
+        .collect()
 }
 
-/// The materials to render, row by row: each BSDF argument, once per grid value, and the number of columns.
-/// Each is built once here, so that every error shows before the first render.
-fn materials(args: &Args) -> Result<(Vec<Sphere<'_>>, usize), Error> {
-    let grid = args.grid.as_deref().map(parse_grid).transpose()?;
-    let mut out = Vec::new();
-    for arg in &args.bsdfs {
-        let props = load_props(arg)?;
-        let variants = match &grid {
-            None => vec![props],
-            Some((name, values)) => values
-                .iter()
-                .map(|v| {
-                    let mut p = props.clone();
-                    p.set(name, grid_value(v), &format!("--grid {name}={v}"));
-                    p
-                })
-                .collect(),
-        };
-        for p in variants {
-            Material::from_props(&p).map_err(|e| in_json_file(arg, e))?;
-            out.push(Sphere { arg: arg.as_str(), props: p });
-        }
+/// `gonio preview --ray`: the same sweep by `python -m gonio.distributed preview`, one task per sphere.
+fn on_ray(address: &str, args: &Args) -> Result<ExitCode, Error> {
+    let [bsdf] = args.bsdfs.as_slice() else {
+        return Err(arg_error(format!("--ray sweeps one BSDF over --grid (got {} BSDFs)", args.bsdfs.len())));
+    };
+    let mut a: Vec<std::ffi::OsString> = vec!["preview".into(), bsdf.into(), "-o".into(), args.output.clone().into()];
+    for g in &args.grid {
+        a.extend(["--grid".into(), g.into()]);
     }
-    let columns = grid.as_ref().map_or(args.bsdfs.len(), |(_, values)| values.len());
-    Ok((out, columns))
+    // The default environment is chosen here, where `gonio preview` without --ray chooses it.
+    match &args.light {
+        Some(l) => a.extend(["--light".into(), l.into()]),
+        None => match environment(args)? {
+            Lighting::Environment(path) => a.extend(["--env".into(), path.into()]),
+            Lighting::Constant(_) => a.extend(["--env".into(), "constant".into()]),
+            _ => a.extend(["--env".into(), "gradient".into()]),
+        },
+    }
+    for (name, value) in [("--spp", args.spp.to_string()), ("--size", args.size.to_string()), ("--seed", args.seed.to_string())] {
+        a.extend([name.into(), value.into()]);
+    }
+    a.extend(["--exposure".into(), args.exposure.to_string().into()]);
+    if let Some(n) = args.threads {
+        a.extend(["--cpus-per-task".into(), n.to_string().into()]);
+    }
+    if args.quiet {
+        a.push("-q".into());
+    }
+    crate::ray::delegate(address, a)
 }
 
 pub fn run(args: Args) -> Result<ExitCode, Error> {
@@ -173,8 +172,11 @@ pub fn run(args: Args) -> Result<ExitCode, Error> {
     if !args.exposure.is_finite() || args.exposure.abs() > 30.0 {
         return Err(arg_error(format!("--exposure must be in [-30, 30], got {}", args.exposure)));
     }
+    if let Some(address) = &args.ray {
+        return on_ray(address, &args);
+    }
     let lighting = lighting(&args)?;
-    let (materials, columns) = materials(&args)?;
+    let sweeps = sweeps(&args)?;
     if let Some(n) = args.threads {
         // The global pool: a material description is not `Sync`, so the render cannot be moved into a pool.
         rayon::ThreadPoolBuilder::new().num_threads(n).build_global().map_err(|e| arg_error(format!("--threads: {e}")))?;
@@ -182,18 +184,19 @@ pub fn run(args: Args) -> Result<ExitCode, Error> {
 
     let start = std::time::Instant::now();
     let cancel = AtomicBool::new(false);
-    let scale = args.exposure.exp2();
-    let mut tiles = Vec::with_capacity(materials.len());
+    let mut tiles = Vec::new();
     let mut nonfinite = 0;
-    for Sphere { arg, props } in &materials {
-        let material = || Material::from_props(props).map_err(|e| in_json_file(arg, e));
-        let mut out = render_preview(&material, &lighting, args.size, args.spp, args.seed, &cancel)?;
-        nonfinite += out.nonfinite;
-        out.image.data.iter_mut().for_each(|v| *v *= scale);
-        tiles.push(out.image);
+    for (arg, sweep) in &sweeps {
+        for point in 0..sweep.len() {
+            let out = sweep.render(point, &lighting, args.size, args.spp, args.seed, &cancel).map_err(|e| in_json_file(arg, e))?;
+            nonfinite += out.nonfinite;
+            tiles.push(out.image);
+        }
     }
     let count = tiles.len();
-    let image = tile(&tiles, columns, (args.size as usize / 64).max(1), Rgb::splat(0.02))?;
+    // A row per BSDF with a grid (a column per value of its last parameter); the BSDFs side by side without.
+    let columns = if args.grid.is_empty() { sweeps.len() } else { sweeps[0].1.columns() };
+    let image = contact_sheet(&tiles, columns, args.exposure)?;
     write_image(&args.output, &image)?;
     if nonfinite > 0 {
         eprintln!("gonio: warning: dropped {nonfinite} non-finite samples (counted as black)");

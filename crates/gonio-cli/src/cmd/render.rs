@@ -47,6 +47,38 @@ pub struct Args {
     /// No progress bar or summary.
     #[arg(short, long)]
     quiet: bool,
+    /// Render on a Ray cluster: `auto` (an existing one, e.g. started by `ray start --head`), `local` (start
+    /// one here) or its address. Runs gonio's Python package (`pip install "gonio[ray]"`); --threads is then
+    /// the CPUs of each task. See docs/distributed.md.
+    #[arg(long, value_name = "ADDRESS")]
+    ray: Option<String>,
+    /// With --ray: samples per pixel in each task (default: about four tasks per CPU of the cluster).
+    #[arg(long, requires = "ray")]
+    chunk_spp: Option<u32>,
+}
+
+/// `gonio render --ray`: the same arguments for `python -m gonio.distributed render`.
+fn on_ray(address: &str, args: &Args) -> Result<ExitCode, Error> {
+    let mut a: Vec<std::ffi::OsString> = vec!["render".into(), args.scene.clone().into()];
+    let mut opt = |name: &str, value: Option<String>| {
+        if let Some(v) = value {
+            a.push(name.into());
+            a.push(v.into());
+        }
+    };
+    opt("-o", args.output.as_ref().map(|p| p.display().to_string()));
+    opt("--spp", args.spp.map(|v| v.to_string()));
+    opt("--seed", args.seed.map(|v| v.to_string()));
+    opt("--chunk-spp", args.chunk_spp.map(|v| v.to_string()));
+    opt("--cpus-per-task", args.threads.map(|v| v.to_string()));
+    for d in &args.define {
+        a.push("-D".into());
+        a.push(d.into());
+    }
+    if args.quiet {
+        a.push("-q".into());
+    }
+    crate::ray::delegate(address, a)
 }
 
 fn arg_error(message: String) -> Error {
@@ -54,6 +86,9 @@ fn arg_error(message: String) -> Error {
 }
 
 pub fn run(args: Args) -> Result<ExitCode, Error> {
+    if let Some(address) = &args.ray {
+        return on_ray(address, &args);
+    }
     let overrides = args
         .define
         .iter()

@@ -2,7 +2,8 @@
 
 Reflection models (BSDFs) with ``f``, ``sample`` and ``pdf``, described with Mitsuba 3's plugin names and
 parameters, evaluated in Rust over numpy arrays; Mitsuba 3 scenes (XML files or scene dictionaries)
-rendered to numpy arrays; images read and written as EXR, PNG or HDR.
+rendered to numpy arrays; lit-sphere previews and parameter sweeps of a material (``preview``); images read
+and written as EXR, PNG or HDR.
 
 Conventions
 -----------
@@ -34,6 +35,7 @@ from typing import Any as _Any, Mapping as _Mapping, Optional as _Optional, Sequ
 
 from . import _gonio, verify
 from .explorer import explore
+from ._preview import PreviewResult, preview
 from ._gonio import (
     AlbedoData,
     Bsdf,
@@ -43,12 +45,15 @@ from ._gonio import (
     SceneError,
     SliceData,
     SpecError,
+    develop,
     examples,
+    fit_models,
     load_dict,
     load_scene,
     look_at,
     plugins,
     read_image,
+    scene_files,
     write_image,
 )
 
@@ -60,14 +65,18 @@ __all__ = [
     "BsdfFlags",
     "BsdfSample",
     "LobeData",
+    "PreviewResult",
     "Scene",
     "SceneError",
     "SliceData",
     "SpecError",
     "__version__",
     "albedo_data",
+    "develop",
     "examples",
     "explore",
+    "fit",
+    "fit_models",
     "load_bsdf",
     "load_dict",
     "load_scene",
@@ -75,7 +84,9 @@ __all__ = [
     "look_at",
     "plot",
     "plugins",
+    "preview",
     "read_image",
+    "scene_files",
     "slice_data",
     "verify",
     "write_image",
@@ -133,6 +144,18 @@ def _to_json(value: _Any) -> _Any:
     if isinstance(value, (tuple, set)):
         return list(value)
     raise TypeError(f"{type(value).__name__} is not a number, string, list or dict")
+
+
+def fit(target: _Any, models: _Sequence[str], strata: int = 12) -> _Any:
+    """Fit each of ``models`` (names from ``fit_models()``) to ``target`` — a ``Bsdf``, a measured file's path
+    (MERL ``.binary``, RGL ``.bsdf``) or anything ``load_bsdf`` takes — as ``gonio fit`` does (the metric of
+    Ngan et al. 2005, Levenberg–Marquardt from several starts). Returns per model a dict: ``model``,
+    ``values``, ``spec`` (JSON text), ``error``, ``relative_error``, ``per_angle``, ``seconds``, and ``xml``,
+    the file ``gonio fit -o`` writes. ``gonio.distributed.fit`` runs many on a Ray cluster."""
+    source = "<bsdf>"
+    if isinstance(target, str) and _gonio.measured_plugin(target):
+        source, target = target, {"type": _gonio.measured_plugin(target), "filename": target}
+    return _gonio.fit(_as_bsdf(target), list(models), strata=strata, source=source)
 
 
 # ---------------------------------------------------------------------------------------------------------

@@ -2,7 +2,7 @@
 
 import enum
 import os
-from typing import Any, List, Mapping, Optional, Sequence, Tuple, Union
+from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -116,6 +116,25 @@ class Scene:
         stderr when it is a terminal (tqdm's widget in Jupyter). The GIL is released; Ctrl-C stops the
         render promptly and raises KeyboardInterrupt.
         """
+    def render_samples(
+        self, first: int, count: int, seed: Optional[int] = None, threads: Optional[int] = None, progress: bool = False
+    ) -> Dict[str, Any]:
+        """The unnormalised sums of the samples first … first + count − 1 of every pixel: `sum` (H, W, 3)
+        float64, `weight` (H, W) float64 or None (box filter), `first`, `spp`, `nonfinite`, `seconds`.
+        Parts of disjoint ranges add up; `develop(sum, weight, spp)` makes the image (docs/distributed.md)."""
+
+def develop(sum: npt.NDArray[np.float64], weight: Optional[npt.NDArray[np.float64]], spp: int) -> npt.NDArray[np.float32]:
+    """The image of summed samples holding `spp` samples per pixel (the development `Scene.render` uses)."""
+
+def scene_files(path: PathLike, **defines: Any) -> List[str]:
+    """The files a Mitsuba 3 XML scene is read from: the file, its includes, then every asset it names."""
+
+def fit(target: Any, models: Sequence[str], strata: int = 12) -> List[Dict[str, Any]]:
+    """Fit each model (`fit_models()`) to `target` (a Bsdf, a measured file's path, or a spec), as `gonio fit`:
+    per model a dict with `model`, `values`, `spec`, `error`, `relative_error`, `per_angle`, `seconds`, `xml`."""
+
+def fit_models() -> List[Tuple[str, str]]:
+    """(name, description) of every model `fit` knows, as `gonio fit --list`."""
 
 def load_scene(path: PathLike, **defines: Any) -> Scene:
     """Load a Mitsuba 3 XML scene; `defines` override `<default>` parameters like `-D name=value`.
@@ -224,3 +243,45 @@ def plot(
 def explore(*models: Any, data: Optional[PathLike] = None, environment: Optional[PathLike] = None, threads: int = 2) -> Any:
     """The explorer as a Jupyter widget (anywidget); ``widget.bsdf`` is the selected model as edited."""
     ...
+
+# Lit-sphere previews (`gonio preview`): one sphere per point of a parameter grid.
+
+class PreviewResult:
+    """The spheres of a preview, one per grid point in row-major order (the last parameter varies fastest)."""
+
+    images: List[npt.NDArray[np.float32]]
+    """(size, size, 3) float32 linear RGB per grid point."""
+    points: List[Dict[str, Any]]
+    """Each image's parameter values, as given in `grid`."""
+    labels: List[str]
+    """`"alpha=0.05, material=Au"` per image ("" without a grid)."""
+    columns: int
+    """Columns of the contact sheet: the number of values of the last parameter (1 without a grid)."""
+    nonfinite: int
+    seconds: float
+    def sheet(self, exposure: float = 0.0) -> npt.NDArray[np.float32]:
+        """The contact sheet (rows of `columns` spheres scaled by 2^exposure, thin dark gaps), as `gonio preview` writes."""
+    def write(
+        self, output: Optional[PathLike] = None, output_dir: Optional[PathLike] = None, exposure: float = 0.0, ext: str = "exr"
+    ) -> List["os.PathLike[str]"]:
+        """Write the contact sheet to `output` and/or each sphere to `output_dir/<index>_<label>.<ext>`."""
+
+def preview(
+    spec: Union[Bsdf, Spec],
+    grid: Optional[Mapping[str, Sequence[Any]]] = None,
+    *,
+    env: Union[None, PathLike, npt.NDArray[np.float32]] = None,
+    light: Optional[Sequence[float]] = None,
+    size: int = 128,
+    spp: int = 64,
+    seed: int = 0,
+    threads: Optional[int] = None,
+    output: Optional[PathLike] = None,
+    output_dir: Optional[PathLike] = None,
+    exposure: float = 0.0,
+    source: str = "<string>",
+) -> PreviewResult:
+    """Lit spheres of a material, one per point of `grid` (e.g. `{"alpha": [0.05, 0.3], "material": ["Au", "Cu"]}`:
+    the product, row-major). `env`: None/"gradient" (the built-in sky), "constant", an image file or array;
+    or `light`, a direction towards a directional light. Raises SpecError/TypeError naming a bad grid
+    parameter before any render. `gonio.distributed.preview` gives the same images on a Ray cluster."""

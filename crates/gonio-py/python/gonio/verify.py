@@ -42,6 +42,9 @@ energy = _verify.energy
 scatters_from_below = _verify.scatters_from_below
 sweep = _verify.sweep
 check = _verify.check
+chi2_tests = _verify.chi2_tests
+expect_violation = _verify.expect_violation
+violations = _verify.violations
 
 __all__ = [
     "CheckRow",
@@ -52,8 +55,11 @@ __all__ = [
     "SweepResult",
     "check",
     "chi2",
+    "chi2_tests",
     "energy",
+    "expect_violation",
     "reciprocity",
     "scatters_from_below",
     "sweep",
+    "violations",
 ]

@@ -129,5 +129,15 @@ def scatters_from_below(bsdf: Bsdf) -> bool:
 def sweep(bsdf: Bsdf, queries: int = 1_000_000, seed: int = 0) -> SweepResult:
     """Query f, pdf and sample with random and degenerate inputs; count non-finite or negative outputs."""
 
-def check(bsdf: Bsdf, samples: int = 1_000_000, sweep: int = 1_000_000, seed: int = 0) -> Report:
-    """Every check of `gonio check`, with the same figures for the same seed."""
+def check(bsdf: Bsdf, samples: int = 1_000_000, sweep: int = 1_000_000, seed: int = 0, family: Optional[int] = None) -> Report:
+    """Every check of `gonio check`, with the same figures for the same seed; `family`: the chi-square
+    tests sharing the significance (Šidák; default: this model's, `chi2_tests(bsdf)`)."""
+
+def chi2_tests(bsdf: Bsdf) -> int:
+    """How many chi-square tests `check` runs on `bsdf`."""
+
+def expect_violation(report: Report, row: str) -> Optional[str]:
+    """None when `report` shows the violation `row` (and nothing else fails), else what went wrong."""
+
+def violations() -> List[Tuple[str, str]]:
+    """The non-physical example specs `gonio check --all` runs, each with the row it must fail."""

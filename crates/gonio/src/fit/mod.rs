@@ -275,6 +275,20 @@ pub fn fit(model: &'static FitModel, pairs: &[Pair]) -> Result<Fit> {
     })
 }
 
+/// A fit as the Mitsuba XML file `gonio fit -o` writes: a comment naming the measured `source`, the model,
+/// its relative error and the number of direction pairs, then the `<bsdf>` element.
+#[must_use]
+pub fn fit_file(fit: &Fit, source: &str, pairs: usize) -> String {
+    // XML comments may not contain "--": hyphens in the source's name become U+2010.
+    let comment = format!(
+        "<!-- fitted by gonio to {}: model {}, relative error {:.4} (Ngan et al. 2005 metric, {pairs} direction pairs) -->\n",
+        source.replace('-', "\u{2010}"),
+        fit.model,
+        fit.relative_error,
+    );
+    comment + &spec_to_xml(&fit.spec, None, 0)
+}
+
 /// A spec (Mitsuba's dictionary form, as the fitted models make them) as a Mitsuba XML `<bsdf>` element.
 #[must_use]
 pub fn spec_to_xml(spec: &Value, name: Option<&str>, indent: usize) -> String {

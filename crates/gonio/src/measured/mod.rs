@@ -12,6 +12,17 @@ pub mod tensor_file;
 
 pub use merl_file::{Interpolation, MerlTable};
 
+/// The plugin that reads a measured file, by its extension (`.binary`: `merl`; `.bsdf`: Mitsuba's
+/// `measured`, RGL's format), or `None` for any other file.
+#[must_use]
+pub fn plugin_for_file(path: &std::path::Path) -> Option<&'static str> {
+    match path.extension().and_then(|e| e.to_str()) {
+        Some("binary") => Some("merl"),
+        Some("bsdf") => Some("measured"),
+        _ => None,
+    }
+}
+
 /// Tables shared by the tests: generating one costs 1.46 M evaluations of f, so each is made once.
 #[cfg(test)]
 pub(crate) mod fixtures {

@@ -39,6 +39,9 @@ pub struct SceneDescription {
     pub source: String,
     /// Things accepted but worth a note, found while reading (see [`XmlEnv::warnings`]).
     pub warnings: Vec<String>,
+    /// The files the scene was read from: the scene file, its `<include>`s, then every asset it names
+    /// (meshes, images, measured data, spectra), each once, in the order first read.
+    pub files: Vec<PathBuf>,
 }
 
 /// Parse a scene file; `overrides` are `-D name=value` pairs that take precedence over `<default>`s.
@@ -99,6 +102,11 @@ impl Loader {
             }
         }
         self.desc.warnings = self.env.warnings.take();
+        for f in self.env.files.take() {
+            if !self.desc.files.contains(&f) {
+                self.desc.files.push(f);
+            }
+        }
         Ok(self.desc)
     }
 
@@ -112,6 +120,7 @@ impl Loader {
             return Err(Error::spec(included_at.unwrap_or("?"), format!("`{}` includes itself", path.display())));
         }
         self.stack.push(canonical);
+        self.desc.files.push(path.to_path_buf());
         // A bare file name has the parent "", which would print as an empty search path.
         let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).map_or_else(|| PathBuf::from("."), Path::to_path_buf);
         let result = self.document(&text, &path.display().to_string(), &dir);
