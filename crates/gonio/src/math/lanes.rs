@@ -4,7 +4,7 @@
 //! |-------------|-------------------------------------------------------------------------------------|
 //! | [`Real`]    | the arithmetic a formula needs: + − × ÷, √, fused multiply–add, min/max, comparisons into a mask, `select`, a table lookup |
 //! | `f32`       | one lane; its mask is `bool` and `select` a branch — the renderer's single calls      |
-//! | [`F32x8`]   | eight lanes as plain Rust: each operation a loop over the lanes, for CPUs without AVX2 (and other architectures) |
+//! | [`F32x8`]   | eight lanes as plain Rust: each operation written out per lane, for CPUs without AVX2 (and other architectures) |
 //! | `avx2::Avx8`, `avx512::Avx16` | eight or sixteen lanes in one AVX / AVX-512 register, each operation its instruction; what the batch drivers run on where the CPU has them (crate-private unless the build enables AVX2 and FMA: see `math::avx2`) |
 //! | `simd::Float8` | the renderer's eight lanes, chosen at compile time: `Avx8` itself where the build enables AVX2 and FMA, else two SSE registers (or an array) |
 //! | `twice::Twice<R>` | two registers of `R` as one, their operations alternating (two dependency chains in flight): the AVX-512 drivers run `Twice<Twice<Avx16>>` |
@@ -224,14 +224,58 @@ pub struct F32x8(pub [f32; 8]);
 #[repr(C, align(32))]
 pub struct M32x8(pub [i32; 8]);
 
-/// `F32x8` from `f(lane index)`, as a loop the compiler unrolls and vectorises.
+/// `F32x8` (or `M32x8`) from an expression of the lane index `i`, written out once per lane: `[e(0), …,
+/// e(7)]`. Not a loop: a loop per operation leaves LLVM one loop to rotate and unroll per operation, and a
+/// kernel inlined into a batch driver holds thousands of operations; its loop passes grew with the
+/// function's size times its number of loops (2026-12-05: 10 of the 16 CPU-minutes of the library's test
+/// build went to `LoopRotate` and `LoopFullUnroll` on the `F32x8` copies of the composites' batch loops).
+/// The SLP vectoriser makes vector instructions of the eight expressions as it did of the unrolled loop.
 macro_rules! lanes {
-    ($t:ident, |$i:ident| $e:expr) => {{
-        let mut r = $t([Default::default(); 8]);
-        for $i in 0..8 {
-            r.0[$i] = $e;
-        }
-        r
+    (|$i:ident| $e:expr) => {
+        [
+            {
+                let $i: usize = 0;
+                $e
+            },
+            {
+                let $i: usize = 1;
+                $e
+            },
+            {
+                let $i: usize = 2;
+                $e
+            },
+            {
+                let $i: usize = 3;
+                $e
+            },
+            {
+                let $i: usize = 4;
+                $e
+            },
+            {
+                let $i: usize = 5;
+                $e
+            },
+            {
+                let $i: usize = 6;
+                $e
+            },
+            {
+                let $i: usize = 7;
+                $e
+            },
+        ]
+    };
+    ($t:ident, |$i:ident| $e:expr) => {
+        $t(lanes!(|$i| $e))
+    };
+}
+
+/// Runs `$s` for the lane indices 0 to 7, written out (not a loop; see [`lanes!`]).
+macro_rules! each_lane {
+    (|$i:ident| $s:expr) => {{
+        let _: [(); 8] = lanes!(|$i| $s);
     }};
 }
 
@@ -385,19 +429,21 @@ impl Real for F32x8 {
     }
     #[inline(always)]
     fn any(m: M32x8) -> bool {
-        m.0.iter().fold(0, |acc, &v| acc | v) != 0
+        let v = m.0;
+        (v[0] | v[1] | v[2] | v[3] | v[4] | v[5] | v[6] | v[7]) != 0
     }
     #[inline(always)]
     fn lane(self, i: usize) -> f32 {
         self.0[i]
     }
     #[inline(always)]
-    fn from_fn(f: impl FnMut(usize) -> f32) -> Self {
-        F32x8(std::array::from_fn(f))
+    fn from_fn(mut f: impl FnMut(usize) -> f32) -> Self {
+        lanes!(F32x8, |i| f(i))
     }
     #[inline(always)]
     fn bitmask(m: M32x8) -> u64 {
-        (0..8).fold(0, |b, i| b | u64::from(m.0[i] != 0) << i)
+        let b: [u64; 8] = lanes!(|i| u64::from(m.0[i] != 0) << i);
+        b[0] | b[1] | b[2] | b[3] | b[4] | b[5] | b[6] | b[7]
     }
 }
 
@@ -563,23 +609,17 @@ impl Rows for F32x8 {
     #[inline(always)]
     fn store3(x: Self, y: Self, z: Self, out: &mut [[f32; 3]]) {
         let out: &mut [[f32; 3]; 8] = out.try_into().expect("eight rows");
-        for (l, r) in out.iter_mut().enumerate() {
-            *r = [x.0[l], y.0[l], z.0[l]];
-        }
+        each_lane!(|l| out[l] = [x.0[l], y.0[l], z.0[l]]);
     }
     #[inline(always)]
     fn store_u32(self, out: &mut [u32]) {
         let out: &mut [u32; 8] = out.try_into().expect("eight numbers");
-        for (l, o) in out.iter_mut().enumerate() {
-            *o = self.0[l] as u32;
-        }
+        each_lane!(|l| out[l] = self.0[l] as u32);
     }
     #[inline(always)]
     fn store_mask(m: M32x8, out: &mut [bool]) {
         let out: &mut [bool; 8] = out.try_into().expect("eight flags");
-        for (l, o) in out.iter_mut().enumerate() {
-            *o = m.get(l);
-        }
+        each_lane!(|l| out[l] = m.get(l));
     }
 }
 
