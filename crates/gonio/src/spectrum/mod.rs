@@ -1,7 +1,9 @@
-//! Colour: linear RGB now ([`Rgb`]), named optical constants of metals and dielectrics ([`named`]).
+//! Colour and spectra: linear RGB ([`Rgb`]), named optical constants ([`named`]), the CIE 1931 observer
+//! ([`cie`]), and the building blocks of spectral mode — hero-wavelength sampling ([`wavelengths`]).
 
 pub mod cie;
 pub mod named;
 pub mod rgb;
+pub mod wavelengths;
 
 pub use rgb::Rgb;
