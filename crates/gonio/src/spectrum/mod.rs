@@ -1,8 +1,11 @@
 //! Colour and spectra: linear RGB ([`Rgb`]), named optical constants ([`named`]), the CIE 1931 observer
-//! ([`cie`]), and the building blocks of spectral mode — hero-wavelength sampling ([`wavelengths`]).
+//! ([`cie`]), and the building blocks of spectral mode — hero-wavelength sampling ([`wavelengths`]),
+//! tabulated spectra ([`piecewise`]) and wavelength-dependent indices of refraction ([`dispersion`]).
 
 pub mod cie;
+pub mod dispersion;
 pub mod named;
+pub mod piecewise;
 pub mod rgb;
 pub mod wavelengths;
 
