@@ -14,14 +14,14 @@ use gonio::spectrum::wavelengths::{
 ///   [print(u, *map(float, mi.sample_rgb_spectrum(u))) for u in [0.0, 0.05, 0.25, 0.5, 0.75, 0.9, 1.0]]"
 /// ```
 /// (at u = 1 Mitsuba returns 830.00006, one ulp past the range; gonio clamps to 830).
-const MITSUBA_SAMPLES: &[(f32, f32, f32)] = &[
+const MITSUBA_SAMPLES: &[(f32, f64, f64)] = &[
     (0.0, 360.0, 955.272_888_183_593_8),
     (0.05, 397.798_248_291_015_6, 613.157_897_949_218_8),
     (0.25, 479.154_052_734_375, 302.176_818_847_656_25),
     (0.5, 545.903_015_136_718_8, 254.642_715_454_101_56),
     (0.75, 616.856_201_171_875, 344.819_091_796_875),
     (0.9, 686.015_869_140_625, 669.168_762_207_031_2),
-    (1.0, 830.0, 4379.801_269_531_25),
+    (1.0, 830.0, 4_379.801_269_531_25),
 ];
 
 /// Mitsuba 3.9.1: (λ, pdf) from `mi.pdf_rgb_spectrum(λ)` (same variant).
@@ -40,9 +40,10 @@ fn matches_mitsuba() {
     for &(u, lambda, inv_pdf) in MITSUBA_SAMPLES {
         let got = sample_visible_wavelength(u);
         // f32 atanh in both; near u = 1 one ulp of the argument moves λ by ~0.01 nm.
-        assert!((got - lambda).abs() < 2e-3 * (1.0 + (u - 0.5).abs() * 10.0), "u = {u}: {got} vs {lambda}");
+        let tolerance = 2e-3 * (1.0 + f64::from((u - 0.5).abs()) * 10.0);
+        assert!((f64::from(got) - lambda).abs() < tolerance, "u = {u}: {got} vs {lambda}");
         let pdf = f64::from(visible_wavelength_pdf(got));
-        assert!((pdf * f64::from(inv_pdf) - 1.0).abs() < 2e-4, "u = {u}: 1/pdf {} vs {inv_pdf}", 1.0 / pdf);
+        assert!((pdf * inv_pdf - 1.0).abs() < 2e-4, "u = {u}: 1/pdf {} vs {inv_pdf}", 1.0 / pdf);
     }
     for &(lambda, want) in MITSUBA_PDF {
         let got = f64::from(visible_wavelength_pdf(lambda));
@@ -130,17 +131,18 @@ fn four_rotated_wavelengths() {
     for uc in [0.0_f32, 0.1, 0.249, 0.25, 0.5, 0.8, 0.999_999, 1.0] {
         let u = rotated_samples(uc);
         assert_eq!(u[0], uc);
-        for i in 0..N_WAVELENGTHS {
-            assert!((0.0..=1.0).contains(&u[i]), "{uc}: {u:?}");
+        for (i, &ui) in u.iter().enumerate() {
+            assert!((0.0..=1.0).contains(&ui), "{uc}: {u:?}");
             // Equally spaced by 1/4 modulo 1.
-            let d = (u[i] - uc - i as f32 * 0.25).rem_euclid(1.0);
-            assert!(d < 1e-6 || d > 1.0 - 1e-6, "{uc}: {u:?}");
+            let d = (ui - uc - i as f32 * 0.25).rem_euclid(1.0);
+            assert!(!(1e-6..=1.0 - 1e-6).contains(&d), "{uc}: {u:?}");
         }
         let swl = SampledWavelengths::sample_visible(uc);
-        for i in 0..N_WAVELENGTHS {
-            assert_eq!(swl.lambda()[i], sample_visible_wavelength(u[i]));
-            assert_eq!(swl.pdf()[i], visible_wavelength_pdf(swl.lambda()[i]));
-            assert!(swl.pdf()[i] > 0.0);
+        assert_eq!(swl.lambda().len(), N_WAVELENGTHS);
+        for ((&ui, lambda), pdf) in u.iter().zip(swl.lambda()).zip(swl.pdf()) {
+            assert_eq!(lambda, sample_visible_wavelength(ui));
+            assert_eq!(pdf, visible_wavelength_pdf(lambda));
+            assert!(pdf > 0.0);
         }
         let uniform = SampledWavelengths::sample_uniform(uc);
         assert_eq!(uniform.lambda()[2], sample_uniform_wavelength(u[2]));
