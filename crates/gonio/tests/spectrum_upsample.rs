@@ -66,7 +66,8 @@ fn gamut_colours() -> Vec<Rgb> {
 fn round_trip_over_the_gamut_within_1e_3() {
     let table = srgb_table();
     let colours = gamut_colours();
-    let (mut worst_fit, mut worst_fetch, mut worst_colour) = (0.0_f64, 0.0_f64, Rgb::ZERO);
+    let (mut worst_fit, mut worst_colour) = (0.0_f64, Rgb::ZERO);
+    let mut fetch_errors = Vec::with_capacity(colours.len());
     let start = Instant::now();
     let fits: Vec<SigmoidPolynomial> = colours.iter().map(|&rgb| table.fit(rgb)).collect();
     let fit_time = start.elapsed();
@@ -76,15 +77,21 @@ fn round_trip_over_the_gamut_within_1e_3() {
             (worst_fit, worst_colour) = (error, rgb);
         }
         let fetched = table.fetch(rgb);
-        worst_fetch = worst_fetch.max(max_abs_error(reference_srgb(|l| fetched.eval(l)), rgb.to_f64()));
+        fetch_errors.push(max_abs_error(reference_srgb(|l| fetched.eval(l)), rgb.to_f64()));
     }
+    fetch_errors.sort_by(f64::total_cmp);
+    let worst_fetch = fetch_errors[fetch_errors.len() - 1];
+    let median_fetch = fetch_errors[fetch_errors.len() / 2];
     eprintln!(
-        "{} colours: worst round trip after fit {worst_fit:.3e} (at {worst_colour}), table lookup alone {worst_fetch:.3e}; \
-         fit {:.2} µs per colour",
+        "{} colours: worst round trip after fit {worst_fit:.3e} (at {worst_colour}); table lookup alone: worst {worst_fetch:.3e}, \
+         median {median_fetch:.3e}; fit {:.2} µs per colour",
         colours.len(),
         fit_time.as_secs_f64() * 1e6 / colours.len() as f64
     );
     assert!(worst_fit < 1e-3, "worst round-trip error {worst_fit} at {worst_colour}");
+    // The lookup alone interpolates coefficients that grow without bound towards white; observed worst
+    // 6.1e-3 (near-white colours), median 4e-4. A guard against a broken table, not a specification.
+    assert!(worst_fetch < 2e-2 && median_fetch < 2e-3, "table lookup: worst {worst_fetch}, median {median_fetch}");
 }
 
 #[test]
@@ -120,6 +127,8 @@ fn table_build_is_fast_and_deterministic() {
         rayon::current_num_threads()
     );
     assert_eq!(&table, srgb_table());
+    // First use must stay short (0.75 s measured on one core); generous for a loaded machine.
+    assert!(elapsed.as_secs_f64() < 20.0, "table build took {elapsed:?}");
 }
 
 #[test]

@@ -41,9 +41,9 @@ const VISIBLE_K: f32 = 0.0072;
 /// λ₀, the centre of the visible-importance density, in nm.
 const VISIBLE_CENTER: f32 = 538.0;
 /// t₀ = tanh(k (360 − 538)), in f64: −0.856910625469828.
-pub(crate) const VISIBLE_T0: f64 = -0.856_910_625_469_828;
+const VISIBLE_T0: f64 = -0.856_910_625_469_828;
 /// t₁ − t₀ = tanh(k (830 − 538)) − t₀, in f64: 1.8275019724100978.
-pub(crate) const VISIBLE_T_RANGE: f64 = 1.827_501_972_410_097_8;
+const VISIBLE_T_RANGE: f64 = 1.827_501_972_410_097_8;
 /// A = k / (t₁ − t₀), the density's normalisation, in nm⁻¹.
 #[allow(clippy::cast_possible_truncation)] // the f32 rounding of the f64 constant is intended
 const VISIBLE_NORM: f32 = (0.0072 / VISIBLE_T_RANGE) as f32;
