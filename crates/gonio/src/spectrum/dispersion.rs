@@ -172,7 +172,7 @@ pub enum Ior {
 const SELLMEIER_GLASSES: &[(&str, &[f64], &[f64])] = &[
     // Schott N-BK7.
     ("bk7", &[1.039_612_12, 0.231_792_344, 1.010_469_45], &[0.006_000_698_67, 0.020_017_914_4, 103.560_653]),
-    // Malitson 1965, eq. (1) of the paper: resonance wavelengths 0.0684043, 0.1162414, 9.896161 µm, squared.
+    // Malitson 1965, his three-term law: resonance wavelengths 0.0684043, 0.1162414, 9.896161 µm, squared.
     (
         "fused silica",
         &[0.696_166_3, 0.407_942_6, 0.897_479_4],

@@ -1,7 +1,7 @@
 //! RGB → spectrum: the sigmoid-polynomial upsampling of W. Jakob and J. Hanika, "A Low-Dimensional
 //! Function Space for Efficient Spectral Upsampling", Computer Graphics Forum 38(2) (Eurographics 2019).
 //!
-//! A colour becomes the smooth spectrum (the paper's eqs. 2–3)
+//! A colour becomes the smooth spectrum (the paper's quadratic polynomial through its algebraic sigmoid)
 //!
 //! ```text
 //! s(λ) = S(c₀ λ² + c₁ λ + c₂),   S(x) = 1/2 + x / (2 √(1 + x²)),   λ in nm,
@@ -20,7 +20,8 @@
 //! Gauss–Legendre rule, 3 nodes on each 5 nm interval of the CIE and D65 tables (282 nodes; exact where
 //! s is a cubic across 5 nm, the product of the two tables being quadratic there).
 //!
-//! **gonio's table** ([`RgbToSpectrumTable`]) is built by gonio's own solver, the paper's scheme (its §4):
+//! **gonio's table** ([`RgbToSpectrumTable`]) is built by gonio's own solver, following the paper's
+//! scheme for its coefficient tables:
 //!
 //! * *parametrisation*: the colour's largest channel l ∈ {r, g, b} picks one of three blocks; its value
 //!   z ∈ [0, 1] and the two others' ratios x = c_{l+1}/z, y = c_{l+2}/z ∈ [0, 1] index a res³ grid, x and
@@ -62,7 +63,7 @@ use super::illuminant::d65;
 use super::named::xyz_to_linear_srgb;
 use super::Rgb;
 
-/// The sigmoid of Jakob & Hanika's eq. (3), S(x) = 1/2 + x / (2 √(1 + x²)): (0, 1) for finite x,
+/// Jakob & Hanika's sigmoid, S(x) = 1/2 + x / (2 √(1 + x²)): (0, 1) for finite x,
 /// 0 and 1 at ∓∞ (and for |x| ≥ 10¹⁸, where x² would overflow); NaN stays NaN.
 #[inline]
 #[must_use]
