@@ -108,8 +108,8 @@ fn light_selection_follows_importance_and_agrees_with_its_pmf() {
         assert_eq!(p, pmf[i]);
         counts[i] += 1;
     }
-    for i in 0..3 {
-        assert!((counts[i] as f32 / n as f32 - pmf[i]).abs() < 3e-3, "{counts:?} vs {pmf:?}");
+    for (c, p) in counts.iter().zip(&pmf) {
+        assert!((*c as f32 / n as f32 - p).abs() < 3e-3, "{counts:?} vs {pmf:?}");
     }
     // One light, or more than MAX_LIGHTS: uniform (Mitsuba's choice).
     let one = LightSelection::new(&lights[..1], &[]);

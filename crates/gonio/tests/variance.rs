@@ -87,8 +87,8 @@ fn gonio_error_is_at_most_mitsubas_and_unbiased() {
                 mse += (0..3).map(|c| (p[c] - r[c]).powi(2)).sum::<f64>() / 3.0;
                 let (lum, ref_lum) = (p.iter().sum::<f64>() / 3.0, r.iter().sum::<f64>() / 3.0);
                 ff += usize::from(lum > factor * ref_lum.max(1e-3));
-                for c in 0..3 {
-                    sums[i][c] += p[c];
+                for (s, v) in sums[i].iter_mut().zip(p) {
+                    *s += v;
                 }
             }
             fireflies_max = fireflies_max.max(ff);
