@@ -19,18 +19,15 @@
 //!
 //! ## Sampling
 //! Directions are importance sampled by luminance · sin θ (pbrt-v4 §12.5.2, "Image Infinite Lights", and
-//! Mitsuba's envmap, whose `Hierarchical2D` warp samples the bilinear interpolant of the texels): a cell of the
-//! W × (H − 1) cells of the bilinear grid is chosen with probability ∝ the mean luminance of its four corner
-//! texels (the cell's integral of the bilinear function) times sin θ at the cell's centre, from an alias table
-//! over the cells ([`AliasTable`], Vose 1991: constant time, no search) with `uc` for the bin and `u.x` for the
-//! coin; the point in the cell is drawn from the coin's remapped number and `u.y` with density ∝ the bilinear
-//! interpolant of the corners' luminance ([`sample_bilinear`]). The density in the (u, v) square is thus
-//! func(cell) / mean(func) · L(point) / mean(L over the cell), L the interpolated luminance: within a cell the
-//! luminance over the density is constant, as in Mitsuba (before issue 28 the point was uniform in the cell, and
-//! a cell with one bright corner — the sun — gave that ratio a spread of up to 4×). In solid angle the density
-//! is divided by the Jacobian 2π² sin θ (dω = sin θ dθ dφ = 2π² sin θ du dv). A point has zero density only
-//! where the interpolated luminance is zero; its radiance is then zero too (texels are ≥ 0), so the estimator
-//! stays unbiased.
+//! Mitsuba's envmap): a piecewise-constant density over the W × (H − 1) cells of the bilinear grid, each
+//! weighted by the mean luminance of its four corner texels (the cell's integral of the bilinear function)
+//! times sin θ at the cell's centre. A cell is chosen from an alias table over the cells
+//! ([`AliasTable`], Vose 1991: constant time, no search) with `uc` for the bin and `u.x` for the coin, and
+//! the point is uniform inside the cell, from the coin's remapped number and `u.y`. The density in the
+//! (u, v) square is thus func(cell) / mean(func), the same as a 2-D piecewise-constant distribution's; in
+//! solid angle it is divided by the Jacobian 2π² sin θ (dω = sin θ dθ dφ = 2π² sin θ du dv). A cell has
+//! zero density only if its four corners are black, where the bilinear radiance is zero too, so the
+//! estimator stays unbiased.
 //!
 //! ## Lanes
 //! [`EnvMap::sample_lanes`] and [`EnvMap::eval_lanes`] are the light, written once over a
@@ -49,7 +46,6 @@ use crate::math::trig::sin_cos_turn;
 use crate::math::Transform;
 use crate::props::Props;
 use crate::sampling::alias::AliasTable;
-use crate::sampling::warp::{bilinear_pdf, sample_bilinear};
 use crate::spectrum::Rgb;
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
@@ -185,16 +181,7 @@ impl EnvMap {
         (x as u32, y as u32, s - x as f32, t - y as f32)
     }
 
-    /// The luminance of the cell (x, y)'s corner texels, [(x, y), (x + 1, y), (x, y + 1), (x + 1, y + 1)]: the
-    /// bilinear interpolant [`sample_bilinear`] draws the point in the cell by.
-    #[inline]
-    fn corner_luminance(&self, x: u32, y: u32) -> [f32; 4] {
-        let (row, x, y) = (self.width + 1, x as usize, y as usize);
-        let lum = |dx: usize, dy: usize| self.texels.get((y + dy) * row + x + dx).map_or(0.0, |t| t.luminance().max(0.0));
-        [lum(0, 0), lum(1, 0), lum(0, 1), lum(1, 1)]
-    }
-
-    /// Mean density in the (u, v) square over the cell (x, y): func(cell) / mean(func) = pmf · cells.
+    /// Density in the (u, v) square of the cell (x, y): func(cell) / mean(func) = pmf · cells.
     #[inline]
     fn cell_density(&self, x: u32, y: u32) -> f32 {
         self.cells.pmf(y as usize * self.width + x as usize) * self.cells.len() as f32
@@ -246,9 +233,7 @@ impl EnvMap {
             let s = self.cells.sample(uc[i], ux[i], uy[i]);
             let (x, y) = (s.index % self.width, s.index / self.width);
             (cells.0[i], cells.1[i]) = (x as u32, y as u32);
-            let corners = self.corner_luminance(x as u32, y as u32);
-            let p = sample_bilinear(Vec2::new(s.u_coin, s.u_low), corners);
-            (fx[i], fy[i], density[i]) = (p.x, p.y, s.pmf * self.cells.len() as f32 * bilinear_pdf(p, corners));
+            (fx[i], fy[i], density[i]) = (s.u_coin, s.u_low, s.pmf * self.cells.len() as f32);
         }
         let (fx, fy, density) = (R::from_fn(|i| fx[i]), R::from_fn(|i| fy[i]), R::from_fn(|i| density[i]));
         // Grid → texture coordinates: the grid starts half a texel into u (no wrap: `sin_cos_turn` is periodic).
@@ -278,7 +263,7 @@ impl EnvMap {
         for i in (0..R::LANES).filter(|i| lanes >> i & 1 != 0) {
             let (x, y, fxi, fyi) = self.grid_point(EnvMap::direction_to_uv(Vec3::new(dx[i], dy[i], dz[i])));
             (cells.0[i], cells.1[i], fx[i], fy[i]) = (x, y, fxi, fyi);
-            density[i] = self.cell_density(x, y) * bilinear_pdf(Vec2::new(fxi, fyi), self.corner_luminance(x, y));
+            density[i] = self.cell_density(x, y);
         }
         let li = self.blend(&cells, R::from_fn(|i| fx[i]), R::from_fn(|i| fy[i]));
         let pdf = R::select(sin_theta.gt(zero), R::from_fn(|i| density[i]) / (sin_theta * (2.0 * PI * PI)), zero);

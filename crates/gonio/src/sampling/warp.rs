@@ -1,5 +1,4 @@
-//! Warps from the unit square to disks, hemispheres, spheres and spherical caps, and to the square itself by a
-//! linear or bilinear density.
+//! Warps from the unit square to disks, hemispheres, spheres and spherical caps.
 //!
 //! Every warp is a triplet: `sample_*` maps `u ∈ [0,1)²` to the domain, `*_pdf` is the density of the result
 //! with respect to area (disk) or solid angle (directions), and `invert_*` maps a point back to the `u`
@@ -241,74 +240,6 @@ pub fn power_cosine_hemisphere_pdf(w: Vec3, n: f32) -> f32 {
 #[must_use]
 pub fn invert_power_cosine_hemisphere_sample(w: Vec3, n: f32) -> Vec2 {
     Vec2::new(w.z.max(0.0).powf(n + 1.0).min(1.0), phi_fraction(w))
-}
-
-/// x ∈ [0, 1) with density proportional to the linear function (1 − x) a + x b (a, b ≥ 0, not both 0; both 0
-/// gives x = u): x = u (a + b) / (a + √((1 − u) a² + u b²)), the inverse of the CDF (x² (b − a)/2 + a x)/((a + b)/2)
-/// in the form without cancellation (pbrt-v4 §A.4.3, "Sampling a linear function", `SampleLinear`).
-#[inline]
-#[must_use]
-pub fn sample_linear(u: f32, a: f32, b: f32) -> f32 {
-    if !(a + b > 0.0) || (u == 0.0 && a == 0.0) {
-        return if a + b > 0.0 { 0.0 } else { u };
-    }
-    let x = u * (a + b) / (a + ((1.0 - u) * a * a + u * b * b).sqrt());
-    x.min(1.0 - f32::EPSILON / 2.0)
-}
-
-/// Density of [`sample_linear`]: 2 ((1 − x) a + x b) / (a + b) on [0, 1] (1 where a = b = 0).
-#[inline]
-#[must_use]
-pub fn linear_pdf(x: f32, a: f32, b: f32) -> f32 {
-    if !(a + b > 0.0) {
-        return 1.0;
-    }
-    2.0 * ((1.0 - x) * a + x * b) / (a + b)
-}
-
-/// The inverse of [`sample_linear`]: its CDF, x ((2 − x) a + x b) / (a + b).
-#[inline]
-#[must_use]
-pub fn invert_linear_sample(x: f32, a: f32, b: f32) -> f32 {
-    if !(a + b > 0.0) {
-        return x;
-    }
-    x * ((2.0 - x) * a + x * b) / (a + b)
-}
-
-/// A point of [0, 1)² with density proportional to the bilinear interpolant of the corner values
-/// `w` = [w(0, 0), w(1, 0), w(0, 1), w(1, 1)] (all ≥ 0, not all 0): y from the marginal, linear between
-/// w₀₀ + w₁₀ and w₀₁ + w₁₁, then x from the conditional, linear at that y (pbrt-v4 §A.4.4, "Sampling
-/// bilinear functions", `SampleBilinear`).
-#[inline]
-#[must_use]
-pub fn sample_bilinear(u: Vec2, w: [f32; 4]) -> Vec2 {
-    let y = sample_linear(u.y, w[0] + w[1], w[2] + w[3]);
-    let x = sample_linear(u.x, (1.0 - y) * w[0] + y * w[2], (1.0 - y) * w[1] + y * w[3]);
-    Vec2::new(x, y)
-}
-
-/// Density of [`sample_bilinear`]: the interpolant over its mean, 4 w(p) / Σ w (1 where every w is 0).
-#[inline]
-#[must_use]
-pub fn bilinear_pdf(p: Vec2, w: [f32; 4]) -> f32 {
-    let sum = w[0] + w[1] + w[2] + w[3];
-    if !(sum > 0.0) {
-        return 1.0;
-    }
-    let (x, y) = (p.x, p.y);
-    4.0 * ((1.0 - x) * (1.0 - y) * w[0] + x * (1.0 - y) * w[1] + (1.0 - x) * y * w[2] + x * y * w[3]) / sum
-}
-
-/// The inverse of [`sample_bilinear`].
-#[inline]
-#[must_use]
-pub fn invert_bilinear_sample(p: Vec2, w: [f32; 4]) -> Vec2 {
-    let y = p.y;
-    Vec2::new(
-        invert_linear_sample(p.x, (1.0 - y) * w[0] + y * w[2], (1.0 - y) * w[1] + y * w[3]),
-        invert_linear_sample(y, w[0] + w[1], w[2] + w[3]),
-    )
 }
 
 #[cfg(test)]
