@@ -95,15 +95,18 @@ browser:
 # Benchmarks, run by hand (never part of `make test`): criterion micro-benchmarks, then gonio against
 # Mitsuba 3 (scalar_rgb, llvm_ad_rgb) on ../shared/scenes with the scaling tables (bench/render_vs_mitsuba.py),
 # the benchmark suite (bench/suite.py: bench/scenes/, time and MSE ratios against llvm_ad_rgb, their
-# geometric mean and worst scene), and the Python package's batched f/pdf/sample against Mitsuba's
-# (bench/python_bsdf_vs_mitsuba.py), and gonio.distributed's scaling on a local two-node Ray cluster
-# (bench/distributed.py: render and fit efficiency over one node, overhead per task; docs/distributed.md).
+# geometric mean and worst scene), the variance suite (bench/variance.py: every BSDF shared with Mitsuba ×
+# every light type, gonio's MSE over llvm_ad_rgb's at equal spp, worst cell, geometric mean, fireflies),
+# the Python package's batched f/pdf/sample against Mitsuba's (bench/python_bsdf_vs_mitsuba.py), and
+# gonio.distributed's scaling on a local two-node Ray cluster (bench/distributed.py: render and fit
+# efficiency over one node, overhead per task; docs/distributed.md).
 # gonio is timed as `make build` builds it (target/release/gonio, for this machine's CPU, as Mitsuba's
 # llvm_ad_rgb JIT-compiles its kernels for it).
 bench: cli python
 	$(CARGO) bench -p gonio
 	GONIO_BIN=target/release/gonio $(VPY) bench/render_vs_mitsuba.py
 	$(VPY) bench/suite.py --gonio target/release/gonio --json bench/.cache/suite.json
+	$(VPY) bench/variance.py --gonio target/release/gonio --json bench/.cache/variance.json
 	$(VPY) bench/python_bsdf_vs_mitsuba.py
 	$(VPY) bench/distributed.py
 

@@ -292,10 +292,12 @@ def start_mitsuba(threads: int) -> tuple[Mitsuba, str | None]:
 # gonio
 
 
-def run_gonio(binary: Path, scene: Scene, spp: int, threads: int, out: Path) -> tuple[dict, Path]:
+def run_gonio(binary: Path, scene: Scene, spp: int, threads: int, out: Path, seed: int | None = None) -> tuple[dict, Path]:
     """The whole `gonio render` process: wall and CPU time (all threads); the render loop's own time as
-    gonio reports it goes along as `render` (not used in the table)."""
+    gonio reports it goes along as `render` (not used in the table). `seed`: `--seed` (else the scene's)."""
     cmd = [str(binary), "render", str(scene.path), "-o", str(out), "--spp", str(spp), "--threads", str(threads)]
+    if seed is not None:
+        cmd += ["--seed", str(seed)]
     for k, v in scene.defines.items():
         cmd += ["-D", f"{k}={v}"]
     cpu0, wall0 = children_cpu(), time.perf_counter()

@@ -9,7 +9,14 @@
 //!    [`SPP`] samples per pixel, as two renders A and B of half the samples with different seeds; while the
 //!    tolerance below is wider than 5 % of the mean, another [`SPP`] are added (to A and to B, new seeds), up
 //!    to [`MAX_ROUNDS`] times (scenes lit through caustics, e.g. `tk_torus`, need more samples for their
-//!    mean to be worth comparing; the samples follow the noise, not the result);
+//!    mean to be worth comparing; the samples follow the noise, not the result); a scene whose mean is
+//!    off Mitsuba's by more than the tolerance also gets another round, up to [`MAX_ROUNDS`], and is judged
+//!    on all its samples: a group-sequential test (at most [`MAX_ROUNDS`] looks, each at the tolerance
+//!    below). A real difference stays (and grows in units of σ as samples are added); what goes is a
+//!    heavy-tailed estimator's miss at few samples, where the blocks' spread underestimates σ because the
+//!    rare large samples (a glossy highlight of a small light found by BSDF sampling) are missing from it —
+//!    e.g. `t_roughplastic_nonlin` at 64 spp, off by 1.73 % with a tolerance of 1.65 %, at 4096 spp within
+//!    0.1 %;
 //! 3. its image mean M (the two renders' average) must match Mitsuba's, per channel, within
 //!    4 · √(σ_g² + σ_m²) + 0.5 % of Mitsuba's mean, where σ_g is the standard error of M: the spread of the
 //!    two renders' difference over 8 × 8-pixel blocks (blocks, not pixels, because a reconstruction filter
@@ -236,7 +243,8 @@ fn every_scene_loads_or_is_a_documented_refusal_and_means_match_mitsuba() {
                 4.0 * (se_g[c].powi(2) + se_m.powi(2)).sqrt() + 0.005 * want
             });
             let wide = (0..3).any(|c| tol[c] > 0.05 * row.mean[c] * scale);
-            if full || !wide || rounds == MAX_ROUNDS {
+            let off = ratio.is_finite() && (0..3).any(|c| (m[c] - row.mean[c] * ratio).abs() > tol[c]);
+            if full || !(wide || off) || rounds == MAX_ROUNDS {
                 break (m, tol);
             }
         };

@@ -44,6 +44,12 @@ impl Disk {
         self.area
     }
 
+    /// The world-space unit normal (the side an area light on the disk emits to).
+    #[must_use]
+    pub fn normal(&self) -> Vec3 {
+        self.normal
+    }
+
     #[inline]
     #[must_use]
     pub fn intersect(&self, ray: &Ray) -> Option<PrimHit> {

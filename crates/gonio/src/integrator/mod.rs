@@ -117,7 +117,7 @@ pub struct BsdfSampled {
     pub n_light: f32,
 }
 
-/// Next-event estimation at `si`: pick a light uniformly, sample it, and return
+/// Next-event estimation at `si`: choose a light ([`LightSelection`](crate::light::LightSelection)), sample it, and return
 /// f · |cos θi| · Lᵢ · w / p_light, with w the power-heuristic weight against `n_bsdf` BSDF samples.
 /// `wo` is local; the caller divides by its number of light samples.
 pub fn sample_emitter(scene: &Scene, si: &SurfaceInteraction, wo: Vec3, bsdf: &Bsdf, rng: &mut Pcg32, n_light: f32, n_bsdf: f32) -> Rgb {
@@ -125,7 +125,7 @@ pub fn sample_emitter(scene: &Scene, si: &SurfaceInteraction, wo: Vec3, bsdf: &B
     if n == 0 {
         return Rgb::ZERO;
     }
-    let index = ((rng.next_f32() * n as f32) as usize).min(n - 1);
+    let (index, pmf) = scene.light_selection.sample(&scene.lights, si.p, rng.next_f32());
     let (uc, u) = (rng.next_f32(), rng.next_vec2());
     let Some(ls) = scene.lights[index].sample_li(&scene.shapes, si.p, si.n, uc, u) else { return Rgb::ZERO };
     if !(ls.pdf > 0.0) || ls.li.is_black() {
@@ -136,7 +136,7 @@ pub fn sample_emitter(scene: &Scene, si: &SurfaceInteraction, wo: Vec3, bsdf: &B
     if f.is_black() || scene.occluded(&ls.shadow) {
         return Rgb::ZERO;
     }
-    let light_pdf = ls.pdf / n as f32;
+    let light_pdf = ls.pdf * pmf;
     let w = if ls.delta || n_bsdf == 0.0 { 1.0 } else { power_heuristic(n_light, light_pdf, n_bsdf, bsdf.pdf(wo, wi)) };
     f * ls.li * (wi.z.abs() * w / light_pdf)
 }
@@ -144,7 +144,8 @@ pub fn sample_emitter(scene: &Scene, si: &SurfaceInteraction, wo: Vec3, bsdf: &B
 /// Radiance reaching the previous vertex along a BSDF-sampled ray that found `hit` (or escaped when
 /// `None`), weighted against light sampling.
 pub fn emitter_hit(scene: &Scene, ray: &Ray, hit: Option<&SurfaceInteraction>, prev: Option<&BsdfSampled>) -> Rgb {
-    let n = scene.lights.len() as f32;
+    // The probability of choosing light `index` at the previous vertex (needed only where there is one).
+    let pmf = |index: usize| prev.map_or(0.0, |p| scene.light_selection.pmf(&scene.lights, p.from, index));
     let (le, light_pdf) = match hit {
         Some(si) => {
             let Some(index) = scene.shape_lights[si.shape as usize] else { return Rgb::ZERO };
@@ -154,12 +155,12 @@ pub fn emitter_hit(scene: &Scene, ray: &Ray, hit: Option<&SurfaceInteraction>, p
                 return Rgb::ZERO;
             }
             let pdf = prev.map_or(0.0, |p| area.pdf_li(&scene.shapes[si.shape as usize], p.from, si));
-            (le, pdf / n)
+            (le, pdf * pmf(index as usize))
         }
         None => {
             let Some(index) = scene.environment else { return Rgb::ZERO };
             let Some((le, pdf)) = scene.lights[index as usize].environment(ray.d) else { return Rgb::ZERO };
-            (le, pdf / n)
+            (le, pdf * pmf(index as usize))
         }
     };
     match prev {

@@ -228,7 +228,6 @@ fn sample_where(model: &Bsdf, wo: V3<Float8>, uc: Float8, ux: Float8, uy: Float8
 #[inline(always)]
 fn trace(scene: &Scene, p: &mut Packet, lanes: u32, hit: &mut Surfaces8, out: &mut [Rgb], settings: Settings) {
     let Settings { max_depth, hide_emitters, .. } = settings;
-    let n_lights = scene.lights.len();
     let rays = RayLanes { o: p.o.lanes(), d: p.d.lanes(), tmax: Float8::load(&p.tmax) };
     let found = scene.intersect_rays(&rays, lanes);
     scene.surfaces_into(&rays, &found, lanes, hit);
@@ -254,7 +253,13 @@ fn trace(scene: &Scene, p: &mut Packet, lanes: u32, hit: &mut Surfaces8, out: &m
     };
     if let Some((radiance, pdf)) = seen {
         sky = shown & !hit.found;
-        let light_pdf = pdf / Float8::splat(n_lights as f32);
+        // The probability of choosing the environment at the vertex the ray left (camera rays: unused).
+        let env = scene.environment.unwrap_or(0) as usize;
+        let pmf =
+            Float8::from_fn(
+                |l| if sky & !first & (1 << l) != 0 { scene.light_selection.pmf(&scene.lights, p.from.get(l), env) } else { 1.0 },
+            );
+        let light_pdf = pdf * pmf;
         let unweighted = Mask8::from_bitmask(first | p.delta);
         let w = Float8::select(unweighted, Float8::splat(1.0), power_heuristic_1(Float8::load(&p.pdf), light_pdf));
         sky_le = radiance.map(|c| w * c);
@@ -411,9 +416,13 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
             let mut shadow = RayRows::default();
             let u_light = p.rng.next_f32(smooth);
             let (u_c, u_x, u_y) = (p.rng.next_f32(smooth), p.rng.next_f32(smooth), p.rng.next_f32(smooth));
-            // `(u · n) as usize`, at most n − 1: u · n is in [0, n), so truncation is the cast.
-            let chosen_lanes = (u_light * n_lights as f32).trunc().min(Float8::splat((n_lights - 1) as f32));
-            let chosen = chosen_lanes.to_array();
+            // The light of each lane and the probability of its choice (`LightSelection::sample`).
+            let (u_light, mut chosen, mut pmf) = (u_light.to_array(), [0.0f32; W], [1.0f32; W]);
+            for lane in bits(smooth) {
+                let (index, p) = scene.light_selection.sample(&scene.lights, hit.p.get(lane), u_light[lane]);
+                (chosen[lane], pmf[lane]) = (index as f32, p);
+            }
+            let chosen_lanes = Float8::load(&chosen);
             // The lanes that chose the same light, in lanes where it is an environment (constant or a map:
             // `ConstantLight::sample_li`, `EnvMap::sample_lanes`; the surfaces' normals are never zero) or a
             // small flat mesh (a `rectangle` light, say: its triangles chosen and loaded in lanes).
@@ -512,8 +521,8 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
                 shadow.merge(ok, &ray);
                 sampled |= m;
             }
-            for v in light_pdf.iter_mut() {
-                *v /= n_lights as f32;
+            for (v, p) in light_pdf.iter_mut().zip(pmf) {
+                *v *= p;
             }
             let wi_local = to_local(fs, ft, fn_, wi.lanes());
             // f and the BSDF's density: in lanes for diffuse surfaces, by the model for the others.

@@ -270,6 +270,13 @@ impl EnvMap {
         EnvEval { li, pdf }
     }
 
+    /// The mean radiance's luminance over the sphere of directions, ∫ L dω / 4π: from the sampling table,
+    /// ∫ L dω = 2π² ∫∫ L sin θ du dv ≈ 2π² · mean over the cells of (mean corner luminance · sin θ).
+    #[must_use]
+    pub fn mean_luminance(&self) -> f32 {
+        (self.cells.sum() / self.cells.len() as f64 * std::f64::consts::FRAC_PI_2) as f32
+    }
+
     /// Radiance arriving from world direction `wi` (towards the environment).
     #[must_use]
     pub fn radiance(&self, wi: Vec3) -> Rgb {

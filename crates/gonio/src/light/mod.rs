@@ -11,6 +11,7 @@ pub mod constant;
 pub mod directional;
 pub mod envmap;
 pub mod point;
+pub mod selection;
 pub mod spot;
 
 pub use area::AreaLight;
@@ -18,6 +19,7 @@ pub use constant::ConstantLight;
 pub use directional::DirectionalLight;
 pub use envmap::EnvMap;
 pub use point::PointLight;
+pub use selection::LightSelection;
 pub use spot::SpotLight;
 
 use crate::geometry::{Ray, Shape};

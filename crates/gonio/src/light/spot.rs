@@ -99,6 +99,12 @@ impl SpotLight {
         }
     }
 
+    /// The falloff factor towards the world-space point `p` ([`Self::falloff`]; the texture not included).
+    #[must_use]
+    pub fn falloff_at(&self, p: Vec3) -> f32 {
+        self.falloff(self.to_local.vector(p - self.position))
+    }
+
     /// The texture coordinates a light-space emission direction `local` (inside the cone) projects to.
     #[must_use]
     pub fn direction_to_uv(&self, local: Vec3) -> Vec2 {

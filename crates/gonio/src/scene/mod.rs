@@ -21,7 +21,7 @@ use crate::geometry::mesh::{parallelogram_barycentrics, FlatTriangles8, Triangle
 use crate::geometry::ray::{ray_point, RayLanes};
 use crate::geometry::sphere::Sphere8;
 use crate::geometry::{Bvh, PrimHit, Ray, Shape, SurfaceInteraction};
-use crate::light::Light;
+use crate::light::{Light, LightSelection};
 use crate::math::simd::{Float8, Mask8};
 use crate::math::Vec2;
 use std::path::Path;
@@ -59,6 +59,8 @@ pub struct Scene {
     /// ([`Mesh::flat_triangles8`](crate::geometry::mesh::Mesh::flat_triangles8)), for the path tracer's
     /// next-event estimation.
     pub light_triangles: Vec<Option<FlatTriangles8>>,
+    /// Which light next-event estimation samples at a point ([`LightSelection`]).
+    pub light_selection: LightSelection,
     pub camera: Camera,
     pub film: FilmSpec,
     pub sampler: SamplerSpec,
@@ -459,6 +461,7 @@ impl Scene {
                 _ => None,
             })
             .collect();
+        let light_selection = LightSelection::new(&lights, &shapes);
         Scene {
             shapes,
             materials,
@@ -466,6 +469,7 @@ impl Scene {
             lights,
             environment,
             light_triangles,
+            light_selection,
             camera,
             film,
             sampler,
