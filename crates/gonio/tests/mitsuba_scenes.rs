@@ -57,7 +57,6 @@ const REFUSED: &[(&str, &str)] = &[
     ("d_projector", "emitter_projector_textured.xml:4:5: unsupported emitter `projector`"),
     ("d_aov", "integrator_aov.xml:4:2: unsupported integrator `aov`"),
     ("d_sss", "medium_homogeneous_sss.xml:14:5: unsupported element <medium> in <scene>"),
-    ("d_thinlens", "sensor_thinlens.xml:4:2: unsupported sensor `thinlens`"),
     ("d_sdfgrid", "shape_sdfgrid.xml:8:5: unsupported shape `shapegroup`"),
     ("d_mesh_attribute", "texture_mesh_attribute_vertex.xml:6:13: unsupported texture `mesh_attribute`"),
     ("tu_shadow_art", "shadow_art.xml:60:2: unsupported shape `bsplinecurve`"),
