@@ -1,4 +1,4 @@
-//! `perspective` — Mitsuba's pinhole camera — and `orthographic`.
+//! `perspective` — Mitsuba's pinhole camera —, `thinlens` and `orthographic`.
 //!
 //! | parameter   | type      | default  | meaning                                                       |
 //! |-------------|-----------|----------|---------------------------------------------------------------|
@@ -9,6 +9,23 @@
 //! | `near_clip` | float     | 0.01     | rays start at this depth                                      |
 //! | `far_clip`  | float     | 10000    | and end at this one                                           |
 //! | `focus_distance` | float | 0     | accepted and ignored: Mitsuba 3's pinhole `perspective` reads it too (for `thinlens`-style scenes) and its image does not depend on it |
+//!
+//! `thinlens` takes the parameters of `perspective` (its `focus_distance` now used) and:
+//!
+//! | parameter         | type  | default    | meaning                                                     |
+//! |-------------------|-------|------------|-------------------------------------------------------------|
+//! | `aperture_radius` | float | (required) | radius of the lens in scene units; 0 is a pinhole           |
+//! | `focus_distance`  | float | `far_clip` | distance from the lens to the plane in focus (camera z), > 0 |
+//!
+//! As Mitsuba 3's (`src/sensors/thinlens.cpp`): the lens point a = `aperture_radius` · (Shirley–Chiu's
+//! concentric map of the lens sample) in the plane z = 0, the point in focus f = `focus_distance` ·
+//! ((1 − 2 sx) tan(fov_x/2), (1 − 2 sy) tan(fov_y/2), 1) (the pinhole's direction scaled to the focal
+//! plane), the ray from a towards f, started at camera depth `near_clip` and ended at `far_clip`. So a
+//! point on the focal plane is seen through the whole lens from one film position, and a point at depth z
+//! from a disk of film positions — on the plane z = 1, of diameter 2 A |z − f| / (z f), the thin lens's
+//! circle of confusion (pbrt-v4 §5.2.3). The lens takes two numbers of the sample's stream after the
+//! pixel offset; a pinhole takes none. `to_world` must not scale (Mitsuba refuses it too: the lens would
+//! scale with it).
 //!
 //! `orthographic` takes `to_world`, `near_clip` and `far_clip`: as Mitsuba 3's (`orthographic_projection`),
 //! film position (sx, sy) starts its ray at (1 − 2 sx, (1 − 2 sy) / aspect, near_clip) in camera space (the
@@ -25,6 +42,7 @@ use crate::geometry::Ray;
 use crate::math::lanes::{Real, V3};
 use crate::math::Transform;
 use crate::props::Props;
+use crate::sampling::warp::concentric_disk;
 use glam::{Vec2, Vec3};
 
 /// A perspective or orthographic camera.
@@ -39,6 +57,9 @@ pub struct Camera {
     far: f32,
     /// For an orthographic camera, the rays' world direction (`to_world · +z`, normalised).
     orthographic: Option<Vec3>,
+    /// The thin lens's radius (0: a pinhole) and the camera-space depth in focus.
+    aperture_radius: f32,
+    focus_distance: f32,
 }
 
 impl Camera {
@@ -73,7 +94,7 @@ impl Camera {
             }
             other => return Err(Error::spec(at, format!("`fov_axis` must be x, y, smaller, larger or diagonal, got `{other}`"))),
         };
-        Ok(Camera { to_world, tan_half_x, tan_half_y, near, far, orthographic: None })
+        Ok(Camera { to_world, tan_half_x, tan_half_y, near, far, orthographic: None, aperture_radius: 0.0, focus_distance: far })
     }
 
     /// An orthographic camera for a film of `width × height` pixels (module docs); `None` when `to_world`
@@ -82,10 +103,34 @@ impl Camera {
     pub fn orthographic(to_world: Transform, width: u32, height: u32, near: f32, far: f32) -> Option<Self> {
         let dir = to_world.vector(Vec3::Z).try_normalize()?;
         let aspect = width as f32 / height as f32;
-        Some(Camera { to_world, tan_half_x: 1.0, tan_half_y: 1.0 / aspect, near, far, orthographic: Some(dir) })
+        Some(Camera {
+            to_world,
+            tan_half_x: 1.0,
+            tan_half_y: 1.0 / aspect,
+            near,
+            far,
+            orthographic: Some(dir),
+            aperture_radius: 0.0,
+            focus_distance: far,
+        })
     }
 
-    /// Read `perspective` or `orthographic` parameters (the film size comes from the nested film).
+    /// This camera with a thin lens of radius `aperture_radius` (0: a pinhole) focused at camera depth
+    /// `focus_distance` (module doc). `to_world` should be a rigid motion.
+    #[must_use]
+    pub fn with_thin_lens(self, aperture_radius: f32, focus_distance: f32) -> Self {
+        debug_assert!(aperture_radius >= 0.0 && focus_distance > 0.0);
+        Camera { aperture_radius, focus_distance, ..self }
+    }
+
+    /// Whether rays need a lens sample: a thin lens of radius > 0 (see [`Self::rays_through_lens`]).
+    #[inline]
+    #[must_use]
+    pub fn has_lens(&self) -> bool {
+        self.aperture_radius > 0.0
+    }
+
+    /// Read `perspective`, `thinlens` or `orthographic` parameters (the film size comes from the nested film).
     pub fn from_props(p: &Props, width: u32, height: u32) -> Result<Self> {
         if p.plugin_type() == "orthographic" {
             let (near, far) = (p.float_positive("near_clip", 1e-2)?, p.float_positive("far_clip", 1e4)?);
@@ -95,8 +140,12 @@ impl Camera {
             return Camera::orthographic(p.transform("to_world")?, width, height, near, far)
                 .ok_or_else(|| Error::spec(p.at_param("to_world"), "`to_world` maps the viewing direction +z to zero"));
         }
-        if p.plugin_type() != "perspective" {
-            return Err(Error::spec(p.at(), format!("unsupported sensor `{}` (gonio has: perspective, orthographic)", p.plugin_type())));
+        let thin_lens = p.plugin_type() == "thinlens";
+        if p.plugin_type() != "perspective" && !thin_lens {
+            return Err(Error::spec(
+                p.at(),
+                format!("unsupported sensor `{}` (gonio has: perspective, thinlens, orthographic)", p.plugin_type()),
+            ));
         }
         let (fov, axis) = if p.has("fov") {
             if p.has("focal_length") {
@@ -111,22 +160,68 @@ impl Camera {
             let _ = p.string("fov_axis")?;
             ((36.0f32.hypot(24.0) / (2.0 * f)).atan().to_degrees() * 2.0, "diagonal".to_string())
         };
-        // A pinhole has everything in focus: Mitsuba's `perspective` accepts the parameter and ignores it.
-        let _ = p.float_in("focus_distance", 0.0, 0.0, f32::MAX)?;
         let near = p.float_positive("near_clip", 1e-2)?;
         let far = p.float_positive("far_clip", 1e4)?;
         if far <= near {
             return Err(Error::spec(p.at_param("far_clip"), format!("`far_clip` ({far}) must exceed `near_clip` ({near})")));
         }
-        Camera::new(p.transform("to_world")?, fov, &axis, width, height, near, far, p.at_param("fov_axis"))
+        let to_world = p.transform("to_world")?;
+        let camera = Camera::new(to_world, fov, &axis, width, height, near, far, p.at_param("fov_axis"))?;
+        if !thin_lens {
+            // A pinhole has everything in focus: Mitsuba's `perspective` accepts the parameter and ignores it.
+            let _ = p.float_in("focus_distance", 0.0, 0.0, f32::MAX)?;
+            return Ok(camera);
+        }
+        if !p.has("aperture_radius") {
+            return Err(Error::spec(p.at(), "`thinlens` needs an `aperture_radius` (the lens radius in scene units; 0 for a pinhole)"));
+        }
+        // Mitsuba makes 0 its smallest positive float, which renders as a pinhole; gonio takes 0 as a pinhole.
+        let aperture = p.float_in("aperture_radius", 0.0, 0.0, f32::MAX)?;
+        let focus = p.float_positive("focus_distance", far)?;
+        // 2026-12: 1e-3 tolerates rounding in a written `lookat` or matrix, not a real scale.
+        if [Vec3::X, Vec3::Y, Vec3::Z].iter().any(|&a| (to_world.vector(a).length() - 1.0).abs() > 1e-3) {
+            return Err(Error::spec(
+                p.at_param("to_world"),
+                "a `thinlens` sensor's `to_world` must not scale (rotate and translate only; the lens would scale with it)",
+            ));
+        }
+        Ok(camera.with_thin_lens(aperture, focus))
     }
 
-    /// The primary ray through film position `s` ∈ [0, 1]² (top-left origin).
+    /// The primary ray through film position `s` ∈ [0, 1]² (top-left origin) and, for a thin lens, the
+    /// lens centre.
     #[inline]
     #[must_use]
     pub fn ray(&self, s: Vec2) -> Ray {
-        let r = self.rays(s.x, s.y);
+        self.ray_through_lens(s, Vec2::splat(0.5))
+    }
+
+    /// The primary ray through film position `s` and lens sample `u` ∈ [0, 1]² (which a pinhole ignores).
+    #[inline]
+    #[must_use]
+    pub fn ray_through_lens(&self, s: Vec2, u: Vec2) -> Ray {
+        let r = self.rays_through_lens(s.x, s.y, u.x, u.y);
         Ray::new(r.o.into(), r.d.into(), r.tmax)
+    }
+
+    /// [`Self::ray_through_lens`] in lanes: film positions (`x`, `y`), lens samples (`ux`, `uy`).
+    #[inline(always)]
+    #[must_use]
+    pub fn rays_through_lens<R: Real>(&self, x: R, y: R, ux: R, uy: R) -> RayLanes<R> {
+        if !self.has_lens() {
+            return self.rays(x, y);
+        }
+        let (one, two) = (R::splat(1.0), R::splat(2.0));
+        let (lx, ly) = concentric_disk(ux, uy);
+        let (ax, ay) = (lx * R::splat(self.aperture_radius), ly * R::splat(self.aperture_radius));
+        // The point in focus seen from this film position, on the plane z = focus_distance.
+        let f = R::splat(self.focus_distance);
+        let (fx, fy) = ((one - two * x) * R::splat(self.tan_half_x) * f, (one - two * y) * R::splat(self.tan_half_y) * f);
+        let d = V3::new(fx - ax, fy - ay, f).normalize();
+        // From the lens point to camera depth near_clip, and on to far_clip.
+        let inv_z = one / d.z;
+        let o = V3::new(ax, ay, R::splat(0.0)).add(d.scale(R::splat(self.near) * inv_z));
+        RayLanes { o: self.to_world.point_lanes(o), d: self.to_world.vector_lanes(d), tmax: R::splat(self.far - self.near) * inv_z }
     }
 
     /// [`Self::ray`] for film positions (`x`, `y`) in lanes ([`Real`]: one `f32` or eight).

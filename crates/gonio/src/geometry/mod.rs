@@ -1,9 +1,10 @@
 //! Geometry: rays, bounding boxes, the shapes of Mitsuba's scene format (sphere, rectangle, cube, disk,
-//! triangle meshes, and the mesh file loaders in [`mesh_io`]), surface interactions and the bounding volume hierarchy over all primitives.
+//! cylinder, triangle meshes, and the mesh file loaders in [`mesh_io`]), surface interactions and the bounding volume hierarchy over all primitives.
 
 pub mod bounds;
 pub mod builtin_meshes;
 pub mod bvh;
+pub mod cylinder;
 pub mod disk;
 pub mod interaction;
 pub mod mesh;

@@ -1,6 +1,7 @@
 //! The closed set of shapes. A shape has one or more primitives (a mesh has one per triangle); the scene's
 //! BVH indexes (shape, primitive) pairs.
 
+use super::cylinder::Cylinder;
 use super::disk::Disk;
 use super::interaction::{PositionSample, SurfaceInteraction};
 use super::mesh::Mesh;
@@ -34,6 +35,7 @@ pub struct PrimHit {
 pub enum Shape {
     Sphere(Sphere),
     Disk(Disk),
+    Cylinder(Cylinder),
     Mesh(Mesh),
 }
 
@@ -42,7 +44,7 @@ impl Shape {
     pub fn primitive_count(&self) -> usize {
         match self {
             Shape::Mesh(m) => m.triangle_count(),
-            Shape::Sphere(_) | Shape::Disk(_) => 1,
+            Shape::Sphere(_) | Shape::Disk(_) | Shape::Cylinder(_) => 1,
         }
     }
 
@@ -51,6 +53,7 @@ impl Shape {
         match self {
             Shape::Sphere(s) => s.bounds(),
             Shape::Disk(d) => d.bounds(),
+            Shape::Cylinder(c) => c.bounds(),
             Shape::Mesh(m) => m.triangle_bounds(prim),
         }
     }
@@ -62,17 +65,19 @@ impl Shape {
             Shape::Mesh(m) => m.intersect(prim, ray),
             Shape::Sphere(s) => s.intersect(ray),
             Shape::Disk(d) => d.intersect(ray),
+            Shape::Cylinder(c) => c.intersect(ray),
         }
     }
 
     /// The full interaction of a hit found by [`Shape::intersect`]; `shape` and `prim` are filled in. Texture
-    /// coordinates only with `uv` (else zero): spheres and disks need an arc tangent for them.
+    /// coordinates only with `uv` (else zero): spheres, disks and cylinders need an arc tangent for them.
     #[must_use]
     pub fn interaction(&self, shape: u32, prim: u32, ray: &Ray, hit: &PrimHit, uv: bool) -> SurfaceInteraction {
         let mut si = match self {
             Shape::Mesh(m) => m.interaction(prim, ray, hit, uv),
             Shape::Sphere(s) => s.interaction(ray, hit.t, uv),
             Shape::Disk(d) => d.interaction(ray, hit, uv),
+            Shape::Cylinder(c) => c.interaction(ray, hit.t, uv),
         };
         si.shape = shape;
         si.prim = prim;
@@ -84,6 +89,7 @@ impl Shape {
         match self {
             Shape::Sphere(s) => s.area(),
             Shape::Disk(d) => d.area(),
+            Shape::Cylinder(c) => c.area(),
             Shape::Mesh(m) => m.area(),
         }
     }
@@ -124,6 +130,7 @@ impl Shape {
         match self {
             Shape::Sphere(s) => s.sample_position(u),
             Shape::Disk(d) => d.sample_position(u),
+            Shape::Cylinder(c) => c.sample_position(u),
             Shape::Mesh(m) => m.sample_position(uc, u),
         }
     }

@@ -38,13 +38,15 @@ pub(crate) fn mix(seed: u64, sample: u64) -> u64 {
 
 /// The start of a camera sample's path: its own PCG32 stream, `Pcg32::new(mix(seed, k), pixel index)`, and
 /// the camera ray through a uniformly jittered point of its pixel, drawn from that stream (the film then
-/// weights the sample by its reconstruction filter).
+/// weights the sample by its reconstruction filter), and for a thin lens through the lens point drawn next.
 #[inline]
 #[must_use]
 pub fn start(scene: &Scene, seed: u64, s: CameraSample) -> (Ray, Pcg32) {
-    let (offset, rng) = stream_and_offset(scene, seed, s);
+    let (offset, mut rng) = stream_and_offset(scene, seed, s);
     let (x, y) = film_point(scene, s.x as f32, s.y as f32, offset.x, offset.y);
-    (scene.camera.ray(glam::Vec2::new(x, y)), rng)
+    // A thin lens takes the next two numbers for its lens point; a pinhole none.
+    let lens = if scene.camera.has_lens() { glam::Vec2::new(rng.next_f32(), rng.next_f32()) } else { glam::Vec2::splat(0.5) };
+    (scene.camera.ray_through_lens(glam::Vec2::new(x, y), lens), rng)
 }
 
 /// Where in its pixel camera sample `s` lies: (ux, uy) ∈ [0, 1)², the first two numbers of its stream
@@ -85,6 +87,10 @@ pub fn start_lanes(scene: &Scene, mixed: &[u64; 8], samples: &[CameraSample; 8],
     let (ux, uy) = (rng.next_f32(lanes), rng.next_f32(lanes));
     let (x, y) = (Float8::from_fn(|i| samples[i].x as f32), Float8::from_fn(|i| samples[i].y as f32));
     let (x, y) = film_point(scene, x, y, ux, uy);
+    if scene.camera.has_lens() {
+        let (lx, ly) = (rng.next_f32(lanes), rng.next_f32(lanes));
+        return scene.camera.rays_through_lens(x, y, lx, ly);
+    }
     scene.camera.rays(x, y)
 }
 

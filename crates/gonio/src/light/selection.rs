@@ -174,10 +174,12 @@ impl LightSelection {
 }
 
 /// The vector area ∫ n dA of an emitting shape: its area times its normal for a disk or a flat mesh, 0 for
-/// a sphere or a closed mesh (Mitsuba's meshes emit on the side of their triangles' normal, p₁ − p₀ × p₂ − p₀).
+/// a sphere, a cylinder or a closed mesh (Mitsuba's meshes emit on the side of their triangles' normal,
+/// p₁ − p₀ × p₂ − p₀).
 fn vector_area(shape: &Shape) -> Vec3 {
     match shape {
-        Shape::Sphere(_) => Vec3::ZERO,
+        // An open cylinder's normals cancel round its circumference.
+        Shape::Sphere(_) | Shape::Cylinder(_) => Vec3::ZERO,
         Shape::Disk(d) => d.normal() * d.area(),
         Shape::Mesh(m) => (0..m.triangle_count() as u32).fold(Vec3::ZERO, |a, t| {
             let [_, e1, e2] = m.triangle_edges(t);

@@ -9,6 +9,7 @@ use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::film::FilmSpec;
 use crate::geometry::builtin_meshes::{cube, rectangle};
+use crate::geometry::cylinder::{Cylinder, CylinderError};
 use crate::geometry::disk::Disk;
 use crate::geometry::sphere::Sphere;
 use crate::geometry::{Mesh, Shape};
@@ -17,7 +18,7 @@ use crate::props::Props;
 use crate::spectrum::Rgb;
 use glam::Vec3;
 
-const SHAPES: &str = "sphere, rectangle, cube, disk, obj, ply, serialized";
+const SHAPES: &str = "sphere, rectangle, cube, disk, cylinder, obj, ply, serialized";
 
 impl Scene {
     /// Build every plugin of a parsed scene.
@@ -115,6 +116,21 @@ fn shape_from_props(p: &Props) -> Result<Shape> {
         "rectangle" => Shape::Mesh(rectangle(&to_world, flip, at)?),
         "cube" => Shape::Mesh(cube(&to_world, flip, at)?),
         "disk" => Shape::Disk(Disk::new(to_world, flip)),
+        "cylinder" => {
+            let p0 = p.vector("p0")?.unwrap_or(Vec3::ZERO);
+            let p1 = p.vector("p1")?.unwrap_or(Vec3::Z);
+            let radius = p.float_positive("radius", 1.0)?;
+            Shape::Cylinder(Cylinder::new(p0, p1, radius, to_world, flip).map_err(|e| match e {
+                CylinderError::NoAxis => Error::spec(
+                    p.at_param(if p.has("p1") { "p1" } else { "p0" }),
+                    format!("a cylinder's `p0` and `p1` must differ (its axis runs from one to the other), got {p0} and {p1}"),
+                ),
+                CylinderError::NotCircular => Error::spec(
+                    p.at_param("to_world"),
+                    "a cylinder's `to_world` must keep its cross-section a circle (rotate, translate, scale x and y by one factor; no shear)",
+                ),
+            })?)
+        }
         kind @ ("obj" | "ply" | "serialized") => {
             let filename = p.string("filename")?.ok_or_else(|| Error::spec(at, format!("`{kind}` needs a `filename`")))?;
             let face_normals = p.bool("face_normals", false)?;

@@ -297,7 +297,7 @@ mod tests {
             (json!({"type": "scene", "s": cam, "b": {"type": "sphere", "bsdf": {"type": "diffuse", "refl": 0.5}}}), "$.b.bsdf.refl"),
             (json!({"type": "scene", "s": cam, "b": {"type": "sphere", "bsdf": {"type": "ref", "id": "x"}}}), "unknown id \"x\""),
             (json!({"type": "scene", "s": cam, "b": {"type": "teapot"}}), "$.b: unknown plugin type `teapot`"),
-            (json!({"type": "scene", "s": cam, "b": {"type": "cylinder"}}), "unsupported shape `cylinder`"),
+            (json!({"type": "scene", "s": cam, "b": {"type": "bsplinecurve"}}), "unsupported shape `bsplinecurve`"),
             (json!({"type": "scene", "s": cam, "f": {"type": "hdrfilm"}}), "belongs inside another plugin"),
             (json!({"type": "scene", "s": cam, "t": cam}), "a second sensor"),
             (json!({"type": "scene", "s": cam, "b": {"type": "sphere", "to_world": [[1, 0], [0, 1]]}}), "4 rows of 4 numbers"),
