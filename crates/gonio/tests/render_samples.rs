@@ -51,7 +51,8 @@ fn split_renders_add_up_to_the_single_render() {
         let (spp, seed) = (40, 7);
         let single = render(&scene, spp, seed, &AtomicBool::new(false), &|_| {});
         // One range: the very same sums, so the same image bit for bit.
-        let (whole, nonfinite) = merged(&scene, seed, &[0..spp]);
+        let whole_range = 0..spp;
+        let (whole, nonfinite) = merged(&scene, seed, std::slice::from_ref(&whole_range));
         assert_eq!(whole, single.data, "{name}: render_samples(0..spp) is render");
         assert_eq!(nonfinite, single.nonfinite);
         // Uneven splits, merged in sample order and out of it: within one unit in the last place of f32

@@ -126,7 +126,7 @@ impl SpotLight {
         if let Some(t) = &self.texture {
             // falloff > 0 puts the direction inside the cone (θ < θ_cutoff ≤ 180°): z > 0 when the cone is
             // narrower than a hemisphere; a wider one projects its back half through z ≤ 0 as Mitsuba does.
-            s.li = s.li * t.eval(self.direction_to_uv(local));
+            s.li *= t.eval(self.direction_to_uv(local));
         }
         Some(s)
     }

@@ -12,7 +12,8 @@ use crate::numerics::horner;
 use std::f32::consts::PI;
 use std::f64::consts::PI as PI64;
 
-/// 1/√π.
+/// 1/√π (the f64 digits; Rust stores the nearest f32).
+#[allow(clippy::excessive_precision)]
 const FRAC_1_SQRT_PI: f32 = 0.564_189_583_547_756_3;
 
 /// The Beckmann distribution with roughness (RMS slope) `alpha_x`, `alpha_y`.
@@ -45,6 +46,7 @@ const LAMBDA_SWITCH: f32 = 2.5;
 /// h(v) = 2a² (1 − a√π e^{a²} erfc a), v = 1/a² ∈ [0, 0.16] (a ≥ 2.5), as a polynomial in u = (v − 0.08)
 /// 12.5 (fit by `tools/fit_special_functions.py`; fit error 6·10⁻⁹): Λ(a) = e^{−a²} h / (4a³√π) without
 /// the cancellation of the erfc form (h → 1 − 3/(2a²) + … as a → ∞).
+#[allow(clippy::excessive_precision)] // the fit's f64 digits; Rust stores the nearest f32
 const LAMBDA_H: [f32; 9] = [
     0.898_986_912_766_714_4,
     -0.085_816_698_234_542_29,

@@ -2,6 +2,9 @@
 //! of the range reduction is found and applied by seven compare-and-scale steps, exact in binary
 //! floating point), so that one formula gives the same bits on an `f32` and in every lane type.
 
+// Constants are written with the digits of their f64 derivation; Rust stores the nearest f32.
+#![allow(clippy::excessive_precision)]
+
 use super::horner;
 use crate::math::lanes::Real;
 

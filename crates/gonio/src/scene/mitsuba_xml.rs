@@ -11,6 +11,7 @@
 //! - **`<ref id>`** may name a plugin declared later in the scene (an area emitter declared after the shapes
 //!   that use it, a top-level `<sampler id>` used by the sensor): references are resolved once the whole
 //!   scene is read.
+//!
 //! Plugin elements are read by [`Props::from_xml_element_in`]; [`super::Scene::build`] turns the result
 //! into a renderable scene.
 //!
