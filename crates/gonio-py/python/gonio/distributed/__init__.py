@@ -203,7 +203,10 @@ def _bundle(scene: Any, defines: Mapping[str, Any]) -> Tuple[Dict[str, Any], str
         return {"kind": "dict", "scene": dict(scene)}, "<dict>"
     if isinstance(scene, (str, os.PathLike)):
         path = Path(scene)
-        files = [Path(f).resolve() for f in _gonio.scene_files(str(path), **defines)]
+        # Absolute but not resolved: a worker finds each file at the path the scene's references spell
+        # out from the scene's own folder, e.g. `../../../shared/data/x` through a symlinked `shared`
+        # (`resolve()` would pack the link's target and the reference would miss it).
+        files = [Path(os.path.abspath(f)) for f in _gonio.scene_files(str(path), **defines)]
         root = Path(os.path.commonpath([f.parent for f in files]))
         data = {str(f.relative_to(root)): f.read_bytes() for f in files}
         return {"kind": "file", "scene": str(files[0].relative_to(root)), "files": data, "defines": dict(defines)}, str(path)
