@@ -2,33 +2,14 @@
 //! 3.9.1 (`cie_d65`, `MI_CIE_D65_NORMALIZATION`), D65's colour (sRGB white), Planck's law against
 //! Mitsuba's `blackbody`, the blackbody normalisations, and `Spectrum` of every kind.
 
-use gonio::spectrum::cie::{cie1931_xyz, CIE_MAX, CIE_MIN, CIE_Y_NORMALIZATION};
 use gonio::spectrum::illuminant::{d65, d65_normalization, d65_relative, planck, Blackbody, BlackbodyNormalization, Spectrum};
 use gonio::spectrum::named::xyz_to_linear_srgb;
 use gonio::spectrum::piecewise::PiecewiseLinear;
 use gonio::spectrum::upsample::{RgbIlluminantSpectrum, RgbReflectanceSpectrum, RgbUnboundedSpectrum};
 use gonio::spectrum::Rgb;
 
-/// XYZ of an emission spectrum: composite 3-point Gauss–Legendre on 0.5 nm steps over [360, 830] nm
-/// (exact for D65 × x̄ȳz̄, quadratic on each step), times `CIE_Y_NORMALIZATION`.
-fn xyz_of(s: impl Fn(f64) -> f64) -> [f64; 3] {
-    let steps = 940;
-    let h = (CIE_MAX - CIE_MIN) / f64::from(steps);
-    let gl = [(-(0.6_f64.sqrt()), 5.0 / 9.0), (0.0, 8.0 / 9.0), (0.6_f64.sqrt(), 5.0 / 9.0)];
-    let mut xyz = [0.0; 3];
-    for i in 0..steps {
-        let mid = CIE_MIN + h * (f64::from(i) + 0.5);
-        for (node, weight) in gl {
-            let lambda = mid + 0.5 * h * node;
-            let w = 0.5 * h * weight * s(lambda) * CIE_Y_NORMALIZATION;
-            let cmf = cie1931_xyz(lambda);
-            for c in 0..3 {
-                xyz[c] += w * cmf[c];
-            }
-        }
-    }
-    xyz
-}
+mod common;
+use common::xyz_of;
 
 /// `mi.cie_d65(λ)` of Mitsuba 3.9.1 (scalar_spectral), D65 × `MI_CIE_D65_NORMALIZATION`, 0 below 360 nm:
 /// `python -c "import mitsuba as mi; mi.set_variant('scalar_spectral'); print([mi.cie_d65(l) for l in L])"`.

@@ -640,31 +640,21 @@ impl RgbUnboundedSpectrum {
 }
 
 /// An RGB emission as scale × a sigmoid polynomial × D65 (module docs): Mitsuba 3's spectrum of an RGB
-/// `radiance`.
+/// `radiance` — [`RgbUnboundedSpectrum`] times D65.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RgbIlluminantSpectrum {
-    scale: f32,
-    polynomial: SigmoidPolynomial,
-}
+pub struct RgbIlluminantSpectrum(RgbUnboundedSpectrum);
 
 impl RgbIlluminantSpectrum {
     /// The spectrum of the emission `rgb` (any non-negative values).
     #[must_use]
     pub fn new(rgb: Rgb) -> Self {
-        let (scale, polynomial) = scaled_fit(rgb);
-        RgbIlluminantSpectrum { scale, polynomial }
+        RgbIlluminantSpectrum(RgbUnboundedSpectrum::new(rgb))
     }
 
-    /// 2 · max(rgb).
+    /// The scaled sigmoid polynomial that D65 multiplies.
     #[must_use]
-    pub fn scale(&self) -> f32 {
-        self.scale
-    }
-
-    /// The sigmoid polynomial of rgb / scale.
-    #[must_use]
-    pub fn polynomial(&self) -> SigmoidPolynomial {
-        self.polynomial
+    pub fn unbounded(&self) -> RgbUnboundedSpectrum {
+        self.0
     }
 
     /// The radiance at `lambda` nm.
@@ -673,6 +663,6 @@ impl RgbIlluminantSpectrum {
     pub fn eval(&self, lambda: f32) -> f32 {
         #[allow(clippy::cast_possible_truncation)]
         let illuminant = d65(f64::from(lambda)) as f32;
-        self.scale * self.polynomial.eval(lambda) * illuminant
+        self.0.eval(lambda) * illuminant
     }
 }
