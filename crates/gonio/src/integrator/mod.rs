@@ -150,8 +150,11 @@ pub fn sample_emitter(scene: &Scene, si: &SurfaceInteraction, wo: Vec3, bsdf: &B
 /// Radiance reaching the previous vertex along a BSDF-sampled ray that found `hit` (or escaped when
 /// `None`), weighted against light sampling.
 pub fn emitter_hit(scene: &Scene, ray: &Ray, hit: Option<&SurfaceInteraction>, prev: Option<&BsdfSampled>) -> Rgb {
-    // The probability of choosing light `index` at the previous vertex (needed only where there is one).
-    let pmf = |index: usize| prev.map_or(0.0, |p| scene.light_selection.pmf(&scene.lights, p.from, index));
+    // The previous vertex where light sampling could also have found this emitter (not after a delta lobe,
+    // nor for camera rays): only there is Le weighted, and only there are the light's densities needed.
+    let weighted = prev.filter(|p| !p.delta && p.n_light > 0.0);
+    // The probability of choosing light `index` at that vertex.
+    let pmf = |p: &BsdfSampled, index: usize| scene.light_selection.pmf(&scene.lights, p.from, index);
     let (le, light_pdf) = match hit {
         Some(si) => {
             let Some(index) = scene.shape_lights[si.shape as usize] else { return Rgb::ZERO };
@@ -160,17 +163,17 @@ pub fn emitter_hit(scene: &Scene, ray: &Ray, hit: Option<&SurfaceInteraction>, p
             if le.is_black() {
                 return Rgb::ZERO;
             }
-            let pdf = prev.map_or(0.0, |p| area.pdf_li(&scene.shapes[si.shape as usize], p.from, si));
-            (le, pdf * pmf(index as usize))
+            let shape = &scene.shapes[si.shape as usize];
+            (le, weighted.map_or(0.0, |p| area.pdf_li(shape, p.from, si) * pmf(p, index as usize)))
         }
         None => {
             let Some(index) = scene.environment else { return Rgb::ZERO };
             let Some((le, pdf)) = scene.lights[index as usize].environment(ray.d) else { return Rgb::ZERO };
-            (le, pdf * pmf(index as usize))
+            (le, weighted.map_or(0.0, |p| pdf * pmf(p, index as usize)))
         }
     };
-    match prev {
-        Some(p) if !p.delta && p.n_light > 0.0 => le * power_heuristic(p.n_bsdf, p.pdf, p.n_light, light_pdf),
-        _ => le,
+    match weighted {
+        Some(p) => le * power_heuristic(p.n_bsdf, p.pdf, p.n_light, light_pdf),
+        None => le,
     }
 }

@@ -253,14 +253,19 @@ fn trace(scene: &Scene, p: &mut Packet, lanes: u32, hit: &mut Surfaces8, out: &m
     };
     if let Some((radiance, pdf)) = seen {
         sky = shown & !hit.found;
-        // The probability of choosing the environment at the vertex the ray left (camera rays: unused).
+        // The probability of choosing the environment at the vertex the ray left, where it is weighted
+        // (not for camera rays nor after a delta lobe, whose lanes keep weight 1).
         let env = scene.environment.unwrap_or(0) as usize;
-        let pmf =
-            Float8::from_fn(
-                |l| if sky & !first & (1 << l) != 0 { scene.light_selection.pmf(&scene.lights, p.from.get(l), env) } else { 1.0 },
-            );
+        let unweighted = first | p.delta;
+        let pmf = Float8::from_fn(|l| {
+            if sky & !unweighted & (1 << l) != 0 {
+                scene.light_selection.pmf(&scene.lights, p.from.get(l), env)
+            } else {
+                1.0
+            }
+        });
         let light_pdf = pdf * pmf;
-        let unweighted = Mask8::from_bitmask(first | p.delta);
+        let unweighted = Mask8::from_bitmask(unweighted);
         let w = Float8::select(unweighted, Float8::splat(1.0), power_heuristic_1(Float8::load(&p.pdf), light_pdf));
         sky_le = radiance.map(|c| w * c);
     }
