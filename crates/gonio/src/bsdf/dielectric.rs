@@ -30,7 +30,7 @@
 use super::lanes::{flag_lanes, sample_one, LaneModel, LaneSample};
 use super::{BsdfFlags, BsdfModel, BsdfSample};
 use crate::error::{Error, Result};
-use crate::fresnel::{cos2_transmitted, fresnel_dielectric, fresnel_dielectric_lanes, reflect, reflect_lanes};
+use crate::fresnel::{cos2_transmitted, fresnel_dielectric, fresnel_dielectric_lanes, reflect_lanes};
 use crate::math::lanes::{channels, Real, V3};
 use crate::math::{Vec2, Vec3};
 use crate::props::{NumberOrName, Props};
@@ -133,26 +133,32 @@ fn ior(p: &Props, name: &'static str, default: f32) -> Result<f32> {
     }
 }
 
-/// The delta sampling shared by the smooth interfaces (`dielectric`, `thindielectric`): mirror `wo`
-/// about +z with probability `r` (the reflected fraction), else follow `transmitted()` = (ωt, ηₜ/ηᵢ),
-/// with probability 1 − r. Choosing a lobe in proportion to its energy cancels the Fresnel factor from
-/// both weights: they are the multipliers, and transmission carries the radiance factor (ηᵢ/ηₜ)² = 1/η²
-/// (1 for a slab, whose two refractions cancel). `None` when `transmitted` has no direction.
-pub(crate) fn sample_reflect_or_transmit(
-    wo: Vec3,
-    uc: f32,
-    r: f32,
+/// The delta sampling shared by the smooth interfaces (`dielectric`, `thindielectric`), in lanes: mirror
+/// `wo` about +z with probability `r` (the reflected fraction), else take the transmitted direction `wt`
+/// with relative index `eta` = ηₜ/ηᵢ (valid where `transmits`), with probability 1 − r. Choosing a lobe in
+/// proportion to its energy cancels the Fresnel factor from both weights: they are the multipliers, and
+/// transmission carries the radiance factor (ηᵢ/ηₜ)² = 1/η² (1 for a slab, whose two refractions cancel).
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn reflect_or_transmit<R: Real>(
+    wo: V3<R>,
+    uc: R,
+    r: R,
     reflectance: Rgb,
     transmittance: Rgb,
-    transmitted: impl FnOnce() -> Option<(Vec3, f32)>,
-) -> Option<BsdfSample> {
-    if uc < r {
-        return BsdfSample::delta(reflect(wo, Vec3::Z), reflectance * r, r, BsdfFlags::DELTA_REFLECTION, 1.0);
-    }
-    let t = 1.0 - r;
-    let (wt, eta) = transmitted()?;
-    // Radiance is compressed into a smaller solid angle on the denser side: (ηᵢ/ηₜ)².
-    BsdfSample::delta(wt, transmittance * (t / (eta * eta)), t, BsdfFlags::DELTA_TRANSMISSION, eta)
+    wt: V3<R>,
+    eta: R,
+    transmits: R::Mask,
+) -> LaneSample<R> {
+    let one = R::splat(1.0);
+    let reflected = uc.lt(r);
+    let t = one - r;
+    let scale = t / (eta * eta);
+    let value = channels!(|c| R::select(reflected, r * reflectance.0[c], scale * transmittance.0[c]));
+    let wi = V3::select(reflected, reflect_lanes(wo, V3::splat(Vec3::Z)), wt);
+    let flags =
+        R::select(reflected, flag_lanes(BsdfFlags::DELTA_REFLECTION | BsdfFlags::DELTA), flag_lanes(BsdfFlags::DELTA_TRANSMISSION | BsdfFlags::DELTA));
+    LaneSample::delta(wi, value, R::select(reflected, r, t), flags, R::select(reflected, one, eta), reflected | transmits)
 }
 
 impl crate::bsdf::Examples for Dielectric {
@@ -207,7 +213,7 @@ impl LaneModel for Dielectric {
         R::splat(0.0)
     }
 
-    /// [`sample_reflect_or_transmit`] with r = [`Dielectric::reflected_fraction`]: the mirror direction
+    /// [`reflect_or_transmit`] with r = [`Dielectric::reflected_fraction`]: the mirror direction
     /// 2 (ωo·n) n − ωo, n = +z, where uc < r, else the refracted one ([`refract`](crate::fresnel::refract) about ±z, on the side of ωo), none
     /// under total internal reflection there and for ωo in the plane.
     #[inline(always)]
@@ -221,19 +227,8 @@ impl LaneModel for Dielectric {
         let cos2_t = cos2_transmitted(cos_i, eta);
         let cos_t = cos2_t.sqrt();
         let wt = V3::new(-wo.x / eta, -wo.y / eta, -wo.z / eta + (cos_i / eta - cos_t) * nz);
-        let reflected = uc.lt(r);
-        let t = one - r;
-        let (refl, trans) = (self.specular_reflectance.0, self.specular_transmittance.0);
-        let scale = t / (eta * eta);
-        let value = channels!(|c| R::select(reflected, r * refl[c], scale * trans[c]));
-        let wi = V3::select(reflected, reflect_lanes(wo, V3::splat(Vec3::Z)), wt);
-        let flags = R::select(
-            reflected,
-            flag_lanes(BsdfFlags::DELTA_REFLECTION | BsdfFlags::DELTA),
-            flag_lanes(BsdfFlags::DELTA_TRANSMISSION | BsdfFlags::DELTA),
-        );
-        let valid = !wo.z.eq(zero) & (reflected | !cos2_t.le(zero));
-        LaneSample::delta(wi, value, R::select(reflected, r, t), flags, R::select(reflected, one, eta), valid)
+        let s = reflect_or_transmit(wo, uc, r, self.specular_reflectance, self.specular_transmittance, wt, eta, !cos2_t.le(zero));
+        LaneSample { valid: s.valid & !wo.z.eq(zero), ..s }
     }
 }
 

@@ -207,6 +207,78 @@ macro_rules! lane_batch_methods {
     };
 }
 
+/// `enum $kernel { Ggx($lobe<Ggx>), Beckmann($lobe<Beckmann>), Blinn($lobe<Blinn>) }`: a model's lobe,
+/// written once over the distribution, for the distribution a model has — the kind matched once per
+/// call (`on_distribution!(d, |d| Lobe { .. }.into())` builds it), the lobe's code monomorphised per kind.
+/// The microfacet models' kernels are these (`ConductorKernel`, `DielectricKernel`, `PlasticKernel`).
+macro_rules! distribution_kernel {
+    ($(#[$doc:meta])* $kernel:ident $(<$lt:lifetime>)?, $lobe:ident) => {
+        $(#[$doc])*
+        #[derive(Clone, Copy, Debug)]
+        pub enum $kernel$(<$lt>)? {
+            Ggx($lobe<$($lt,)? $crate::microfacet::Ggx>),
+            Beckmann($lobe<$($lt,)? $crate::microfacet::Beckmann>),
+            Blinn($lobe<$($lt,)? $crate::microfacet::Blinn>),
+        }
+
+        impl$(<$lt>)? From<$lobe<$($lt,)? $crate::microfacet::Ggx>> for $kernel$(<$lt>)? {
+            #[inline(always)]
+            fn from(k: $lobe<$($lt,)? $crate::microfacet::Ggx>) -> Self {
+                $kernel::Ggx(k)
+            }
+        }
+
+        impl$(<$lt>)? From<$lobe<$($lt,)? $crate::microfacet::Beckmann>> for $kernel$(<$lt>)? {
+            #[inline(always)]
+            fn from(k: $lobe<$($lt,)? $crate::microfacet::Beckmann>) -> Self {
+                $kernel::Beckmann(k)
+            }
+        }
+
+        impl$(<$lt>)? From<$lobe<$($lt,)? $crate::microfacet::Blinn>> for $kernel$(<$lt>)? {
+            #[inline(always)]
+            fn from(k: $lobe<$($lt,)? $crate::microfacet::Blinn>) -> Self {
+                $kernel::Blinn(k)
+            }
+        }
+
+        impl$(<$lt>)? $crate::bsdf::lanes::LaneModel for $kernel$(<$lt>)? {
+            #[inline(always)]
+            fn f_lanes<R: $crate::math::lanes::Real>(&self, wo: $crate::math::lanes::V3<R>, wi: $crate::math::lanes::V3<R>) -> [R; 3] {
+                match self {
+                    $kernel::Ggx(k) => k.f_lanes(wo, wi),
+                    $kernel::Beckmann(k) => k.f_lanes(wo, wi),
+                    $kernel::Blinn(k) => k.f_lanes(wo, wi),
+                }
+            }
+
+            #[inline(always)]
+            fn pdf_lanes<R: $crate::math::lanes::Real>(&self, wo: $crate::math::lanes::V3<R>, wi: $crate::math::lanes::V3<R>) -> R {
+                match self {
+                    $kernel::Ggx(k) => k.pdf_lanes(wo, wi),
+                    $kernel::Beckmann(k) => k.pdf_lanes(wo, wi),
+                    $kernel::Blinn(k) => k.pdf_lanes(wo, wi),
+                }
+            }
+
+            #[inline(always)]
+            fn sample_lanes<R: $crate::math::lanes::Real>(
+                &self,
+                wo: $crate::math::lanes::V3<R>,
+                uc: R,
+                ux: R,
+                uy: R,
+            ) -> $crate::bsdf::lanes::LaneSample<R> {
+                match self {
+                    $kernel::Ggx(k) => k.sample_lanes(wo, uc, ux, uy),
+                    $kernel::Beckmann(k) => k.sample_lanes(wo, uc, ux, uy),
+                    $kernel::Blinn(k) => k.sample_lanes(wo, uc, ux, uy),
+                }
+            }
+        }
+    };
+}
+
 pub mod ashikhmin_shirley;
 pub mod blend;
 pub mod blinn_phong;

@@ -47,13 +47,14 @@
 //! ```
 
 use super::dielectric::relative_ior_with_default;
+use super::lanes::{f_one, flag_lanes, pdf_one, sample_one, LaneModel, LaneSample};
 use super::{BsdfFlags, BsdfModel, BsdfSample};
 use crate::error::Result;
-use crate::fresnel::{fresnel_dielectric, fresnel_diffuse_reflectance, reflect};
-use crate::math::lanes::{channels, Real};
+use crate::fresnel::{fresnel_diffuse_reflectance, fresnel_dielectric_lanes, reflect_lanes};
+use crate::math::lanes::{channels, Real, V3};
 use crate::math::{Vec2, Vec3};
 use crate::props::Props;
-use crate::sampling::warp::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
+use crate::sampling::warp::{cosine_hemisphere, cosine_hemisphere_density};
 use crate::spectrum::Rgb;
 use std::f32::consts::FRAC_1_PI;
 
@@ -149,9 +150,17 @@ impl Plastic {
         Ok(Plastic { specular_reflectance: c.specular_reflectance, ..Plastic::new(c.eta, c.diffuse_reflectance, c.nonlinear) })
     }
 
-    fn specular_probability(&self, cos_theta_o: f32) -> f32 {
+    /// The probability of sampling the mirror at cos θo.
+    #[inline(always)]
+    fn specular_probability<R: Real>(&self, cos_theta_o: R) -> R {
         let w = specular_sampling_weight(self.diffuse_reflectance, self.specular_reflectance);
-        specular_probability(fresnel_dielectric(cos_theta_o, self.eta), w)
+        specular_probability(fresnel_dielectric_lanes(cos_theta_o, self.eta), w)
+    }
+
+    /// Itself: its lane code runs every configuration (the batch methods' `lane_batch_methods!`).
+    #[inline(always)]
+    fn lanes(&self) -> Option<&Self> {
+        Some(self)
     }
 }
 
@@ -161,34 +170,66 @@ impl BsdfModel for Plastic {
     }
 
     fn f(&self, wo: Vec3, wi: Vec3) -> Rgb {
-        if !(wo.z > 0.0 && wi.z > 0.0) {
-            return Rgb::ZERO;
-        }
-        let (t_o, t_i) = (1.0 - fresnel_dielectric(wo.z, self.eta), 1.0 - fresnel_dielectric(wi.z, self.eta));
-        Rgb(coated_diffuse(self.diffuse_reflectance, t_o, t_i, self.eta, self.internal_reflectance, self.nonlinear))
+        f_one(self, wo, wi)
     }
 
     fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
-        if !(wo.z > 0.0) {
-            return None;
-        }
-        let p_specular = self.specular_probability(wo.z);
-        if uc < p_specular {
-            let r = fresnel_dielectric(wo.z, self.eta);
-            return BsdfSample::delta(reflect(wo, Vec3::Z), self.specular_reflectance * r, p_specular, BsdfFlags::DELTA_REFLECTION, 1.0);
-        }
-        let wi = sample_cosine_hemisphere(u);
-        if !(wi.z > 0.0) {
-            return None;
-        }
-        BsdfSample::smooth(wi, self.f(wo, wi), self.pdf(wo, wi), BsdfFlags::DIFFUSE_REFLECTION, 1.0)
+        sample_one(self, wo, uc, u)
     }
 
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        if !(wo.z > 0.0 && wi.z > 0.0) {
-            return 0.0;
+        pdf_one(self, wo, wi)
+    }
+
+    lane_batch_methods!(lanes);
+}
+
+/// The model in lanes ([`LaneModel`]): its single calls run it for one pair, the batches and the path
+/// tracer's packets for a register of them.
+impl LaneModel for Plastic {
+    /// The diffuse lobe (the mirror is a delta: 0 here).
+    #[inline(always)]
+    fn f_lanes<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> [R; 3] {
+        let zero = R::splat(0.0);
+        let above = wo.z.gt(zero) & wi.z.gt(zero);
+        let one = R::splat(1.0);
+        let (t_o, t_i) = (one - fresnel_dielectric_lanes(wo.z, self.eta), one - fresnel_dielectric_lanes(wi.z, self.eta));
+        let diffuse = coated_diffuse(self.diffuse_reflectance, t_o, t_i, self.eta, self.internal_reflectance, self.nonlinear);
+        channels!(|c| R::select(above, diffuse[c], zero))
+    }
+
+    /// The diffuse lobe's cosine density times its probability 1 − P.
+    #[inline(always)]
+    fn pdf_lanes<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> R {
+        let zero = R::splat(0.0);
+        let above = wo.z.gt(zero) & wi.z.gt(zero);
+        R::select(above, (R::splat(1.0) - self.specular_probability(wo.z)) * cosine_hemisphere_density(wi.z), zero)
+    }
+
+    /// The mirror with probability P, weight F · `specular_reflectance` / P; else a cosine-weighted direction.
+    #[inline(always)]
+    fn sample_lanes<R: Real>(&self, wo: V3<R>, uc: R, ux: R, uy: R) -> LaneSample<R> {
+        let zero = R::splat(0.0);
+        let above = wo.z.gt(zero);
+        if !R::any(above) {
+            return LaneSample::none(above);
         }
-        (1.0 - self.specular_probability(wo.z)) * cosine_hemisphere_pdf(wi)
+        let p = self.specular_probability(wo.z);
+        let mirror = uc.lt(p);
+        let r = fresnel_dielectric_lanes(wo.z, self.eta);
+        let value = channels!(|c| r * self.specular_reflectance.0[c]);
+        let delta = LaneSample::delta(
+            reflect_lanes(wo, V3::splat(Vec3::Z)),
+            value,
+            p,
+            flag_lanes(BsdfFlags::DELTA_REFLECTION | BsdfFlags::DELTA),
+            R::splat(1.0),
+            above,
+        );
+        let wi = cosine_hemisphere(ux, uy);
+        let diffuse =
+            LaneSample::smooth(wi, self.f_lanes(wo, wi), self.pdf_lanes(wo, wi), flag_lanes(BsdfFlags::DIFFUSE_REFLECTION), above & wi.z.gt(zero));
+        LaneSample::select(mirror, delta, diffuse)
     }
 }
 
@@ -207,6 +248,7 @@ impl crate::bsdf::Examples for Plastic {
 mod tests {
     use super::*;
     use crate::bsdf::Bsdf;
+    use crate::fresnel::fresnel_dielectric;
     use crate::verify::energy;
 
     #[test]

@@ -54,7 +54,7 @@ use crate::math::lanes::{channels, Real, V3};
 use crate::math::{Vec2, Vec3};
 use crate::microfacet::reflection::ReflectionLobe;
 use crate::microfacet::{
-    alpha_from_blinn_exponent, on_distribution, Beckmann, Blinn, Distribution, Ggx, MicrofacetDistribution, MicrofacetKind, Shadowing,
+    alpha_from_blinn_exponent, on_distribution, Distribution, MicrofacetDistribution, MicrofacetKind, Shadowing,
 };
 use crate::props::Props;
 use crate::spectrum::Rgb;
@@ -222,53 +222,9 @@ impl<D: Distribution> LaneModel for ConductorLobe<D> {
     }
 }
 
-/// [`ConductorLobe`] for the distribution a model has: the kind matched once per call.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum ConductorKernel {
-    Ggx(ConductorLobe<Ggx>),
-    Beckmann(ConductorLobe<Beckmann>),
-    Blinn(ConductorLobe<Blinn>),
-}
-
-macro_rules! conductor_kernel_from {
-    ($($kind:ident),*) => {$(
-        impl From<ConductorLobe<$kind>> for ConductorKernel {
-            #[inline(always)]
-            fn from(k: ConductorLobe<$kind>) -> Self {
-                ConductorKernel::$kind(k)
-            }
-        }
-    )*};
-}
-conductor_kernel_from!(Ggx, Beckmann, Blinn);
-
-impl LaneModel for ConductorKernel {
-    #[inline(always)]
-    fn f_lanes<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> [R; 3] {
-        match self {
-            ConductorKernel::Ggx(k) => k.f_lanes(wo, wi),
-            ConductorKernel::Beckmann(k) => k.f_lanes(wo, wi),
-            ConductorKernel::Blinn(k) => k.f_lanes(wo, wi),
-        }
-    }
-
-    #[inline(always)]
-    fn pdf_lanes<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> R {
-        match self {
-            ConductorKernel::Ggx(k) => k.pdf_lanes(wo, wi),
-            ConductorKernel::Beckmann(k) => k.pdf_lanes(wo, wi),
-            ConductorKernel::Blinn(k) => k.pdf_lanes(wo, wi),
-        }
-    }
-
-    #[inline(always)]
-    fn sample_lanes<R: Real>(&self, wo: V3<R>, uc: R, ux: R, uy: R) -> LaneSample<R> {
-        match self {
-            ConductorKernel::Ggx(k) => k.sample_lanes(wo, uc, ux, uy),
-            ConductorKernel::Beckmann(k) => k.sample_lanes(wo, uc, ux, uy),
-            ConductorKernel::Blinn(k) => k.sample_lanes(wo, uc, ux, uy),
-        }
-    }
+distribution_kernel! {
+    /// [`ConductorLobe`] for the distribution a model has: the kind matched once per call.
+    ConductorKernel, ConductorLobe
 }
 
 /// `distribution` (one of `rules.kinds`) and its roughness (see [`read_roughness`]). Shared by every

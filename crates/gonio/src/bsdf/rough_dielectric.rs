@@ -63,12 +63,15 @@
 
 use super::dielectric::relative_ior;
 use super::energy_compensation::DielectricCompensation;
+use super::lanes::{f_one, flag_lanes, pdf_one, sample_one, LaneModel, LaneSample};
 use super::rough_conductor::{read_distribution, MicrofacetParams};
 use super::{BsdfFlags, BsdfModel, BsdfSample};
 use crate::error::{Error, Result};
-use crate::fresnel::{fresnel_dielectric, reflect, refract_about};
+use crate::fresnel::{cos2_transmitted, fresnel_dielectric, fresnel_dielectric_lanes, reflect, reflect_lanes, refract_about};
+use crate::math::lanes::{channels, Real, V3};
 use crate::math::{Vec2, Vec3};
-use crate::microfacet::{MicrofacetDistribution, MicrofacetKind, Shadowing};
+use crate::microfacet::reflection::ReflectionLobe;
+use crate::microfacet::{on_distribution, Distribution, MicrofacetDistribution, MicrofacetKind, Shadowing};
 use crate::props::Props;
 use crate::spectrum::Rgb;
 
@@ -96,12 +99,6 @@ pub struct RoughDielectric {
 pub struct EnergySplit {
     pub reflected: f64,
     pub transmitted: f64,
-}
-
-/// Which way a direction pair scatters, with its half vector (on the +z side of the "upper" frame).
-struct HalfVector {
-    wm: Vec3,
-    reflection: bool,
 }
 
 impl RoughDielectric {
@@ -158,100 +155,41 @@ impl RoughDielectric {
         }
     }
 
-    /// The half vector of a pair with `wo` above and index ratio `eta` (eqs. 13 and 16), on the +z side.
-    /// `None` when it is undefined (a direction on the horizon, or ωo + η ωi = 0).
+    /// The single-scattering lobes as a lane kernel, for this model's distribution (matched here, once
+    /// per call).
     #[inline(always)]
-    fn half_vector(wo: Vec3, wi: Vec3, eta: f32) -> Option<HalfVector> {
-        if wo.z <= 0.0 || wi.z == 0.0 {
-            return None;
-        }
-        let reflection = wi.z > 0.0;
-        let h = if reflection { wo + wi } else { -(wo + eta * wi) };
-        let len = h.length();
-        if !(len > 0.0) || !len.is_finite() {
-            return None;
-        }
-        let wm = h / len;
-        Some(HalfVector { wm: if wm.z < 0.0 { -wm } else { wm }, reflection })
+    pub(crate) fn kernel(&self) -> DielectricKernel {
+        let (eta, reflectance, transmittance, visible) = (self.eta, self.specular_reflectance, self.specular_transmittance, self.sample_visible);
+        on_distribution!(self.distribution, |d| DielectricKernel::from(DielectricLobe {
+            lobe: ReflectionLobe { distribution: d, shadowing: Shadowing::Smith, visible },
+            eta,
+            specular_reflectance: reflectance,
+            specular_transmittance: transmittance,
+        }))
     }
 
-    /// The reflection lobe for `wo` above with index ratio `eta`: Walter 2007 eq. 20.
+    /// The kernel of this model when the single-scattering lobes are all of it (no energy compensation,
+    /// whose lobes look their tables up per lane and stay on the single calls).
     #[inline(always)]
-    fn reflection_upper(&self, wo: Vec3, wi: Vec3, eta: f32) -> Rgb {
-        let Some(HalfVector { wm, reflection: true }) = Self::half_vector(wo, wi, eta) else { return Rgb::ZERO };
-        let d = self.distribution.d(wm);
-        // G also enforces the sides: ωo·ωm > 0 and ωi·ωm > 0.
-        let g = self.distribution.g(wo, wi, wm, Shadowing::Smith);
-        if d == 0.0 || g == 0.0 {
-            return Rgb::ZERO;
-        }
-        // ωo·ωh = ωi·ωh exactly but not in f32: average, so that f(ωo, ωi) = f(ωi, ωo) bit for bit.
-        let f = fresnel_dielectric(0.5 * (wo.dot(wm) + wi.dot(wm)), eta);
-        let value = f * d * g / (4.0 * wo.z * wi.z);
-        if value.is_finite() {
-            self.specular_reflectance * value
-        } else {
-            Rgb::ZERO
-        }
+    pub(crate) fn lanes(&self) -> Option<DielectricKernel> {
+        self.compensation.is_none().then(|| self.kernel())
     }
 
-    /// The transmission lobe divided by ηo² (indices relative to the outside): Walter 2007 eq. 21 for
-    /// `w_out` above and `w_in` below, symmetric in the two, so that f(ωo, ωi)/ηo² = f(ωi, ωo)/ηi² holds
-    /// bit for bit: every quantity is computed from the outside and inside directions, never from which
-    /// of them is ωo.
-    fn transmission_over_eta2(&self, w_out: Vec3, w_in: Vec3) -> f32 {
-        let eta = self.eta;
-        let Some(HalfVector { wm, reflection: false }) = Self::half_vector(w_out, w_in, eta) else { return 0.0 };
-        let d = self.distribution.d(wm);
-        // G also enforces the sides: ωout·ωm > 0 > ωin·ωm.
-        let g = self.distribution.g(w_out, w_in, wm, Shadowing::Smith);
-        if d == 0.0 || g == 0.0 {
-            return 0.0;
-        }
-        let (out_m, in_m) = (w_out.dot(wm), w_in.dot(wm));
-        // F from the direction on the less dense side: it is smooth in that cosine (no critical angle).
-        let f = if eta > 1.0 { fresnel_dielectric(out_m, eta) } else { fresnel_dielectric(in_m, eta) };
-        let denom = out_m + eta * in_m;
-        let value = (out_m * in_m).abs() / (w_out.z * w_in.z).abs() * (1.0 - f) * d * g / (denom * denom);
-        // Within f32 underflow of the horizon the cosines vanish; G → 0 there but 0/0 can be NaN
-        // (2026-11: never NaN/Inf).
-        if value.is_finite() {
-            value
-        } else {
-            0.0
-        }
-    }
-
-    /// f for either side: reflection through the upper frame, transmission from the symmetric form.
+    /// f for either side: the kernel's lobes, plus with compensation the multiply scattered ones.
     #[inline(always)]
     fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
+        let single = f_one(&self.kernel(), wo, wi);
+        let Some(ms) = &self.compensation else { return single };
         if wo.z * wi.z > 0.0 {
-            let inside = wo.z < 0.0;
-            let (wo, wi, eta) = self.upper(wo, wi);
-            let single = self.reflection_upper(wo, wi, eta);
-            return match &self.compensation {
-                Some(ms) => single + self.specular_reflectance * ms.reflection(wo.z, wi.z, inside),
-                None => single,
-            };
-        }
-        if wo.z > 0.0 && wi.z < 0.0 {
+            single + self.specular_reflectance * ms.reflection(wo.z.abs(), wi.z.abs(), wo.z < 0.0)
+        } else if wo.z > 0.0 && wi.z < 0.0 {
             // ηo = 1 (outside).
-            return self.specular_transmittance * self.all_transmission_over_eta2(wo, wi);
-        }
-        if wo.z < 0.0 && wi.z > 0.0 {
+            single + self.specular_transmittance * ms.transmission_over_eta2(wo.z, -wi.z)
+        } else if wo.z < 0.0 && wi.z > 0.0 {
             // ηo = η (inside).
-            return self.specular_transmittance * (self.eta * self.eta * self.all_transmission_over_eta2(wi, wo));
-        }
-        Rgb::ZERO
-    }
-
-    /// Single- and (with compensation) multiple-scattering transmission divided by ηo², for `w_out` above
-    /// and `w_in` below: symmetric in the two.
-    fn all_transmission_over_eta2(&self, w_out: Vec3, w_in: Vec3) -> f32 {
-        let single = self.transmission_over_eta2(w_out, w_in);
-        match &self.compensation {
-            Some(ms) => single + ms.transmission_over_eta2(w_out.z, -w_in.z),
-            None => single,
+            single + self.specular_transmittance * (self.eta * self.eta * ms.transmission_over_eta2(wi.z, -wo.z))
+        } else {
+            single
         }
     }
 
@@ -261,15 +199,7 @@ impl RoughDielectric {
     #[must_use]
     pub fn reflection(&self, wo: Vec3, wi: Vec3) -> Rgb {
         debug_assert!(wo.z > 0.0 && wi.z > 0.0);
-        // As in `eval`: a product that underflows to 0 counts as the horizon.
-        if !(wo.z * wi.z > 0.0) {
-            return Rgb::ZERO;
-        }
-        let single = self.reflection_upper(wo, wi, self.eta);
-        match &self.compensation {
-            Some(ms) => single + self.specular_reflectance * ms.reflection(wo.z, wi.z, false),
-            None => single,
-        }
+        self.eval(wo, wi)
     }
 
     /// The density of reflecting `wo` (above) into `wi` (above) about a sampled microfacet, before the
@@ -278,15 +208,9 @@ impl RoughDielectric {
     #[must_use]
     #[inline(always)]
     pub fn reflection_pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        if wo.z <= 0.0 || wi.z <= 0.0 {
-            return 0.0;
-        }
-        let Some(HalfVector { wm, .. }) = Self::half_vector(wo, wi, self.eta) else { return 0.0 };
-        let o_m = wo.dot(wm);
-        if o_m <= 0.0 {
-            return 0.0;
-        }
-        self.distribution.pdf_reflected(wo, wm, self.sample_visible)
+        let visible = self.sample_visible;
+        on_distribution!(self.distribution, |d| ReflectionLobe { distribution: d, shadowing: Shadowing::Smith, visible }
+            .pdf::<f32>(wo.into(), wi.into()))
     }
 
     /// Reflect `wo` (above) about a sampled microfacet normal: the specular lobe of `roughplastic`, whose
@@ -294,44 +218,10 @@ impl RoughDielectric {
     #[must_use]
     #[inline(always)]
     pub fn sample_reflection(&self, wo: Vec3, u: Vec2) -> Option<Vec3> {
-        let wm = self.distribution.sample_wm(wo, u, self.sample_visible);
-        if !(wo.dot(wm) > 0.0) {
-            return None;
-        }
-        let wi = reflect(wo, wm).normalize();
-        (wi.z > 0.0).then_some(wi)
-    }
-
-    /// pdf for `wo` above with index ratio `eta`: Walter 2007 eqs. 14, 17 with the lobe probabilities.
-    fn pdf_upper(&self, wo: Vec3, wi: Vec3, eta: f32) -> f32 {
-        let Some(HalfVector { wm, reflection }) = Self::half_vector(wo, wi, eta) else { return 0.0 };
-        let (o_m, i_m) = (wo.dot(wm), wi.dot(wm));
-        // Only microfacets facing ωo are sampled, and a refracted ωi lies behind its microfacet.
-        if o_m <= 0.0 || (reflection && i_m <= 0.0) || (!reflection && i_m >= 0.0) {
-            return 0.0;
-        }
-        let f = fresnel_dielectric(o_m, eta);
-        if reflection {
-            return self.reflection_pdf(wo, wi) * f;
-        }
-        self.distribution.pdf_refracted(wo, wi, wm, eta, self.sample_visible) * (1.0 - f)
-    }
-
-    /// The microfacet normal, and the direction scattered about it, for `wo` above: reflection when
-    /// `uc` < F(ωo·ωm), refraction otherwise. `None` if ωm faces away from ωo or the direction
-    /// leaves the side its lobe belongs to.
-    fn sample_upper(&self, wo: Vec3, eta: f32, uc: f32, u: Vec2) -> Option<(Vec3, bool)> {
-        let wm = self.distribution.sample_wm(wo, u, self.sample_visible);
-        let o_m = wo.dot(wm);
-        if !(o_m > 0.0) {
-            return None;
-        }
-        if uc < fresnel_dielectric(o_m, eta) {
-            let wi = reflect(wo, wm).normalize();
-            return (wi.z > 0.0).then_some((wi, true));
-        }
-        let wi = refract_about(wo, wm, eta)?.wt.normalize();
-        (wi.z < 0.0).then_some((wi, false))
+        let visible = self.sample_visible;
+        let s = on_distribution!(self.distribution, |d| ReflectionLobe { distribution: d, shadowing: Shadowing::Smith, visible }
+            .sample::<f32>(wo.into(), u.x, u.y));
+        s.valid.then(|| s.wi.into())
     }
 
     /// The single-scattering energy split at `wo` (either side): (reflected, transmitted) fraction of the
@@ -827,39 +717,34 @@ impl BsdfModel for RoughDielectric {
     }
 
     fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
+        let kernel = self.kernel();
+        let Some(ms) = &self.compensation else { return sample_one(&kernel, wo, uc, u) };
         if wo.z == 0.0 || wo.is_nan() {
             return None;
         }
-        let sign = if wo.z < 0.0 { -1.0 } else { 1.0 };
-        let (wo_up, _, eta) = self.upper(wo, Vec3::Z);
-        // With compensation: the multiple-scattering lobes with probability P = 1 − E(|cos θo|), `uc`
-        // rescaled to choose within them; else the single-scattering lobes with `uc` rescaled.
-        let (p_ms, uc) = match &self.compensation {
-            Some(ms) => {
-                let p = ms.probability(wo);
-                if uc < p {
-                    let (wi, crossed) = ms.sample(wo, uc / p, u);
-                    let (flags, eta_path) = if crossed { (DIFFUSE_TRANSMISSION, eta) } else { (BsdfFlags::DIFFUSE_REFLECTION, 1.0) };
-                    let s = BsdfSample::smooth(wi, self.eval(wo, wi), self.pdf(wo, wi), flags, eta_path)?;
-                    return s.weight.is_finite().then_some(s);
-                }
-                (p, (uc - p) / (1.0 - p))
+        // The multiple-scattering lobes with probability P = 1 − E(|cos θo|), `uc` rescaled to choose within
+        // them; else the single-scattering lobes with `uc` rescaled.
+        let p = ms.probability(wo);
+        let (wi, flags, eta) = if uc < p {
+            let (wi, crossed) = ms.sample(wo, uc / p, u);
+            let eta = if wo.z < 0.0 { 1.0 / self.eta } else { self.eta };
+            if crossed {
+                (wi, DIFFUSE_TRANSMISSION, eta)
+            } else {
+                (wi, BsdfFlags::DIFFUSE_REFLECTION, 1.0)
             }
-            None => (0.0, uc),
+        } else {
+            let s = sample_one(&kernel, wo, (uc - p) / (1.0 - p), u)?;
+            (s.wi, s.flags, s.eta)
         };
-        let (wi_up, reflection) = self.sample_upper(wo_up, eta, uc, u)?;
-        let (flags, eta_path) = if reflection { (BsdfFlags::GLOSSY_REFLECTION, 1.0) } else { (GLOSSY_TRANSMISSION, eta) };
-        let wi = sign * wi_up;
-        let pdf = if p_ms > 0.0 { self.pdf(wo, wi) } else { self.pdf_upper(wo_up, wi_up, eta) };
-        let s = BsdfSample::smooth(wi, self.eval(wo, wi), pdf, flags, eta_path)?;
+        let s = BsdfSample::smooth(wi, self.eval(wo, wi), self.pdf(wo, wi), flags, eta)?;
         // Far in the tails f and pdf are both subnormal and f·cos/pdf overflows; such a direction carries
         // no measurable energy (2026-11: as in roughconductor).
         s.weight.is_finite().then_some(s)
     }
 
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        let (wo_up, wi_up, eta) = self.upper(wo, wi);
-        let single = self.pdf_upper(wo_up, wi_up, eta);
+        let single = pdf_one(&self.kernel(), wo, wi);
         match &self.compensation {
             Some(ms) if wo.z != 0.0 && wi.z != 0.0 => {
                 let p = ms.probability(wo);
@@ -867,6 +752,146 @@ impl BsdfModel for RoughDielectric {
             }
             _ => single,
         }
+    }
+
+    lane_batch_methods!(lanes);
+}
+
+/// The single-scattering rough dielectric for the distribution `D` in lanes ([`LaneModel`]): Walter 2007's
+/// reflection and transmission lobes (module doc), its sampling and densities. `f`, `pdf` and `sample` of
+/// [`RoughDielectric`] are these (with compensation's lobes added), for single calls and batches alike.
+///
+/// Seen from below, the directions are negated and η inverted ("upper" frame, per lane). Reflection is
+/// the [`ReflectionLobe`] times F(ωo·ωh) of the relative index on ωo's side; transmission is computed from
+/// the outside and inside directions, whichever of them is ωo, divided by ηo², so that reciprocity
+/// f(ωo, ωi)/ηo² = f(ωi, ωo)/ηi² holds bit for bit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DielectricLobe<D> {
+    /// The distribution, Smith shadowing and whether visible normals are sampled.
+    pub lobe: ReflectionLobe<D>,
+    /// Relative index η = int_ior / ext_ior.
+    pub eta: f32,
+    pub specular_reflectance: Rgb,
+    pub specular_transmittance: Rgb,
+}
+
+distribution_kernel! {
+    /// [`DielectricLobe`] for the distribution a model has.
+    DielectricKernel, DielectricLobe
+}
+
+impl<D: Distribution> DielectricLobe<D> {
+    /// F(ωo·ωm) for `cos` = ωo·ωm > 0 in the upper frame: of η, or of 1/η in the lanes of `inside`.
+    #[inline(always)]
+    fn fresnel<R: Real>(&self, cos: R, inside: R::Mask) -> R {
+        fresnel_dielectric_lanes(R::select(inside, -cos, cos), self.eta)
+    }
+
+    /// The transmission lobe divided by ηo², Walter 2007 eq. 21, for `w_out` above and `w_in` below the
+    /// surface (other lanes: unspecified): symmetric in the two, never computed from which one is ωo.
+    #[inline(always)]
+    fn transmission_over_eta2<R: Real>(&self, w_out: V3<R>, w_in: V3<R>) -> R {
+        let (zero, one) = (R::splat(0.0), R::splat(1.0));
+        let eta = R::splat(self.eta);
+        let d = &self.lobe.distribution;
+        // The generalised half vector −(ωout + η ωin) (eq. 16), on the +z side.
+        let h = w_out.add(w_in.scale(eta)).neg();
+        let wm = unit_upper(h);
+        // G also enforces the sides: ωout·ωm > 0 > ωin·ωm.
+        let g = d.g(w_out, w_in, wm, Shadowing::Smith);
+        let (out_m, in_m) = (w_out.dot(wm), w_in.dot(wm));
+        // F from the direction on the less dense side: it is smooth in that cosine (no critical angle).
+        let f = fresnel_dielectric_lanes(if self.eta > 1.0 { out_m } else { in_m }, self.eta);
+        let denom = out_m + eta * in_m;
+        let value = (out_m * in_m).abs() / (w_out.z * w_in.z).abs() * (one - f) * d.d(wm) * g / (denom * denom);
+        // Within f32 underflow of the horizon the cosines vanish, and h can vanish (ωout = −η ωin); G → 0
+        // there but 0/0 is NaN (2026-11: never NaN/Inf).
+        R::select(value.is_finite() & g.gt(zero), value, zero)
+    }
+}
+
+/// h/|h| turned to the +z side: a half vector. Each component divided by the length, as the single calls
+/// did before this kernel, whose values the Mitsuba cross-check's bounds were measured on: near the
+/// critical angle 1 − F is ill-conditioned in ωo·ωm, and one rounding more (times the reciprocal) moved a
+/// transmitted pdf of 8·10⁻⁶ by 2.6 % (f64 of the same f32 directions: 8.006·10⁻⁶; gonio 8.07·10⁻⁶ with
+/// the reciprocal, 7.86·10⁻⁶ with the division; Mitsuba 7.76·10⁻⁶; 2026-12-05).
+#[inline(always)]
+fn unit_upper<R: Real>(h: V3<R>) -> V3<R> {
+    let wm = h.div(h.length());
+    V3::select(wm.z.lt(R::splat(0.0)), wm.neg(), wm)
+}
+
+impl<D: Distribution> LaneModel for DielectricLobe<D> {
+    #[inline(always)]
+    fn f_lanes<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> [R; 3] {
+        let zero = R::splat(0.0);
+        let inside = wo.z.lt(zero);
+        let same_side = (wo.z * wi.z).gt(zero);
+        let crossing = (wo.z.gt(zero) & wi.z.lt(zero)) | (inside & wi.z.gt(zero));
+        let (r, t) = (self.specular_reflectance.0, self.specular_transmittance.0);
+        let mut out = [zero; 3];
+        if R::any(same_side) {
+            let v = self.lobe.eval(V3::select(inside, wo.neg(), wo), V3::select(inside, wi.neg(), wi));
+            let value = v.value * self.fresnel(v.cos_theta_d, inside);
+            let ok = same_side & v.ok & value.is_finite();
+            out = channels!(|c| R::select(ok, value * r[c], zero));
+        }
+        if R::any(crossing) {
+            // ηo = 1 outside, η inside.
+            let over_eta2 = self.transmission_over_eta2(V3::select(inside, wi, wo), V3::select(inside, wo, wi));
+            let value = R::select(inside, over_eta2 * (self.eta * self.eta), over_eta2);
+            out = channels!(|c| R::select(crossing, value * t[c], out[c]));
+        }
+        out
+    }
+
+    /// Walter 2007 eqs. 14, 17 with the lobe probabilities F and 1 − F.
+    #[inline(always)]
+    fn pdf_lanes<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> R {
+        let zero = R::splat(0.0);
+        let inside = wo.z.lt(zero);
+        let eta = R::select(inside, R::splat(1.0 / self.eta), R::splat(self.eta));
+        let (wo, wi) = (V3::select(inside, wo.neg(), wo), V3::select(inside, wi.neg(), wi));
+        let reflection = wi.z.gt(zero);
+        // The half vector of either lobe (eqs. 13, 16), on the +z side.
+        let h = V3::select(reflection, wo.add(wi), wo.add(wi.scale(eta)).neg());
+        let wm = unit_upper(h);
+        let (o_m, i_m) = (wo.dot(wm), wi.dot(wm));
+        // Only microfacets facing ωo are sampled, and a refracted ωi lies behind its microfacet.
+        let ok = wo.z.gt(zero) & !wi.z.eq(zero) & o_m.gt(zero) & ((reflection & i_m.gt(zero)) | (!reflection & i_m.lt(zero)));
+        let f = self.fresnel(o_m, inside);
+        let d = &self.lobe.distribution;
+        let mut pdf = zero;
+        if R::any(ok & reflection) {
+            pdf = d.pdf_reflected(wo, wm, self.lobe.visible) * f;
+        }
+        if R::any(ok & !reflection) {
+            pdf = R::select(reflection, pdf, d.pdf_refracted(wo, wi, wm, eta, self.lobe.visible) * (R::splat(1.0) - f));
+        }
+        R::select(ok & pdf.is_finite(), pdf, zero)
+    }
+
+    /// Draw ωm (visible normals of ωo, or D·cos), reflect ωo about it where `uc` < F(ωo·ωm), else refract.
+    #[inline(always)]
+    fn sample_lanes<R: Real>(&self, wo: V3<R>, uc: R, ux: R, uy: R) -> LaneSample<R> {
+        let zero = R::splat(0.0);
+        let inside = wo.z.lt(zero);
+        let eta = R::select(inside, R::splat(1.0 / self.eta), R::splat(self.eta));
+        let wo_up = V3::select(inside, wo.neg(), wo);
+        let wm = self.lobe.distribution.sample_wm(wo_up, ux, uy, self.lobe.visible);
+        let o_m = wo_up.dot(wm);
+        let reflected = uc.lt(self.fresnel(o_m, inside));
+        let wr = reflect_lanes(wo_up, wm).normalize();
+        // Refraction about ωm (pbrt-v4 eq. 9.4 with the normal ωm).
+        let cos2_t = cos2_transmitted(o_m, eta);
+        let wt = wo_up.div(eta).neg().add(wm.scale(o_m / eta - cos2_t.sqrt())).normalize();
+        let wi_up = V3::select(reflected, wr, wt);
+        let sides = (reflected & wr.z.gt(zero)) | (!reflected & cos2_t.gt(zero) & wt.z.lt(zero));
+        let valid = !wo.z.eq(zero) & o_m.gt(zero) & sides;
+        let wi = V3::select(inside, wi_up.neg(), wi_up);
+        let flags = R::select(reflected, flag_lanes(BsdfFlags::GLOSSY_REFLECTION), flag_lanes(GLOSSY_TRANSMISSION));
+        let s = LaneSample::smooth(wi, self.f_lanes(wo, wi), self.pdf_lanes(wo, wi), flags, valid);
+        LaneSample { eta: R::select(reflected, R::splat(1.0), eta), ..s }
     }
 }
 

@@ -71,10 +71,11 @@ use super::rough_conductor::{read_distribution, MicrofacetParams};
 use super::rough_dielectric::SplitLobes;
 use super::{BsdfFlags, BsdfModel, BsdfSample, RoughDielectric};
 use crate::error::{Error, Result};
-use crate::fresnel::{fresnel_dielectric_lanes, reflect_lanes};
+use crate::fresnel::fresnel_dielectric_lanes;
 use crate::math::lanes::{channels, Real, V3};
 use crate::math::{Vec2, Vec3};
-use crate::microfacet::{Ggx, MicrofacetDistribution, MicrofacetKind};
+use crate::microfacet::reflection::ReflectionLobe;
+use crate::microfacet::{on_distribution, Distribution, MicrofacetDistribution, MicrofacetKind, Shadowing};
 use crate::props::Props;
 use crate::sampling::warp::{cosine_hemisphere, cosine_hemisphere_density, cosine_hemisphere_pdf, sample_cosine_hemisphere};
 use crate::spectrum::Rgb;
@@ -530,12 +531,13 @@ impl BsdfModel for RoughPlastic {
     lane_batch_methods!(lanes);
 }
 
-/// GGX rough plastic with visible-normal sampling and no compensation, in lanes ([`LaneModel`]): `f`, `pdf`
-/// and `sample` of that configuration are these, for single calls and batches alike. Each step is the one
-/// of [`RoughPlastic`]'s methods and [`RoughDielectric::reflection`] with selects for the early returns.
+/// Rough plastic without compensation for the distribution `D`, in lanes ([`LaneModel`]): `f`, `pdf` and
+/// `sample` of those configurations are these, for single calls and batches alike. The glossy lobe is the
+/// coating's [`ReflectionLobe`] times F (what [`RoughDielectric::reflection`] is above the surface), the base
+/// [`coated_diffuse`]; each step is the one of [`RoughPlastic`]'s methods with selects for the early returns.
 #[derive(Clone, Copy, Debug)]
-pub struct GgxPlastic<'a> {
-    ggx: Ggx,
+pub struct PlasticLobe<'a, D> {
+    lobe: ReflectionLobe<D>,
     eta: f32,
     specular_reflectance: Rgb,
     diffuse_reflectance: Rgb,
@@ -548,13 +550,23 @@ pub struct GgxPlastic<'a> {
     even: Option<&'a [f32; TABLE_SIZE]>,
 }
 
+distribution_kernel! {
+    /// [`PlasticLobe`] for the distribution a model has.
+    PlasticKernel<'a>, PlasticLobe
+}
+
 impl RoughPlastic {
-    /// The [`GgxPlastic`] kernel of this model, `None` for other configurations.
+    /// The [`PlasticKernel`] of this model, `None` with energy compensation (whose lobes look their tables
+    /// up per lane and stay on the single calls).
     #[inline(always)]
-    pub(crate) fn lanes(&self) -> Option<GgxPlastic<'_>> {
+    pub(crate) fn lanes(&self) -> Option<PlasticKernel<'_>> {
         let c = &self.coating;
-        (c.distribution.kind == MicrofacetKind::Ggx && c.sample_visible && c.compensation.is_none()).then(|| GgxPlastic {
-            ggx: c.distribution.ggx(),
+        if c.compensation.is_some() {
+            return None;
+        }
+        let visible = c.sample_visible;
+        Some(on_distribution!(c.distribution, |d| PlasticKernel::from(PlasticLobe {
+            lobe: ReflectionLobe { distribution: d, shadowing: Shadowing::Smith, visible },
             eta: c.eta,
             specular_reflectance: c.specular_reflectance,
             diffuse_reflectance: self.diffuse_reflectance,
@@ -563,11 +575,11 @@ impl RoughPlastic {
             weight: specular_sampling_weight(self.diffuse_reflectance, c.specular_reflectance),
             tables: &self.tables,
             even: self.tables.graded.is_none().then_some(&self.tables.transmittance),
-        })
+        })))
     }
 }
 
-impl GgxPlastic<'_> {
+impl<D: Distribution> PlasticLobe<'_, D> {
     /// T(μ) per lane ([`CoatingTables::transmittance`]): the even table by [`Real::lerp_table`] (gathers in
     /// the AVX lanes), graded nodes (η < 1) by a search per lane.
     #[inline(always)]
@@ -584,28 +596,18 @@ impl GgxPlastic<'_> {
         specular_probability(R::splat(1.0) - self.transmittance(cos_theta_o), self.weight)
     }
 
-    /// [`RoughDielectric::reflection`] (no compensation): Walter 2007 eq. 20, from the unnormalised half
-    /// vector h = ωo + ωi as in [`ConductorLobe`](super::rough_conductor::ConductorLobe) (one division and
-    /// three square roots besides F's, 2026-12; F's cosine ωo·ωh = √(h·h)/2).
+    /// [`RoughDielectric::reflection`] (no compensation): Walter 2007 eq. 20, F's cosine ωo·ωh = |ωo + ωi|/2.
     #[inline(always)]
     fn reflection<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> [R; 3] {
         let zero = R::splat(0.0);
-        let h = wo.add(wi);
-        let l = h.dot(h);
-        let value = self.ggx.reflection_term(wo, wi, h, l) * fresnel_dielectric_lanes(l.sqrt() * 0.5, self.eta);
-        let ok = wo.z.gt(zero) & wi.z.gt(zero) & wo.dot(h).gt(zero) & wi.dot(h).gt(zero) & value.is_finite();
+        let v = self.lobe.eval(wo, wi);
+        let value = v.value * fresnel_dielectric_lanes(v.cos_theta_d, self.eta);
+        let ok = v.ok & value.is_finite();
         channels!(|c| R::select(ok, value * self.specular_reflectance.0[c], zero))
-    }
-
-    /// [`RoughDielectric::reflection_pdf`] for GGX visible normals ([`Ggx::pdf_reflected_visible_h`]).
-    #[inline(always)]
-    fn reflection_pdf<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> R {
-        let h = wo.add(wi);
-        R::select(wi.z.gt(R::splat(0.0)), self.ggx.pdf_reflected_visible_h(wo, h, h.dot(h)), R::splat(0.0))
     }
 }
 
-impl LaneModel for GgxPlastic<'_> {
+impl<D: Distribution> LaneModel for PlasticLobe<'_, D> {
     #[inline(always)]
     fn f_lanes<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> [R; 3] {
         let zero = R::splat(0.0);
@@ -621,7 +623,7 @@ impl LaneModel for GgxPlastic<'_> {
         let zero = R::splat(0.0);
         let above = wo.z.gt(zero) & wi.z.gt(zero);
         let p = self.specular_probability(wo.z);
-        let pdf = p * self.reflection_pdf(wo, wi) + (R::splat(1.0) - p) * cosine_hemisphere_density(wi.z);
+        let pdf = p * self.lobe.pdf(wo, wi) + (R::splat(1.0) - p) * cosine_hemisphere_density(wi.z);
         R::select(above, pdf, zero)
     }
 
@@ -634,12 +636,16 @@ impl LaneModel for GgxPlastic<'_> {
         }
         // The glossy lobe with probability p (its sample may fail), else the base's cosine lobe.
         let glossy = uc.lt(self.specular_probability(wo.z));
-        let wm = self.ggx.sample_visible(wo, ux, uy);
-        let reflected = reflect_lanes(wo, wm).normalize();
-        let glossy_ok = wo.dot(wm).gt(zero) & reflected.z.gt(zero);
-        let wi = V3::select(glossy, reflected, cosine_hemisphere(ux, uy));
+        let mut wi = cosine_hemisphere(ux, uy);
+        let mut valid = above & wi.z.gt(zero);
+        // The glossy lobe's sample only where some lane chose it (Beckmann's visible normals cost ~10× the
+        // cosine lobe's; a single call computes one of the two).
+        if R::any(glossy) {
+            let reflected = self.lobe.sample(wo, ux, uy);
+            wi = V3::select(glossy, reflected.wi, wi);
+            valid = (glossy & above & reflected.valid & wi.z.gt(zero)) | (!glossy & valid);
+        }
         let flags = R::select(glossy, flag_lanes(BsdfFlags::GLOSSY_REFLECTION), flag_lanes(BsdfFlags::DIFFUSE_REFLECTION));
-        let valid = above & (!glossy | glossy_ok) & wi.z.gt(zero);
         LaneSample::smooth(wi, self.f_lanes(wo, wi), self.pdf_lanes(wo, wi), flags, valid)
     }
 }

@@ -25,10 +25,12 @@
 //! assert!((s.pdf - (1.0 - 2.0 * 0.04 / 1.04)).abs() < 1e-6);
 //! ```
 
-use super::dielectric::{relative_ior, sample_reflect_or_transmit};
+use super::dielectric::{reflect_or_transmit, relative_ior};
+use super::lanes::{sample_one, LaneModel, LaneSample};
 use super::{BsdfFlags, BsdfModel, BsdfSample};
 use crate::error::Result;
-use crate::fresnel::fresnel_dielectric;
+use crate::fresnel::fresnel_dielectric_lanes;
+use crate::math::lanes::{Real, V3};
 use crate::math::{Vec2, Vec3};
 use crate::props::Props;
 use crate::spectrum::Rgb;
@@ -54,9 +56,44 @@ impl ThinDielectric {
     /// Total reflectance R' = 2R/(1 + R) of the slab at incidence cosine `cos_theta` (either side).
     #[must_use]
     pub fn reflected_fraction(&self, cos_theta: f32) -> f32 {
-        let r = fresnel_dielectric(cos_theta.abs(), self.eta);
+        self.reflected_fraction_lanes(cos_theta)
+    }
+
+    /// [`Self::reflected_fraction`] in lanes.
+    #[inline(always)]
+    fn reflected_fraction_lanes<R: Real>(&self, cos_theta: R) -> R {
+        let r = fresnel_dielectric_lanes(cos_theta.abs(), self.eta);
         // Grazing light (R = 1) is reflected entirely: 2·1/(1+1) = 1, no special case needed.
-        2.0 * r / (1.0 + r)
+        r * 2.0 / (r + 1.0)
+    }
+
+    /// Itself: its lane code runs every configuration (the batch methods' `lane_batch_methods!`).
+    #[inline(always)]
+    fn lanes(&self) -> Option<&Self> {
+        Some(self)
+    }
+}
+
+/// The model in lanes ([`LaneModel`]), which its `sample` runs for one direction.
+impl LaneModel for ThinDielectric {
+    #[inline(always)]
+    fn f_lanes<R: Real>(&self, _wo: V3<R>, _wi: V3<R>) -> [R; 3] {
+        [R::splat(0.0); 3]
+    }
+
+    #[inline(always)]
+    fn pdf_lanes<R: Real>(&self, _wo: V3<R>, _wi: V3<R>) -> R {
+        R::splat(0.0)
+    }
+
+    /// [`reflect_or_transmit`] with the slab's r: transmission is undeviated and leaves into the medium it
+    /// came from (η = 1); none for ωo in the plane.
+    #[inline(always)]
+    fn sample_lanes<R: Real>(&self, wo: V3<R>, uc: R, _ux: R, _uy: R) -> LaneSample<R> {
+        let (zero, one) = (R::splat(0.0), R::splat(1.0));
+        let r = self.reflected_fraction_lanes(wo.z);
+        let s = reflect_or_transmit(wo, uc, r, self.specular_reflectance, self.specular_transmittance, wo.neg(), one, !wo.z.eq(zero));
+        LaneSample { valid: s.valid & !wo.z.eq(zero), ..s }
     }
 }
 
@@ -77,23 +114,21 @@ impl BsdfModel for ThinDielectric {
         Rgb::ZERO
     }
 
-    fn sample(&self, wo: Vec3, uc: f32, _u: Vec2) -> Option<BsdfSample> {
-        if wo.z == 0.0 {
-            return None;
-        }
-        let r = self.reflected_fraction(wo.z);
-        // Transmission is undeviated and leaves into the medium it came from: η = 1.
-        sample_reflect_or_transmit(wo, uc, r, self.specular_reflectance, self.specular_transmittance, || Some((-wo, 1.0)))
+    fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
+        sample_one(self, wo, uc, u)
     }
 
     fn pdf(&self, _wo: Vec3, _wi: Vec3) -> f32 {
         0.0
     }
+
+    lane_batch_methods!(lanes);
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::fresnel::fresnel_dielectric;
     #[allow(unused_imports)]
     use crate::bsdf::Examples;
 

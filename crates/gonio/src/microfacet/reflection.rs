@@ -77,12 +77,15 @@ impl<D: Distribution> ReflectionLobe<D> {
     }
 
     /// Draw ωh (visible normals or D·cos), reflect ωo about it; valid where ωo and ωi are above the
-    /// surface (and ωi is not NaN).
+    /// surface (and ωi is not NaN) and ωh faces ωo. A D·cos normal facing away from ωo reflects it to the
+    /// direction whose half vector is −ωh, where [`pdf`](Self::pdf) (D(−ωh) = 0) does not count it: such a
+    /// sample is rejected, so that the density of the accepted ones is `pdf` (a model mixing this lobe with
+    /// another would otherwise weight it by the other lobe's density).
     #[inline(always)]
     pub fn sample<R: Real>(&self, wo: V3<R>, ux: R, uy: R) -> LobeSample<R> {
         let zero = R::splat(0.0);
         let wm = self.distribution.sample_wm(wo, ux, uy, self.visible);
         let wi = reflect_lanes(wo, wm).normalize();
-        LobeSample { wi, valid: !wo.z.le(zero) & !(wi.z.is_nan() | wi.z.le(zero)) }
+        LobeSample { wi, valid: !wo.z.le(zero) & wo.dot(wm).gt(zero) & !(wi.z.is_nan() | wi.z.le(zero)) }
     }
 }

@@ -175,11 +175,19 @@ pub fn erf_inv_lanes<R: Real>(y: R) -> R {
     let a = R::select(a.gt(R::splat(ERF_INV_CLAMP)), R::splat(ERF_INV_CLAMP), a);
     let one = R::splat(1.0);
     let w = -ln_unit((one - a) * (one + a));
-    let central = horner((w - 2.5) * 0.4, &ERF_INV_CENTRAL);
-    let s = w.sqrt() - 3.0;
-    // The middle (√5 − 2)/2 and half-width (4 − √5)/2 of s's range.
-    let tail = horner((s - 0.118_033_988_749_894_9) * 1.133_830_541_363_598_3, &ERF_INV_TAIL);
-    (R::select(w.lt(R::splat(5.0)), central, tail) * a).xor_sign(y)
+    // Each polynomial only where some lane needs it (the tail is |y| > 0.9966: rare).
+    let central_lanes = w.lt(R::splat(5.0));
+    let mut ratio = R::splat(0.0);
+    if R::any(central_lanes) {
+        ratio = horner((w - 2.5) * 0.4, &ERF_INV_CENTRAL);
+    }
+    if R::any(!central_lanes) {
+        let s = w.sqrt() - 3.0;
+        // The middle (√5 − 2)/2 and half-width (4 − √5)/2 of s's range.
+        let tail = horner((s - 0.118_033_988_749_894_9) * 1.133_830_541_363_598_3, &ERF_INV_TAIL);
+        ratio = R::select(central_lanes, ratio, tail);
+    }
+    (ratio * a).xor_sign(y)
 }
 
 #[cfg(test)]
