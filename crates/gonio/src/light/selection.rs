@@ -26,8 +26,6 @@
 
 use super::Light;
 use crate::geometry::Shape;
-use crate::math::lanes::Real;
-use crate::math::simd::Float8;
 use glam::Vec3;
 use std::f32::consts::PI;
 
@@ -37,111 +35,86 @@ pub const UNIFORM_SHARE: f32 = 0.2;
 /// Above this many lights the choice is uniform.
 pub const MAX_LIGHTS: usize = 16;
 
-/// The lights' estimates in one form, importance = L · max(m, a·ŵ) / (k d² + q), d the distance from the
-/// centre c to x and ŵ their unit direction, as columns of [`MAX_LIGHTS`] numbers, so that [`Float8`] lanes
-/// estimate eight lights at once (2026-12-05: one light at a time, the estimates were 14 % of a render
-/// lit by four area lights):
-/// - `point`, `spot`: L = I, m = 1, a = 0, k = 1, q = 0 (I / d²; a spot's falloff multiplied in after);
-/// - `directional`, `constant`, `envmap`: L = E, m = 1, a = 0, k = 0, q = 1 (E);
-/// - `area`: L the radiance, m = q = A/4, a the vector area, k = 1;
-/// - the columns past the last light: L = 0, k = 0, q = 1 (0).
-#[derive(Clone, Debug, PartialEq)]
-struct Estimates {
-    center: [[f32; MAX_LIGHTS]; 3],
-    vector_area: [[f32; MAX_LIGHTS]; 3],
-    l: [f32; MAX_LIGHTS],
-    m: [f32; MAX_LIGHTS],
-    k: [f32; MAX_LIGHTS],
-    q: [f32; MAX_LIGHTS],
-    /// The lights that are spots: their falloff towards x multiplies their estimate.
-    spots: Vec<usize>,
+/// How a light's importance at a point is estimated (module docs).
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Estimate {
+    /// The same everywhere (directional, constant, envmap).
+    Distant(f32),
+    /// I / d² at a point light's position, times the spot's falloff for a spot (its index into the lights).
+    Point { position: Vec3, intensity: f32, spot: Option<usize> },
+    /// An emitting shape: radiance, centre, A/4 and its vector area.
+    Area { radiance: f32, center: Vec3, quarter_area: f32, vector_area: Vec3 },
 }
-
-/// One light's row of [`Estimates`]: (L, m, k, q, centre, vector area).
-type Row = (f32, f32, f32, f32, Vec3, Vec3);
 
 /// The light choice of a scene (module docs).
 #[derive(Clone, Debug, PartialEq)]
 pub struct LightSelection {
-    /// The number of lights, 0 for the uniform choice.
-    n: usize,
-    estimates: Box<Estimates>,
+    estimates: Vec<Estimate>,
 }
 
 impl LightSelection {
     /// The choice among `lights` (area lights on `shapes`).
     #[must_use]
     pub fn new(lights: &[Light], shapes: &[Shape]) -> Self {
-        let mut e = Estimates {
-            center: [[0.0; MAX_LIGHTS]; 3],
-            vector_area: [[0.0; MAX_LIGHTS]; 3],
-            l: [0.0; MAX_LIGHTS],
-            m: [0.0; MAX_LIGHTS],
-            k: [0.0; MAX_LIGHTS],
-            q: [1.0; MAX_LIGHTS],
-            spots: Vec::new(),
-        };
         if lights.len() > MAX_LIGHTS || lights.len() < 2 {
-            return LightSelection { n: 0, estimates: Box::new(e) };
+            return LightSelection { estimates: Vec::new() };
         }
-        for (index, light) in lights.iter().enumerate() {
-            let point = |intensity: f32, position: Vec3| -> Row { (intensity, 1.0, 1.0, 0.0, position, Vec3::ZERO) };
-            let distant = |irradiance: f32| -> Row { (irradiance, 1.0, 0.0, 1.0, Vec3::ZERO, Vec3::ZERO) };
-            let (l, m, k, q, center, vector) = match light {
-                Light::Point(p) => point(p.intensity.luminance(), p.position),
-                Light::Spot(s) => {
-                    e.spots.push(index);
-                    point(s.intensity.luminance(), s.position)
-                }
-                Light::Directional(d) => distant(d.irradiance.luminance()),
-                Light::Constant(c) => distant(PI * c.radiance.luminance()),
-                Light::EnvMap(env) => distant(PI * env.mean_luminance()),
+        let estimates = lights
+            .iter()
+            .enumerate()
+            .map(|(index, light)| match light {
+                Light::Point(p) => Estimate::Point { position: p.position, intensity: p.intensity.luminance(), spot: None },
+                Light::Spot(s) => Estimate::Point { position: s.position, intensity: s.intensity.luminance(), spot: Some(index) },
+                Light::Directional(d) => Estimate::Distant(d.irradiance.luminance()),
+                Light::Constant(c) => Estimate::Distant(PI * c.radiance.luminance()),
+                Light::EnvMap(e) => Estimate::Distant(PI * e.mean_luminance()),
                 Light::Area(a) => {
                     let shape = &shapes[a.shape as usize];
                     let center = (0..shape.primitive_count() as u32)
                         .fold(crate::geometry::bounds::Bounds3::EMPTY, |b, p| b.union(shape.primitive_bounds(p)))
                         .centroid();
-                    let quarter_area = 0.25 * shape.area();
-                    (a.radiance.luminance(), quarter_area, 1.0, quarter_area, center, vector_area(shape))
+                    Estimate::Area {
+                        radiance: a.radiance.luminance(),
+                        center,
+                        quarter_area: 0.25 * shape.area(),
+                        vector_area: vector_area(shape),
+                    }
                 }
-            };
-            (e.l[index], e.m[index], e.k[index], e.q[index]) = (l, m, k, q);
-            for axis in 0..3 {
-                e.center[axis][index] = center[axis];
-                e.vector_area[axis][index] = vector[axis];
-            }
-        }
-        LightSelection { n: lights.len(), estimates: Box::new(e) }
+            })
+            .collect();
+        LightSelection { estimates }
     }
 
     /// Whether the choice is uniform (one light, or more than [`MAX_LIGHTS`]).
     #[must_use]
     pub fn is_uniform(&self) -> bool {
-        self.n == 0
+        self.estimates.is_empty()
     }
 
-    /// The estimated importance of every light at `x` (module docs) into `out`, each ≥ 0 and finite.
-    fn importances(&self, lights: &[Light], x: Vec3, out: &mut [f32; MAX_LIGHTS]) {
-        let e = &*self.estimates;
-        let zero = Float8::splat(0.0);
-        // Infinite (x at a point light): large, but summable over every light.
-        let large = Float8::splat(f32::MAX / (MAX_LIGHTS as f32 * 2.0));
-        for start in (0..self.n).step_by(8) {
-            let column = |c: &[f32; MAX_LIGHTS]| Float8::from_fn(|i| c[start + i]);
-            let d = [0, 1, 2].map(|axis| Float8::splat(x[axis]) - column(&e.center[axis]));
-            let d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-            let a_dot_d = column(&e.vector_area[0]) * d[0] + column(&e.vector_area[1]) * d[1] + column(&e.vector_area[2]) * d[2];
-            let facing = Float8::select(d2.gt(zero), a_dot_d / d2.sqrt(), zero);
-            let value = column(&e.l) * column(&e.m).max(facing) / (column(&e.k) * d2 + column(&e.q));
-            let value = Float8::select(value.is_finite() & value.gt(zero), value, Float8::select(value.eq(Float8::splat(f32::INFINITY)), large, zero));
-            for i in 0..8 {
-                out[start + i] = value.lane(i);
+    /// The estimated importance of light `index` at `x` (module docs), ≥ 0 and finite.
+    fn importance(&self, lights: &[Light], index: usize, x: Vec3) -> f32 {
+        let value = match self.estimates[index] {
+            Estimate::Distant(e) => e,
+            Estimate::Point { position, intensity, spot } => {
+                let falloff = match spot.map(|s| &lights[s]) {
+                    Some(Light::Spot(s)) => s.falloff_at(x),
+                    _ => 1.0,
+                };
+                intensity * falloff / (x - position).length_squared()
             }
-        }
-        for &s in &e.spots {
-            if let Light::Spot(spot) = &lights[s] {
-                out[s] *= spot.falloff_at(x);
+            Estimate::Area { radiance, center, quarter_area, vector_area } => {
+                let d = x - center;
+                let d2 = d.length_squared();
+                let facing = if d2 > 0.0 { vector_area.dot(d) / d2.sqrt() } else { 0.0 };
+                radiance * quarter_area.max(facing) / (d2 + quarter_area)
             }
+        };
+        if value.is_finite() && value > 0.0 {
+            value
+        } else if value.is_infinite() {
+            f32::MAX / (MAX_LIGHTS as f32 * 2.0)
+        } else {
+            0.0
         }
     }
 
@@ -183,9 +156,12 @@ impl LightSelection {
     /// Each light's weight at `x` (into `weights`), (1 − s) imp/Σimp + s/n with s = [`UNIFORM_SHARE`] (all
     /// uniform where every importance is 0), and their sum (1 up to rounding).
     fn weights(&self, lights: &[Light], x: Vec3, weights: &mut [f32; MAX_LIGHTS]) -> f32 {
-        let n = self.n;
-        self.importances(lights, x, weights);
-        let sum: f32 = weights[..n].iter().sum();
+        let n = self.estimates.len();
+        let mut sum = 0.0f32;
+        for (i, w) in weights[..n].iter_mut().enumerate() {
+            *w = self.importance(lights, i, x);
+            sum += *w;
+        }
         let uniform = 1.0 / n as f32;
         let (share, scale) = if sum > 0.0 && sum.is_finite() { (UNIFORM_SHARE, (1.0 - UNIFORM_SHARE) / sum) } else { (1.0, 0.0) };
         let mut total = 0.0;
@@ -242,11 +218,11 @@ mod tests {
         }
     }
 
-    /// The estimates eight lights at a time give what the module doc's table gives light by light: ten
-    /// lights of every kind (two blocks of lanes), at points near and far, in front of and behind the flat
-    /// emitters, inside and outside the spot's cone; and a point on a point light is large and finite.
+    /// The estimates are the module doc's table: ten lights of every kind, at points near and far, in
+    /// front of and behind the flat emitters, inside and outside the spot's cone; and a point on a point
+    /// light is large and finite.
     #[test]
-    fn estimates_in_lanes_follow_the_table() {
+    fn estimates_follow_the_table() {
         let shapes = vec![
             Shape::Sphere(Sphere::new(Vec3::new(1.0, 2.0, 0.0), 0.5, Transform::IDENTITY, false).unwrap()),
             Shape::Disk(Disk::new(Transform::translate(Vec3::new(-1.0, 0.0, 3.0)), false)),
@@ -272,21 +248,17 @@ mod tests {
         let selection = LightSelection::new(&lights, &shapes);
         let points = [Vec3::ZERO, Vec3::new(0.1, -0.2, 0.3), Vec3::new(-1.0, 0.5, 4.0), Vec3::new(2.0, -1.0, -3.0), Vec3::new(9.0, 9.0, -9.0)];
         for x in points {
-            let mut got = [0.0f32; MAX_LIGHTS];
-            selection.importances(&lights, x, &mut got);
             for (i, light) in lights.iter().enumerate() {
-                let want = by_the_table(light, &shapes, x);
-                assert!((f64::from(got[i]) - want).abs() <= 1e-5 * want, "light {i} at {x}: {} vs {want}", got[i]);
+                let (got, want) = (selection.importance(&lights, i, x), by_the_table(light, &shapes, x));
+                assert!((f64::from(got) - want).abs() <= 1e-5 * want, "light {i} at {x}: {got} vs {want}");
             }
             let total: f32 = (0..lights.len()).map(|i| selection.pmf(&lights, x, i)).sum();
             assert!((total - 1.0).abs() < 1e-6, "at {x}: the choice's probabilities sum to {total}");
         }
         // The spot's cone holds the origin and not (9, 9, −9); the flat emitters face +z and −z.
-        let mut at = [0.0f32; MAX_LIGHTS];
-        selection.importances(&lights, Vec3::new(9.0, 9.0, -9.0), &mut at);
-        assert_eq!(at[3], 0.0);
-        selection.importances(&lights, Vec3::new(0.0, 2.0, 0.0), &mut at);
-        assert!(at[0].is_finite() && at[0] > 1e30, "on the point light: {}", at[0]);
+        assert_eq!(selection.importance(&lights, 3, Vec3::new(9.0, 9.0, -9.0)), 0.0);
+        let on_light = selection.importance(&lights, 0, Vec3::new(0.0, 2.0, 0.0));
+        assert!(on_light.is_finite() && on_light > 1e30, "on the point light: {on_light}");
         let p = selection.pmf(&lights, Vec3::new(0.0, 2.0, 0.0), 0);
         assert!(p.is_finite() && p > 0.79, "{p}");
     }
