@@ -800,8 +800,8 @@ mod tests {
     use super::*;
     use crate::sampling::rng::Pcg32;
 
-    /// The batch methods (one `match` per batch, AVX2-compiled loops, the eight-lane kernels of diffuse and
-    /// GGX roughconductor and roughplastic in `lanes`) give every example model's per-pair results bit for
+    /// The batch methods (one `match` per batch, AVX2-compiled loops, the eight-lane kernels of the models
+    /// that have one in `lanes`) give every example model's per-pair results bit for
     /// bit, including directions below the horizon and on it, and the rows after the last full eight.
     /// The `_checked` batch methods compute what the plain ones do, bit for bit, and report a row that fails
     /// the check wherever it is (in a full register of rows or among the last rows), for models with SIMD
