@@ -793,6 +793,39 @@ impl Bsdf {
     pub fn from_xml(text: &str, source: &str) -> Result<Bsdf> {
         Bsdf::from_props(&Props::from_xml_bsdf(text, source)?)
     }
+
+    /// The field that holds this model's colour parameter `name`, where a texture can set it at a hit
+    /// without building the model again: a reflectance in [0, 1] per channel (`Props::reflectance`) that
+    /// the model reads as it is, deriving nothing from it when built. `None` where the model must be
+    /// built again from its parameters (for models with energy-compensation lobes too, which are built
+    /// from the model).
+    pub fn reflectance_slot(&mut self, name: &str) -> Option<&mut Rgb> {
+        let compensated = match self {
+            Bsdf::RoughConductor(RoughConductor(c)) => c.compensation.is_some(),
+            Bsdf::RoughDielectric(d) => d.compensation.is_some(),
+            Bsdf::RoughPlastic(p) => p.coating.compensation.is_some(),
+            _ => false,
+        };
+        if compensated {
+            return None;
+        }
+        match (self, name) {
+            (Bsdf::Diffuse(d), "reflectance") => Some(&mut d.reflectance),
+            (Bsdf::Conductor(c), "specular_reflectance") => Some(&mut c.specular_reflectance),
+            (Bsdf::RoughConductor(RoughConductor(c)), "specular_reflectance") => Some(&mut c.fresnel.specular_reflectance),
+            (Bsdf::Dielectric(d), "specular_reflectance") => Some(&mut d.specular_reflectance),
+            (Bsdf::Dielectric(d), "specular_transmittance") => Some(&mut d.specular_transmittance),
+            (Bsdf::ThinDielectric(d), "specular_reflectance") => Some(&mut d.specular_reflectance),
+            (Bsdf::ThinDielectric(d), "specular_transmittance") => Some(&mut d.specular_transmittance),
+            (Bsdf::RoughDielectric(d), "specular_reflectance") => Some(&mut d.specular_reflectance),
+            (Bsdf::RoughDielectric(d), "specular_transmittance") => Some(&mut d.specular_transmittance),
+            (Bsdf::Plastic(p), "diffuse_reflectance") => Some(&mut p.diffuse_reflectance),
+            (Bsdf::Plastic(p), "specular_reflectance") => Some(&mut p.specular_reflectance),
+            (Bsdf::RoughPlastic(p), "diffuse_reflectance") => Some(&mut p.diffuse_reflectance),
+            (Bsdf::RoughPlastic(p), "specular_reflectance") => Some(&mut p.coating.specular_reflectance),
+            _ => None,
+        }
+    }
 }
 
 #[cfg(test)]

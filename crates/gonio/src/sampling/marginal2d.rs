@@ -55,6 +55,16 @@ pub struct Marginal2D<const D: usize> {
     normalized: bool,
 }
 
+/// The most parameter corners of a lookup (2ᴰ, D ≤ 3).
+const MAX_CORNERS: usize = 8;
+
+/// The parameter corners of a lookup ([`Marginal2D::lookup`]): the weights (w₀, w₁) per parameter, and
+/// for corner c (bit k set: parameter k's upper value) its offset from the lower corner, in slices.
+struct Corners<const D: usize> {
+    step: [usize; MAX_CORNERS],
+    weights: [[f32; 2]; D],
+}
+
 impl<const D: usize> Marginal2D<D> {
     /// Build from `data`: one `size = [w, h]` grid (row-major, x fastest) per combination of the
     /// parameter values `param_values` (the last parameter varying fastest, as in C order).
@@ -164,15 +174,19 @@ impl<const D: usize> Marginal2D<D> {
         !self.marg_cdf.is_empty()
     }
 
-    /// The slice offset of the lower corner and the interpolation weights (w₀, w₁) per parameter.
-    fn interpolate_weights(&self, param: [f32; D]) -> (usize, [[f32; 2]; D]) {
+    /// The slice offset of the lower corner and the parameters' corners: the interpolation weights
+    /// (w₀, w₁) per parameter and each corner's slice offset from the lower one.
+    fn interpolate_weights(&self, param: [f32; D]) -> (usize, Corners<D>) {
+        const { assert!(D <= 3, "at most 2³ = MAX_CORNERS corners") };
         let mut weights = [[1.0, 0.0]; D];
-        let mut offset = 0;
+        let (mut offset, mut upper) = (0, [0; D]);
         for dim in 0..D {
             let values = &self.param_values[dim];
             if values.len() == 1 {
+                // No upper value: its corners read the lower one (with weight 0).
                 continue;
             }
+            upper[dim] = self.param_strides[dim];
             // The interval [values[i], values[i+1]] holding the parameter, clamped to the first and last.
             let i = find_interval(values.len(), |k| values[k] < param[dim]);
             let (p0, p1) = (values[i], values[i + 1]);
@@ -182,42 +196,46 @@ impl<const D: usize> Marginal2D<D> {
             weights[dim] = [1.0 - w1, w1];
             offset += self.param_strides[dim] * i;
         }
-        (offset, weights)
+        // Corner c takes the upper value of parameter k where bit k of c is set.
+        let mut step = [0; MAX_CORNERS];
+        for (c, s) in step.iter_mut().enumerate().take(1 << D) {
+            *s = (0..D).filter(|k| c & (1 << k) != 0).map(|k| upper[k]).sum();
+        }
+        (offset, Corners { step, weights })
     }
 
     /// Multilinear interpolation over the parameters of `table[i0 + offset]`, where slices of `table` are
-    /// `size` long. The last parameter is the outermost level, as in Mitsuba's recursive `lookup`.
+    /// `size` long: Mitsuba's recursive `lookup` (the last parameter the outermost level, a level whose
+    /// upper weight is 0 taking its lower value alone), evaluated level by level from the first parameter
+    /// up, with the same operations in the same order.
     #[inline]
-    fn lookup(&self, table: &[f32], offset: usize, i0: usize, size: usize, weights: &[[f32; 2]; D]) -> f32 {
-        self.lookup_dim(table, offset, i0, size, weights, D)
-    }
-
-    fn lookup_dim(&self, table: &[f32], offset: usize, i0: usize, size: usize, weights: &[[f32; 2]; D], dim: usize) -> f32 {
-        if dim == 0 {
-            return table[i0 + offset];
+    fn lookup(&self, table: &[f32], offset: usize, i0: usize, size: usize, corners: &Corners<D>) -> f32 {
+        let mut v = [0.0f32; MAX_CORNERS];
+        for (c, v) in v.iter_mut().enumerate().take(1 << D) {
+            *v = table[i0 + offset + corners.step[c] * size];
         }
-        let [w0, w1] = weights[dim - 1];
-        let v0 = self.lookup_dim(table, offset, i0, size, weights, dim - 1);
-        if w1 == 0.0 {
-            return v0 * w0;
+        let mut n = 1 << D;
+        for [w0, w1] in corners.weights {
+            n /= 2;
+            for j in 0..n {
+                v[j] = if w1 == 0.0 { v[2 * j] * w0 } else { v[2 * j].mul_add(w0, v[2 * j + 1] * w1) };
+            }
         }
-        let i1 = i0 + self.param_strides[dim - 1] * size;
-        let v1 = self.lookup_dim(table, offset, i1, size, weights, dim - 1);
-        v0.mul_add(w0, v1 * w1)
+        v[0]
     }
 
     /// The (interpolated) value at `pos` ∈ [0, 1]²: a density when normalised.
     #[must_use]
     pub fn eval(&self, pos: Vec2, param: [f32; D]) -> f32 {
-        let (slice, weights) = self.interpolate_weights(param);
+        let (slice, corners) = self.interpolate_weights(param);
         let [w, h] = self.size;
         let (cell, t) = self.cell(pos);
         let n_data = w * h;
         let index = cell[0] + cell[1] * w + slice * n_data;
-        let v00 = self.lookup(&self.data, 0, index, n_data, &weights);
-        let v10 = self.lookup(&self.data, 1, index, n_data, &weights);
-        let v01 = self.lookup(&self.data, w, index, n_data, &weights);
-        let v11 = self.lookup(&self.data, w + 1, index, n_data, &weights);
+        let v00 = self.lookup(&self.data, 0, index, n_data, &corners);
+        let v10 = self.lookup(&self.data, 1, index, n_data, &corners);
+        let v01 = self.lookup(&self.data, w, index, n_data, &corners);
+        let v11 = self.lookup(&self.data, w + 1, index, n_data, &corners);
         lerp(lerp(v00, v10, t.x), lerp(v01, v11, t.x), t.y)
     }
 
@@ -237,13 +255,13 @@ impl<const D: usize> Marginal2D<D> {
         debug_assert!(self.can_sample(), "Marginal2D::sample: built without sampling");
         let [w, h] = self.size;
         let (n_cond, n_marg, n_data) = (h * (w - 1), h - 1, w * h);
-        let (slice, weights) = self.interpolate_weights(param);
+        let (slice, corners) = self.interpolate_weights(param);
         let clamp = |v: f32| if v.is_nan() { 0.5 } else { v.clamp(EPSILON, ONE_MINUS_EPSILON) };
         let mut s = Vec2::new(clamp(u.x), clamp(u.y));
 
         // Row: search the marginal CDF.
         let offset_marg = slice * n_marg;
-        let fetch_marginal = |i: usize| self.lookup(&self.marg_cdf, 0, offset_marg + i, n_marg, &weights);
+        let fetch_marginal = |i: usize| self.lookup(&self.marg_cdf, 0, offset_marg + i, n_marg, &corners);
         if !self.normalized {
             s.y *= fetch_marginal(n_marg - 1);
         }
@@ -253,15 +271,15 @@ impl<const D: usize> Marginal2D<D> {
         }
         let offset_cond = slice * n_cond + row * (w - 1);
         // Row integrals at both ends of the segment: the marginal density is linear between them.
-        let r0 = self.lookup(&self.cond_cdf, w - 2, offset_cond, n_cond, &weights);
-        let r1 = self.lookup(&self.cond_cdf, 2 * (w - 1) - 1, offset_cond, n_cond, &weights);
+        let r0 = self.lookup(&self.cond_cdf, w - 2, offset_cond, n_cond, &corners);
+        let r1 = self.lookup(&self.cond_cdf, 2 * (w - 1) - 1, offset_cond, n_cond, &corners);
         s.y = sample_segment(s.y, self.inv_patch_size[1], r0, r1);
 
         // Column: search the conditional CDF of the interpolated row.
         s.x *= lerp(r0, r1, s.y);
         let fetch_conditional = |i: usize| {
-            let v0 = self.lookup(&self.cond_cdf, 0, offset_cond + i, n_cond, &weights);
-            let v1 = self.lookup(&self.cond_cdf, w - 1, offset_cond + i, n_cond, &weights);
+            let v0 = self.lookup(&self.cond_cdf, 0, offset_cond + i, n_cond, &corners);
+            let v1 = self.lookup(&self.cond_cdf, w - 1, offset_cond + i, n_cond, &corners);
             lerp(v0, v1, s.y)
         };
         let col = binary_search(0, w - 2, |i| fetch_conditional(i) < s.x);
@@ -269,10 +287,10 @@ impl<const D: usize> Marginal2D<D> {
             s.x -= fetch_conditional(col - 1);
         }
         let offset_data = slice * n_data + row * w + col;
-        let v00 = self.lookup(&self.data, 0, offset_data, n_data, &weights);
-        let v10 = self.lookup(&self.data, 1, offset_data, n_data, &weights);
-        let v01 = self.lookup(&self.data, w, offset_data, n_data, &weights);
-        let v11 = self.lookup(&self.data, w + 1, offset_data, n_data, &weights);
+        let v00 = self.lookup(&self.data, 0, offset_data, n_data, &corners);
+        let v10 = self.lookup(&self.data, 1, offset_data, n_data, &corners);
+        let v01 = self.lookup(&self.data, w, offset_data, n_data, &corners);
+        let v11 = self.lookup(&self.data, w + 1, offset_data, n_data, &corners);
         let (c0, c1) = (lerp(v00, v01, s.y), lerp(v10, v11, s.y));
         s.x = sample_segment(s.x, self.inv_patch_size[0], c0, c1);
         let p = Vec2::new((col as f32 + s.x) * self.patch_size[0], (row as f32 + s.y) * self.patch_size[1]);
@@ -285,13 +303,13 @@ impl<const D: usize> Marginal2D<D> {
         debug_assert!(self.can_sample(), "Marginal2D::invert: built without sampling");
         let [w, h] = self.size;
         let (n_cond, n_marg, n_data) = (h * (w - 1), h - 1, w * h);
-        let (slice, weights) = self.interpolate_weights(param);
+        let (slice, corners) = self.interpolate_weights(param);
         let ([cx, cy], mut s) = self.cell(pos);
         let offset_data = slice * n_data + cy * w + cx;
-        let v00 = self.lookup(&self.data, 0, offset_data, n_data, &weights);
-        let v10 = self.lookup(&self.data, 1, offset_data, n_data, &weights);
-        let v01 = self.lookup(&self.data, w, offset_data, n_data, &weights);
-        let v11 = self.lookup(&self.data, w + 1, offset_data, n_data, &weights);
+        let v00 = self.lookup(&self.data, 0, offset_data, n_data, &corners);
+        let v10 = self.lookup(&self.data, 1, offset_data, n_data, &corners);
+        let v01 = self.lookup(&self.data, w, offset_data, n_data, &corners);
+        let v11 = self.lookup(&self.data, w + 1, offset_data, n_data, &corners);
         let (c0, c1) = (lerp(v00, v01, s.y), lerp(v10, v11, s.y));
         let pdf = lerp(c0, c1, s.x);
 
@@ -299,22 +317,22 @@ impl<const D: usize> Marginal2D<D> {
         s.x = invert_segment(s.x, self.patch_size[0], c0, c1);
         let offset_cond = slice * n_cond + cy * (w - 1);
         if cx > 0 {
-            let v0 = self.lookup(&self.cond_cdf, 0, offset_cond + cx - 1, n_cond, &weights);
-            let v1 = self.lookup(&self.cond_cdf, w - 1, offset_cond + cx - 1, n_cond, &weights);
+            let v0 = self.lookup(&self.cond_cdf, 0, offset_cond + cx - 1, n_cond, &corners);
+            let v1 = self.lookup(&self.cond_cdf, w - 1, offset_cond + cx - 1, n_cond, &corners);
             s.x += lerp(v0, v1, s.y);
         }
-        let r0 = self.lookup(&self.cond_cdf, w - 2, offset_cond, n_cond, &weights);
-        let r1 = self.lookup(&self.cond_cdf, 2 * (w - 1) - 1, offset_cond, n_cond, &weights);
+        let r0 = self.lookup(&self.cond_cdf, w - 2, offset_cond, n_cond, &corners);
+        let r1 = self.lookup(&self.cond_cdf, 2 * (w - 1) - 1, offset_cond, n_cond, &corners);
         s.x /= lerp(r0, r1, s.y);
 
         // y: the marginal CDF at pos.y.
         s.y = invert_segment(s.y, self.patch_size[1], r0, r1);
         let offset_marg = slice * n_marg;
         if cy > 0 {
-            s.y += self.lookup(&self.marg_cdf, 0, offset_marg + cy - 1, n_marg, &weights);
+            s.y += self.lookup(&self.marg_cdf, 0, offset_marg + cy - 1, n_marg, &corners);
         }
         if !self.normalized {
-            s.y /= self.lookup(&self.marg_cdf, 0, offset_marg + n_marg - 1, n_marg, &weights);
+            s.y /= self.lookup(&self.marg_cdf, 0, offset_marg + n_marg - 1, n_marg, &corners);
         }
         (s, pdf)
     }

@@ -25,6 +25,10 @@ pub enum Material {
     Fixed(Bsdf),
     /// A `diffuse` whose reflectance is a texture (the common case, built without `Props`).
     TexturedDiffuse(Texture),
+    /// A model whose every texture sets a reflectance it reads as it is ([`Bsdf::reflectance_slot`]):
+    /// built once, and at a hit copied with the textures' values written into it — the model
+    /// [`Material::Textured`] would build from the same values, without `Props`.
+    Slotted { model: Bsdf, textures: Vec<(String, Texture)> },
     /// Any other BSDF with texture parameters: the description without them, and the textures with their
     /// parameter paths. Rebuilt at every hit from a copy of the template (`Props` tracks which parameters
     /// were read, so it is not `Sync`: the template sits behind a mutex held only for the copy). A slow,
@@ -42,27 +46,55 @@ pub enum Material {
 impl Material {
     /// Build from a `<bsdf>` description (textures included).
     pub fn from_props(p: &Props) -> Result<Material> {
+        let material = Self::rebuilt(p)?;
+        let Material::Textured { textures, .. } = &material else { return Ok(material) };
+        // Built once now, so that parameter errors surface at load time; that model is the slotted form's
+        // where every texture has a slot in it.
+        let model = material.try_at(Vec2::splat(0.5))?.into_owned();
+        let slotted = textures.iter().all(|(path, _)| match path.as_slice() {
+            [name] => !SCALAR_PARAMETERS.contains(&name.as_str()) && model.clone().reflectance_slot(name).is_some(),
+            _ => false,
+        });
+        if slotted {
+            let textures = textures.iter().map(|(path, t)| (path[0].clone(), t.clone())).collect();
+            return Ok(Material::Slotted { model, textures });
+        }
+        Ok(material)
+    }
+
+    /// The material without slots: `Fixed`, `TexturedDiffuse`, or `Textured` (built again at each hit).
+    fn rebuilt(p: &Props) -> Result<Material> {
         let mut template = p.clone();
         let taken = template.take_textures();
         if taken.is_empty() {
             return Ok(Material::Fixed(Bsdf::from_props(p)?));
         }
         let textures = taken.iter().map(|(path, t)| Ok((path.clone(), Texture::from_props(t)?))).collect::<Result<Vec<_>>>()?;
-        let material = match (template.plugin_type(), textures.as_slice()) {
+        Ok(match (template.plugin_type(), textures.as_slice()) {
             ("diffuse", [(path, t)]) if path == &["reflectance"] => Material::TexturedDiffuse(t.clone()),
             _ => Material::Textured { template: Mutex::new(template), textures, cache: RwLock::new(HashMap::new()) },
-        };
-        // Build once now so that parameter errors surface at load time.
-        if let Material::Textured { .. } = &material {
-            material.try_at(Vec2::splat(0.5))?;
-        }
-        Ok(material)
+        })
     }
 
     fn try_at(&self, uv: Vec2) -> Result<Cow<'_, Bsdf>> {
         Ok(match self {
             Material::Fixed(b) => Cow::Borrowed(b),
             Material::TexturedDiffuse(t) => Cow::Owned(Bsdf::Diffuse(Diffuse::new(Self::texel(t, uv)))),
+            Material::Slotted { model, textures } => {
+                let mut model = model.clone();
+                for (name, t) in textures {
+                    let value = t.eval(uv);
+                    // `Props::reflectance`'s range, so that a value out of it fails as the rebuilt model would.
+                    if !value.0.iter().all(|c| (0.0..=1.0).contains(c)) {
+                        return Err(crate::error::Error::spec(
+                            "",
+                            format!("texture value {value:?} of `{name}` outside [0, 1]"),
+                        ));
+                    }
+                    *model.reflectance_slot(name).expect("slots checked when the material was built") = value;
+                }
+                Cow::Owned(model)
+            }
             Material::Textured { template, textures, cache } => {
                 let values: Vec<TextureValue> = textures.iter().map(|(path, t)| TextureValue::of(path, t, uv)).collect();
                 let key: Vec<u32> = values.iter().flat_map(TextureValue::bits).collect();
@@ -170,6 +202,70 @@ impl TextureValue {
         match self {
             TextureValue::Scalar(v) => Value::Number(f64::from(*v)),
             TextureValue::Colour(c) => Value::List(c.to_f64().to_vec()),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A `<bsdf>` with checkerboards (of colours `c0`, `c1`) on the parameters `textured`.
+    fn props(plugin: &str, extra: &str, textured: &[(&str, &str, &str)]) -> Props {
+        let textures: String = textured
+            .iter()
+            .map(|(name, c0, c1)| {
+                format!(
+                    r#"<texture type="checkerboard" name="{name}"><rgb name="color0" value="{c0}"/><rgb name="color1" value="{c1}"/>
+                       <transform name="to_uv"><scale x="3" y="2"/></transform></texture>"#
+                )
+            })
+            .collect();
+        Props::from_xml_bsdf(&format!(r#"<bsdf type="{plugin}">{extra}{textures}</bsdf>"#), "test.xml").unwrap()
+    }
+
+    /// Every texture the slotted form writes gives the model that building it again from the texture's
+    /// values gives, bit for bit, over each model's reflectances (one and two textures at once), and a
+    /// value out of [0, 1] gives the same black diffuse; models whose textures have no slot (a roughness,
+    /// energy compensation, a nested model) are built again.
+    #[test]
+    fn slotted_textures_give_the_rebuilt_models() {
+        let (a, b) = ("0.9, 0.25, 0.5", "0.1, 0.7, 1");
+        let cases: Vec<(&str, &str, Vec<(&str, &str, &str)>)> = vec![
+            ("conductor", r#"<string name="material" value="Au"/>"#, vec![("specular_reflectance", a, b)]),
+            ("roughconductor", r#"<float name="alpha" value="0.3"/>"#, vec![("specular_reflectance", a, b)]),
+            ("dielectric", "", vec![("specular_reflectance", a, b), ("specular_transmittance", b, a)]),
+            ("thindielectric", "", vec![("specular_transmittance", a, b)]),
+            ("roughdielectric", r#"<string name="distribution" value="ggx"/>"#, vec![("specular_transmittance", a, b)]),
+            ("roughdielectric", "", vec![("specular_reflectance", a, b)]),
+            ("plastic", r#"<boolean name="nonlinear" value="true"/>"#, vec![("diffuse_reflectance", a, b), ("specular_reflectance", b, a)]),
+            ("roughplastic", "", vec![("diffuse_reflectance", a, b)]),
+            ("roughplastic", r#"<string name="distribution" value="ggx"/>"#, vec![("specular_reflectance", a, b)]),
+            ("roughplastic", "", vec![("diffuse_reflectance", a, "0.5, 1.5, 0.5")]),
+        ];
+        for (plugin, extra, textured) in &cases {
+            let p = props(plugin, extra, textured);
+            let slotted = Material::from_props(&p).unwrap();
+            assert!(matches!(slotted, Material::Slotted { .. }), "{plugin} {textured:?}");
+            let rebuilt = Material::rebuilt(&p).unwrap();
+            for i in 0..64 {
+                let uv = Vec2::new((i as f32 * 0.37).fract(), (i as f32 * 0.61).fract());
+                assert_eq!(slotted.at(uv), rebuilt.at(uv), "{plugin} {textured:?} at {uv}");
+            }
+        }
+        // The out-of-range colour gave black somewhere: the test above compared a failure too.
+        let p = props("roughplastic", "", &[("diffuse_reflectance", a, "0.5, 1.5, 0.5")]);
+        let m = Material::from_props(&p).unwrap();
+        let black = Bsdf::Diffuse(Diffuse::new(crate::spectrum::Rgb::ZERO));
+        assert!((0..64).any(|i| *m.at(Vec2::new(i as f32 / 64.0, 0.3)) == black));
+
+        for (plugin, extra, textured) in [
+            ("roughconductor", "", vec![("alpha", "0.1", "0.3")]),
+            ("roughconductor", r#"<boolean name="energy_compensation" value="true"/>"#, vec![("specular_reflectance", a, b)]),
+            ("roughplastic", r#"<boolean name="energy_compensation" value="true"/>"#, vec![("diffuse_reflectance", a, b)]),
+        ] {
+            let m = Material::from_props(&props(plugin, extra, &textured)).unwrap();
+            assert!(matches!(m, Material::Textured { .. }), "{plugin} {textured:?}");
         }
     }
 }
