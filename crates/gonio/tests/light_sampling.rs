@@ -27,7 +27,7 @@ fn light_selection_follows_importance_and_agrees_with_its_pmf() {
     let mut counts = [0u32; 3];
     let n = 300_000;
     for _ in 0..n {
-        let (i, p) = selection.sample(&lights, x, rng.next_f32());
+        let (i, p, _) = selection.sample(&lights, x, rng.next_f32());
         assert_eq!(p, pmf[i]);
         counts[i] += 1;
     }

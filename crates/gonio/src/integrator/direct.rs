@@ -41,7 +41,7 @@ pub fn radiance(scene: &Scene, ray: &Ray, rng: &mut Pcg32, emitter_samples: u32,
         let Some(s) = bsdf.sample(wo, uc, u) else { continue };
         let next = spawn_ray(si.p, si.n, si.shading.to_world(s.wi));
         let found = scene.intersect(&next);
-        let prev = BsdfSampled { from: si.p, pdf: s.pdf, delta: s.flags.contains(BsdfFlags::DELTA), n_bsdf: nb, n_light: ne };
+        let prev = BsdfSampled { from: si.p, pdf: s.pdf, delta: s.flags.contains(BsdfFlags::DELTA), n_bsdf: nb, n_light: ne, sums: None };
         l += s.weight * emitter_hit(scene, &next, found.as_ref(), Some(&prev)) / nb;
     }
     l

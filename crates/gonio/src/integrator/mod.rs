@@ -11,6 +11,7 @@ pub mod path;
 use crate::bsdf::{Bsdf, BsdfModel};
 use crate::geometry::ray::RayLanes;
 use crate::geometry::{Ray, SurfaceInteraction};
+use crate::light::selection::SelectionSums;
 use crate::math::lanes::Real;
 use crate::math::simd::Float8;
 use crate::sampling::mis::power_heuristic;
@@ -132,6 +133,8 @@ pub struct BsdfSampled {
     /// Number of BSDF samples taken there (`n_b` of the power heuristic), and of light samples (`n_l`).
     pub n_bsdf: f32,
     pub n_light: f32,
+    /// The light choice's sums at `from`, where a light was sampled there (`LightSelection::pmf_with`).
+    pub sums: Option<SelectionSums>,
 }
 
 /// Next-event estimation at `si`: choose a light ([`LightSelection`](crate::light::LightSelection)), sample it, and return
@@ -142,7 +145,7 @@ pub fn sample_emitter(scene: &Scene, si: &SurfaceInteraction, wo: Vec3, bsdf: &B
     if n == 0 {
         return Rgb::ZERO;
     }
-    let (index, pmf) = scene.light_selection.sample(&scene.lights, si.p, rng.next_f32());
+    let (index, pmf, _) = scene.light_selection.sample(&scene.lights, si.p, rng.next_f32());
     let (uc, u) = (rng.next_f32(), rng.next_vec2());
     let Some(ls) = scene.lights[index].sample_li(&scene.shapes, si.p, si.n, uc, u) else { return Rgb::ZERO };
     if !(ls.pdf > 0.0) || ls.li.is_black() {
@@ -165,7 +168,10 @@ pub fn emitter_hit(scene: &Scene, ray: &Ray, hit: Option<&SurfaceInteraction>, p
     // nor for camera rays): only there is Le weighted, and only there are the light's densities needed.
     let weighted = prev.filter(|p| !p.delta && p.n_light > 0.0);
     // The probability of choosing light `index` at that vertex.
-    let pmf = |p: &BsdfSampled, index: usize| scene.light_selection.pmf(&scene.lights, p.from, index);
+    let pmf = |p: &BsdfSampled, index: usize| match p.sums {
+        Some(sums) => scene.light_selection.pmf_with(&scene.lights, p.from, index, sums),
+        None => scene.light_selection.pmf(&scene.lights, p.from, index),
+    };
     let (le, light_pdf) = match hit {
         Some(si) => {
             let Some(index) = scene.shape_lights[si.shape as usize] else { return Rgb::ZERO };

@@ -31,6 +31,7 @@ use crate::geometry::ray::{offset_origin_lanes, spawn_ray_to_lanes, RayLanes};
 use crate::geometry::shape::solid_angle_density;
 use crate::geometry::{Ray, Shape};
 use crate::light::area::towards;
+use crate::light::selection::SelectionSums;
 use crate::light::Light;
 use crate::math::lanes::{Real, V3};
 use crate::math::simd::{Float8, Mask8};
@@ -102,6 +103,10 @@ struct Packet {
     from: Rows3,
     pdf: [f32; W],
     delta: u32,
+    /// The light choice's sums at that vertex (`LightSelection::sample`'s), in the lanes of `sums_at`:
+    /// the lanes that sampled a light there.
+    sums: [SelectionSums; W],
+    sums_at: u32,
 }
 
 impl Packet {
@@ -120,7 +125,26 @@ impl Packet {
             from: Rows3::default(),
             pdf: [0.0; W],
             delta: 0,
+            sums: [SelectionSums::UNIFORM; W],
+            sums_at: 0,
         }
+    }
+
+    /// The probability of choosing light `index` at the vertex lane `lane`'s ray left
+    /// (`LightSelection::pmf`; from the light choice's sums there where that vertex sampled a light).
+    #[inline]
+    fn pmf(&self, scene: &Scene, lane: usize, index: usize) -> f32 {
+        let (selection, x) = (&scene.light_selection, self.from.get(lane));
+        match self.sums(lane) {
+            Some(sums) => selection.pmf_with(&scene.lights, x, index, sums),
+            None => selection.pmf(&scene.lights, x, index),
+        }
+    }
+
+    /// The light choice's sums at the vertex lane `lane`'s ray left, where that vertex sampled a light.
+    #[inline(always)]
+    fn sums(&self, lane: usize) -> Option<SelectionSums> {
+        (self.sums_at & (1 << lane) != 0).then_some(self.sums[lane])
     }
 
     #[inline(always)]
@@ -259,7 +283,7 @@ fn trace(scene: &Scene, p: &mut Packet, lanes: u32, hit: &mut Surfaces8, out: &m
         let unweighted = first | p.delta;
         let pmf = Float8::from_fn(|l| {
             if sky & !unweighted & (1 << l) != 0 {
-                scene.light_selection.pmf(&scene.lights, p.from.get(l), env)
+                p.pmf(scene, l, env)
             } else {
                 1.0
             }
@@ -278,6 +302,7 @@ fn trace(scene: &Scene, p: &mut Packet, lanes: u32, hit: &mut Surfaces8, out: &m
             delta: p.delta & (1 << lane) != 0,
             n_bsdf: 1.0,
             n_light: 1.0,
+            sums: p.sums(lane),
         });
         let si = (hit.found & (1 << lane) != 0).then(|| hit.interaction(lane, t[lane]));
         le.set_rgb(lane, emitter_hit(scene, &p.ray(lane), si.as_ref(), prev.as_ref()));
@@ -412,6 +437,8 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
         let smooth = diffuse
             | bits(p.live & !diffuse)
                 .fold(0, |m, lane| m | (u32::from(models[lane].as_ref().is_some_and(|b| b.flags().has_smooth())) << lane));
+        // The lanes whose light choice at this vertex (the `from` of the rays sampled below) is kept.
+        p.sums_at = if n_lights > 0 { smooth } else { 0 };
         if n_lights > 0 && smooth != 0 {
             // The light, chosen per lane. For an area light on a flat mesh (the common case) the triangle, and
             // the point on it in lanes; other lights sample in full per lane.
@@ -424,8 +451,8 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
             // The light of each lane and the probability of its choice (`LightSelection::sample`).
             let (u_light, mut chosen, mut pmf) = (u_light.to_array(), [0.0f32; W], [1.0f32; W]);
             for lane in bits(smooth) {
-                let (index, p) = scene.light_selection.sample(&scene.lights, hit.p.get(lane), u_light[lane]);
-                (chosen[lane], pmf[lane]) = (index as f32, p);
+                let (index, q, sums) = scene.light_selection.sample(&scene.lights, hit.p.get(lane), u_light[lane]);
+                (chosen[lane], pmf[lane], p.sums[lane]) = (index as f32, q, sums);
             }
             let chosen_lanes = Float8::load(&chosen);
             // The lanes that chose the same light, in lanes where it is an environment (constant or a map:

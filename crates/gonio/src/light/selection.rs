@@ -119,27 +119,29 @@ impl LightSelection {
     }
 
     /// Choose one of the `lights` (the scene's, which this choice was made for) for the shading point `x` with
-    /// the uniform number `u`: its index and the probability of having chosen it.
+    /// the uniform number `u`: its index, the probability of having chosen it, and the choice's sums at
+    /// `x`, with which [`Self::pmf_with`] gives the probability of any other light there without
+    /// estimating every light again.
     #[must_use]
-    pub fn sample(&self, lights: &[Light], x: Vec3, u: f32) -> (usize, f32) {
+    pub fn sample(&self, lights: &[Light], x: Vec3, u: f32) -> (usize, f32, SelectionSums) {
         let n = lights.len();
         if self.is_uniform() {
             // `(u · n) as usize`, at most n − 1.
-            return (((u * n as f32) as usize).min(n - 1), 1.0 / n as f32);
+            return (((u * n as f32) as usize).min(n - 1), 1.0 / n as f32, SelectionSums::UNIFORM);
         }
         let mut weights = [0.0f32; MAX_LIGHTS];
-        let total = self.weights(lights, x, &mut weights);
-        let target = u * total;
+        let sums = self.weights(lights, x, &mut weights);
+        let target = u * sums.total;
         let mut sum = 0.0;
         for (i, w) in weights[..n].iter().enumerate() {
             sum += w;
             if target < sum {
-                return (i, w / total);
+                return (i, w / sums.total, sums);
             }
         }
         // Rounding in the sum: the last light with a positive weight.
         let last = weights[..n].iter().rposition(|w| *w > 0.0).unwrap_or(n - 1);
-        (last, weights[last] / total)
+        (last, weights[last] / sums.total, sums)
     }
 
     /// The probability that [`Self::sample`] chooses light `index` for the shading point `x`.
@@ -149,27 +151,58 @@ impl LightSelection {
             return 1.0 / lights.len() as f32;
         }
         let mut weights = [0.0f32; MAX_LIGHTS];
-        let total = self.weights(lights, x, &mut weights);
-        weights[index] / total
+        let sums = self.weights(lights, x, &mut weights);
+        weights[index] / sums.total
+    }
+
+    /// [`Self::pmf`] with the sums [`Self::sample`] returned at `x`: the same number, from light `index`'s
+    /// estimate alone.
+    #[must_use]
+    pub fn pmf_with(&self, lights: &[Light], x: Vec3, index: usize, sums: SelectionSums) -> f32 {
+        if self.is_uniform() {
+            return 1.0 / lights.len() as f32;
+        }
+        sums.weight(self.importance(lights, index, x), lights.len()) / sums.total
     }
 
     /// Each light's weight at `x` (into `weights`), (1 − s) imp/Σimp + s/n with s = [`UNIFORM_SHARE`] (all
-    /// uniform where every importance is 0), and their sum (1 up to rounding).
-    fn weights(&self, lights: &[Light], x: Vec3, weights: &mut [f32; MAX_LIGHTS]) -> f32 {
+    /// uniform where every importance is 0), and the sums they were made with.
+    fn weights(&self, lights: &[Light], x: Vec3, weights: &mut [f32; MAX_LIGHTS]) -> SelectionSums {
         let n = self.estimates.len();
         let mut sum = 0.0f32;
         for (i, w) in weights[..n].iter_mut().enumerate() {
             *w = self.importance(lights, i, x);
             sum += *w;
         }
-        let uniform = 1.0 / n as f32;
         let (share, scale) = if sum > 0.0 && sum.is_finite() { (UNIFORM_SHARE, (1.0 - UNIFORM_SHARE) / sum) } else { (1.0, 0.0) };
+        let mut sums = SelectionSums { share, scale, total: 0.0 };
         let mut total = 0.0;
         for w in &mut weights[..n] {
-            *w = *w * scale + share * uniform;
+            *w = sums.weight(*w, n);
             total += *w;
         }
-        total
+        sums.total = total;
+        sums
+    }
+}
+
+/// What a light's probability at a shading point takes besides its own estimate (the light choice's
+/// `weights` there): its weight is imp · `scale` + `share` / n, its probability that over `total`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SelectionSums {
+    share: f32,
+    scale: f32,
+    total: f32,
+}
+
+impl SelectionSums {
+    /// The sums of a uniform choice (unused by it).
+    pub const UNIFORM: SelectionSums = SelectionSums { share: 1.0, scale: 0.0, total: 1.0 };
+
+    /// The weight of a light of estimated importance `importance` among `n`.
+    #[inline]
+    fn weight(self, importance: f32, n: usize) -> f32 {
+        importance * self.scale + self.share * (1.0 / n as f32)
     }
 }
 
@@ -254,6 +287,15 @@ mod tests {
             }
             let total: f32 = (0..lights.len()).map(|i| selection.pmf(&lights, x, i)).sum();
             assert!((total - 1.0).abs() < 1e-6, "at {x}: the choice's probabilities sum to {total}");
+            // The sums a sample returns give every light's probability as `pmf` does, bit for bit, and
+            // the sample's own.
+            for u in [0.0, 0.3, 0.97] {
+                let (chosen, p, sums) = selection.sample(&lights, x, u);
+                assert_eq!(p, selection.pmf(&lights, x, chosen));
+                for i in 0..lights.len() {
+                    assert_eq!(selection.pmf_with(&lights, x, i, sums), selection.pmf(&lights, x, i), "light {i} at {x}");
+                }
+            }
         }
         // The spot's cone holds the origin and not (9, 9, −9); the flat emitters face +z and −z.
         assert_eq!(selection.importance(&lights, 3, Vec3::new(9.0, 9.0, -9.0)), 0.0);
