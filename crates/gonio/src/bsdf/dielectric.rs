@@ -156,8 +156,11 @@ pub(crate) fn reflect_or_transmit<R: Real>(
     let scale = t / (eta * eta);
     let value = channels!(|c| R::select(reflected, r * reflectance.0[c], scale * transmittance.0[c]));
     let wi = V3::select(reflected, reflect_lanes(wo, V3::splat(Vec3::Z)), wt);
-    let flags =
-        R::select(reflected, flag_lanes(BsdfFlags::DELTA_REFLECTION | BsdfFlags::DELTA), flag_lanes(BsdfFlags::DELTA_TRANSMISSION | BsdfFlags::DELTA));
+    let flags = R::select(
+        reflected,
+        flag_lanes(BsdfFlags::DELTA_REFLECTION | BsdfFlags::DELTA),
+        flag_lanes(BsdfFlags::DELTA_TRANSMISSION | BsdfFlags::DELTA),
+    );
     LaneSample::delta(wi, value, R::select(reflected, r, t), flags, R::select(reflected, one, eta), reflected | transmits)
 }
 

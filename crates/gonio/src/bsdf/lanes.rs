@@ -21,10 +21,10 @@
 use super::conductor::Conductor;
 use super::dielectric::Dielectric;
 use super::plastic::Plastic;
-use super::thin_dielectric::ThinDielectric;
 use super::rough_conductor::ConductorKernel;
 use super::rough_dielectric::DielectricKernel;
 use super::rough_plastic::PlasticKernel;
+use super::thin_dielectric::ThinDielectric;
 use super::{Bsdf, BsdfFlags, BsdfSample, SampleColumns};
 use crate::math::lanes::{channels, F32x8, Real, Rows, V3};
 use crate::math::{Vec2, Vec3};

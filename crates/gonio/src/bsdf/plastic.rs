@@ -50,7 +50,7 @@ use super::dielectric::relative_ior_with_default;
 use super::lanes::{f_one, flag_lanes, pdf_one, sample_one, LaneModel, LaneSample};
 use super::{BsdfFlags, BsdfModel, BsdfSample};
 use crate::error::Result;
-use crate::fresnel::{fresnel_diffuse_reflectance, fresnel_dielectric_lanes, reflect_lanes};
+use crate::fresnel::{fresnel_dielectric_lanes, fresnel_diffuse_reflectance, reflect_lanes};
 use crate::math::lanes::{channels, Real, V3};
 use crate::math::{Vec2, Vec3};
 use crate::props::Props;
@@ -227,8 +227,13 @@ impl LaneModel for Plastic {
             above,
         );
         let wi = cosine_hemisphere(ux, uy);
-        let diffuse =
-            LaneSample::smooth(wi, self.f_lanes(wo, wi), self.pdf_lanes(wo, wi), flag_lanes(BsdfFlags::DIFFUSE_REFLECTION), above & wi.z.gt(zero));
+        let diffuse = LaneSample::smooth(
+            wi,
+            self.f_lanes(wo, wi),
+            self.pdf_lanes(wo, wi),
+            flag_lanes(BsdfFlags::DIFFUSE_REFLECTION),
+            above & wi.z.gt(zero),
+        );
         LaneSample::select(mirror, delta, diffuse)
     }
 }

@@ -53,9 +53,7 @@ use crate::fresnel::fresnel_conductor_rgb_lanes;
 use crate::math::lanes::{channels, Real, V3};
 use crate::math::{Vec2, Vec3};
 use crate::microfacet::reflection::ReflectionLobe;
-use crate::microfacet::{
-    alpha_from_blinn_exponent, on_distribution, Distribution, MicrofacetDistribution, MicrofacetKind, Shadowing,
-};
+use crate::microfacet::{alpha_from_blinn_exponent, on_distribution, Distribution, MicrofacetDistribution, MicrofacetKind, Shadowing};
 use crate::props::Props;
 use crate::spectrum::Rgb;
 

@@ -159,7 +159,8 @@ impl RoughDielectric {
     /// per call).
     #[inline(always)]
     pub(crate) fn kernel(&self) -> DielectricKernel {
-        let (eta, reflectance, transmittance, visible) = (self.eta, self.specular_reflectance, self.specular_transmittance, self.sample_visible);
+        let (eta, reflectance, transmittance, visible) =
+            (self.eta, self.specular_reflectance, self.specular_transmittance, self.sample_visible);
         on_distribution!(self.distribution, |d| DielectricKernel::from(DielectricLobe {
             lobe: ReflectionLobe { distribution: d, shadowing: Shadowing::Smith, visible },
             eta,

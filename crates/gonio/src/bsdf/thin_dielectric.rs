@@ -128,9 +128,9 @@ impl BsdfModel for ThinDielectric {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fresnel::fresnel_dielectric;
     #[allow(unused_imports)]
     use crate::bsdf::Examples;
+    use crate::fresnel::fresnel_dielectric;
 
     #[test]
     fn slab_reflectance_is_the_sum_of_the_interreflection_series() {

@@ -108,13 +108,23 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
         IntegratorKind::Direct { emitter_samples: 1, bsdf_samples: 1, hide_emitters } => {
             path::radiance(scene, seed, samples, out, path::Settings { max_depth: 2, rr_depth: i32::MAX, hide_emitters });
         }
-        IntegratorKind::Direct { emitter_samples, bsdf_samples, hide_emitters } => direct_each(scene, seed, samples, out, emitter_samples, bsdf_samples, hide_emitters),
+        IntegratorKind::Direct { emitter_samples, bsdf_samples, hide_emitters } => {
+            direct_each(scene, seed, samples, out, emitter_samples, bsdf_samples, hide_emitters)
+        }
     }
 }
 
 /// The `direct` integrator one camera sample at a time ([`direct::radiance`]): what [`radiance`] runs for
 /// other sample counts than one of each, and the scalar reference the packets are tested against.
-pub fn direct_each(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [Rgb], emitter_samples: u32, bsdf_samples: u32, hide_emitters: bool) {
+pub fn direct_each(
+    scene: &Scene,
+    seed: u64,
+    samples: &[CameraSample],
+    out: &mut [Rgb],
+    emitter_samples: u32,
+    bsdf_samples: u32,
+    hide_emitters: bool,
+) {
     for (s, l) in samples.iter().zip(out) {
         let (ray, mut rng) = start(scene, seed, *s);
         *l = direct::radiance(scene, &ray, &mut rng, emitter_samples, bsdf_samples, hide_emitters);

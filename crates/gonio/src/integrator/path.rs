@@ -281,13 +281,7 @@ fn trace(scene: &Scene, p: &mut Packet, lanes: u32, hit: &mut Surfaces8, out: &m
         // (not for camera rays nor after a delta lobe, whose lanes keep weight 1).
         let env = scene.environment.unwrap_or(0) as usize;
         let unweighted = first | p.delta;
-        let pmf = Float8::from_fn(|l| {
-            if sky & !unweighted & (1 << l) != 0 {
-                p.pmf(scene, l, env)
-            } else {
-                1.0
-            }
-        });
+        let pmf = Float8::from_fn(|l| if sky & !unweighted & (1 << l) != 0 { p.pmf(scene, l, env) } else { 1.0 });
         let light_pdf = pdf * pmf;
         let unweighted = Mask8::from_bitmask(unweighted);
         let w = Float8::select(unweighted, Float8::splat(1.0), power_heuristic_1(Float8::load(&p.pdf), light_pdf));

@@ -279,7 +279,8 @@ mod tests {
             Light::Constant(ConstantLight { radiance: Rgb::splat(0.01) }),
         ];
         let selection = LightSelection::new(&lights, &shapes);
-        let points = [Vec3::ZERO, Vec3::new(0.1, -0.2, 0.3), Vec3::new(-1.0, 0.5, 4.0), Vec3::new(2.0, -1.0, -3.0), Vec3::new(9.0, 9.0, -9.0)];
+        let points =
+            [Vec3::ZERO, Vec3::new(0.1, -0.2, 0.3), Vec3::new(-1.0, 0.5, 4.0), Vec3::new(2.0, -1.0, -3.0), Vec3::new(9.0, 9.0, -9.0)];
         for x in points {
             for (i, light) in lights.iter().enumerate() {
                 let (got, want) = (selection.importance(&lights, i, x), by_the_table(light, &shapes, x));

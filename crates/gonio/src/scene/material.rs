@@ -28,7 +28,10 @@ pub enum Material {
     /// A model whose every texture sets a reflectance it reads as it is ([`Bsdf::reflectance_slot`]):
     /// built once, and at a hit copied with the textures' values written into it — the model
     /// [`Material::Textured`] would build from the same values, without `Props`.
-    Slotted { model: Bsdf, textures: Vec<(String, Texture)> },
+    Slotted {
+        model: Bsdf,
+        textures: Vec<(String, Texture)>,
+    },
     /// Any other BSDF with texture parameters: the description without them, and the textures with their
     /// parameter paths. Rebuilt at every hit from a copy of the template (`Props` tracks which parameters
     /// were read, so it is not `Sync`: the template sits behind a mutex held only for the copy). A slow,
@@ -86,10 +89,7 @@ impl Material {
                     let value = t.eval(uv);
                     // `Props::reflectance`'s range, so that a value out of it fails as the rebuilt model would.
                     if !value.0.iter().all(|c| (0.0..=1.0).contains(c)) {
-                        return Err(crate::error::Error::spec(
-                            "",
-                            format!("texture value {value:?} of `{name}` outside [0, 1]"),
-                        ));
+                        return Err(crate::error::Error::spec("", format!("texture value {value:?} of `{name}` outside [0, 1]")));
                     }
                     *model.reflectance_slot(name).expect("slots checked when the material was built") = value;
                 }
@@ -210,8 +210,11 @@ impl TextureValue {
 mod tests {
     use super::*;
 
+    /// A texture on a parameter: the parameter's name and the checkerboard's two colours.
+    type Textured<'a> = (&'a str, &'a str, &'a str);
+
     /// A `<bsdf>` with checkerboards (of colours `c0`, `c1`) on the parameters `textured`.
-    fn props(plugin: &str, extra: &str, textured: &[(&str, &str, &str)]) -> Props {
+    fn props(plugin: &str, extra: &str, textured: &[Textured<'_>]) -> Props {
         let textures: String = textured
             .iter()
             .map(|(name, c0, c1)| {
@@ -231,7 +234,7 @@ mod tests {
     #[test]
     fn slotted_textures_give_the_rebuilt_models() {
         let (a, b) = ("0.9, 0.25, 0.5", "0.1, 0.7, 1");
-        let cases: Vec<(&str, &str, Vec<(&str, &str, &str)>)> = vec![
+        let cases: Vec<(&str, &str, Vec<Textured<'_>>)> = vec![
             ("conductor", r#"<string name="material" value="Au"/>"#, vec![("specular_reflectance", a, b)]),
             ("roughconductor", r#"<float name="alpha" value="0.3"/>"#, vec![("specular_reflectance", a, b)]),
             ("dielectric", "", vec![("specular_reflectance", a, b), ("specular_transmittance", b, a)]),
