@@ -22,6 +22,10 @@ use crate::math::{Frame, Transform};
 use crate::sampling::distribution::Distribution1D;
 use glam::{Vec2, Vec3};
 
+/// The most a flat-shaded triangle's unit vertex normals differ, per component ([`Mesh::flat_frames`]):
+/// about eight roundings of 1, what computing one normal of a plane from different triangles of it gives.
+pub const FLAT_NORMAL_TOLERANCE: f32 = 1e-6;
+
 /// A triangle mesh, already transformed to world space.
 #[derive(Clone, Debug)]
 pub struct Mesh {
@@ -35,10 +39,13 @@ pub struct Mesh {
     area: f32,
     /// Unit geometric normal of each triangle (after `flip_normals`; zero for degenerate triangles).
     tri_normals: Vec<Vec3>,
-    /// For a flat-shaded mesh (no vertex normals; the built-in `rectangle` and `cube` among them): each
-    /// triangle's shading frame, which is then constant over the triangle (2026-11: computing it at every
-    /// hit was a tenth of a Cornell box's intersection cost). Empty for smooth-shaded meshes.
-    flat_frames: Vec<Frame>,
+    /// Each flat-shaded triangle's shading frame, constant over it (2026-11: computing it at every hit was
+    /// a tenth of a Cornell box's intersection cost): every triangle of a mesh without vertex normals (the
+    /// built-in `rectangle` and `cube` among them), and the triangles of a mesh with normals whose three
+    /// vertex normals agree to [`FLAT_NORMAL_TOLERANCE`] (the planar parts of a mesh whose normals a file
+    /// gave per face or gonio computed, as Mitsuba does, for a mesh file without them). Empty where no
+    /// triangle is flat.
+    flat_frames: Vec<Option<Frame>>,
 }
 
 impl Mesh {
@@ -127,18 +134,38 @@ impl Mesh {
         Ok(mesh)
     }
 
-    /// Fill [`Mesh::flat_frames`] when the mesh is flat-shaded, else empty it.
+    /// Fill [`Mesh::flat_frames`]. A triangle with vertex normals is flat when they agree to
+    /// [`FLAT_NORMAL_TOLERANCE`]: its shading normal is then their normalised sum everywhere on it, where
+    /// interpolating them gives a normal that differs by at most that much.
     fn update_flat_frames(&mut self) {
-        self.flat_frames = if self.normals.is_none() {
+        let n = self.indices.len();
+        // A smooth mesh (a scanned or subdivided model, most often) keeps no table at all.
+        if !(0..n).any(|t| self.flat_shading_normal(t).is_some()) {
+            self.flat_frames = Vec::new();
+            return;
+        }
+        let frame = |t: usize| {
+            let shading = self.flat_shading_normal(t)?;
             // Degenerate triangles (zero normal) are never hit nor sampled: any frame stands for theirs.
-            let frame = |t: usize| match self.tri_normals[t] {
+            Some(match self.tri_normals[t] {
                 Vec3::ZERO => Frame::from_normal(Vec3::Z),
-                ng => self.shading_frame(t as u32, ng),
-            };
-            (0..self.indices.len()).map(frame).collect()
-        } else {
-            Vec::new()
+                _ => self.shading_frame(t as u32, shading),
+            })
         };
+        self.flat_frames = (0..n).map(frame).collect();
+    }
+
+    /// The shading normal of triangle `t` where it is flat-shaded ([`Mesh::flat_frames`]): the geometric
+    /// normal without vertex normals, else their normalised sum where they agree.
+    fn flat_shading_normal(&self, t: usize) -> Option<Vec3> {
+        let Some(ns) = &self.normals else { return Some(self.tri_normals[t]) };
+        let [a, b, c] = self.indices[t].map(|i| ns[i as usize]);
+        let close = |x: Vec3, y: Vec3| (x - y).abs().max_element() <= FLAT_NORMAL_TOLERANCE;
+        if !(close(a, b) && close(a, c) && close(b, c)) {
+            return None;
+        }
+        let sign = if self.flip_normals { -1.0 } else { 1.0 };
+        ((a + b + c) * sign).try_normalize()
     }
 
     #[must_use]
@@ -183,9 +210,10 @@ impl Mesh {
     pub fn parallelogram(&self, tri: u32, uv_matters: bool) -> Option<u8> {
         const TOLERANCE: f32 = 1e-5;
         let (a, b) = (tri as usize, tri as usize + 1);
-        if b >= self.indices.len() || self.flat_frames.is_empty() || (uv_matters && self.uvs.is_none()) {
+        if b >= self.indices.len() || (uv_matters && self.uvs.is_none()) {
             return None;
         }
+        let (Some(fa), Some(fb)) = (self.flat_frame(tri), self.flat_frame(tri + 1)) else { return None };
         let (ia, ib) = (self.indices[a], self.indices[b]);
         // The corner of `a` not in `b`, and the vertex of `b` not in `a`: exactly one each.
         let mut corners = (0..3).filter(|&k| !ib.contains(&ia[k]));
@@ -201,7 +229,6 @@ impl Mesh {
         if (p(v1) + p(v2) - p(c) - p(d)).length() > TOLERANCE * size {
             return None;
         }
-        let (fa, fb) = (&self.flat_frames[a], &self.flat_frames[b]);
         if [(fa.s, fb.s), (fa.t, fb.t), (fa.n, fb.n)].iter().any(|(x, y)| (*x - *y).length() > TOLERANCE) {
             return None;
         }
@@ -285,7 +312,7 @@ impl Mesh {
         let p = barycentric_point::<f32>(p0.into(), e1.into(), e2.into(), b.x, b.y).into();
         let (ng, ns, uv) = self.surface_at(tri, b, uv);
         let _ = ray;
-        let shading = match self.flat_frames.get(tri as usize) {
+        let shading = match self.flat_frame(tri) {
             Some(&f) => f,
             None => self.shading_frame(tri, ns),
         };
@@ -310,12 +337,19 @@ impl Mesh {
         Frame::from_normal_and_dp_du(ns, dp_du)
     }
 
-    /// The shading frame of triangle `tri` of a flat-shaded mesh (its `n` is the geometric normal), `None`
-    /// for a smooth-shaded one.
+    /// The shading frame of triangle `tri` where it is flat-shaded ([`Mesh::flat_frames`]; without vertex
+    /// normals its `n` is the geometric normal), `None` where it is smooth-shaded.
     #[inline]
     #[must_use]
     pub fn flat_frame(&self, tri: u32) -> Option<&Frame> {
-        self.flat_frames.get(tri as usize)
+        self.flat_frames.get(tri as usize).and_then(Option::as_ref)
+    }
+
+    /// The unit geometric normal of triangle `tri` (after `flip_normals`; zero where it is degenerate).
+    #[inline]
+    #[must_use]
+    pub fn geometric_normal(&self, tri: u32) -> Vec3 {
+        self.tri_normals[tri as usize]
     }
 
     /// The texture coordinates at barycentrics (b₁, b₂) of triangle `tri`: interpolated where the mesh has
@@ -824,6 +858,33 @@ mod tests {
         }
     }
 
+    /// A triangle whose vertex normals agree to [`FLAT_NORMAL_TOLERANCE`] is flat-shaded, with a shading
+    /// normal within that of the interpolated one everywhere on it (and its geometric normal its own);
+    /// normals that differ by more are interpolated; `flip_normals` turns the flat frame too.
+    #[test]
+    fn triangles_whose_normals_agree_are_flat() {
+        use crate::geometry::shape::PrimHit;
+        let positions = vec![Vec3::ZERO, Vec3::new(2.0, 0.0, 0.1), Vec3::new(0.0, 1.0, -0.1)];
+        let tilt = |e: f32| vec![Vec3::Y, Vec3::new(e, 1.0, 0.0).normalize(), Vec3::new(0.0, 1.0, e).normalize()];
+        let mesh = |e: f32, flip: bool| {
+            Mesh::new(positions.clone(), Some(tilt(e)), None, vec![[0, 1, 2]], &Transform::IDENTITY, false, flip, "t").unwrap()
+        };
+        assert!(mesh(1e-5, false).flat_frame(0).is_none(), "normals 10⁻⁵ apart are interpolated");
+        for flip in [false, true] {
+            let m = mesh(4e-7, flip);
+            let frame = *m.flat_frame(0).expect("normals 4·10⁻⁷ apart are flat");
+            let ray = Ray::new(Vec3::new(0.3, 5.0, 0.2), -Vec3::Y, f32::INFINITY);
+            for b in [Vec2::new(0.1, 0.1), Vec2::new(0.8, 0.1), Vec2::new(0.05, 0.9), Vec2::splat(1.0 / 3.0)] {
+                let si = m.interaction(0, &ray, &PrimHit { t: 1.0, uv: b }, false);
+                assert_eq!(si.shading, frame);
+                assert_eq!(si.n, m.geometric_normal(0));
+                let (_, interpolated, _) = m.surface_at(0, b, false);
+                assert!((si.shading.n - interpolated).abs().max_element() <= FLAT_NORMAL_TOLERANCE, "{b}: {:?}", si.shading.n);
+                assert!(si.shading.n.dot(Vec3::Y) * if flip { -1.0 } else { 1.0 } > 0.99);
+            }
+        }
+    }
+
     #[test]
     fn smooth_normals_of_a_tent_bisect_its_faces() {
         let p = vec![
@@ -1037,8 +1098,9 @@ mod tests {
     }
 
     /// Which neighbouring triangles are taken as a parallelogram: a rectangle's two (its corner 1, or 2
-    /// when a mirroring transform reversed the winding), each of a cube's faces, and not a folded pair, a
-    /// smooth-shaded one, a trapezoid, nor texture coordinates that are not affine over it.
+    /// when a mirroring transform reversed the winding), each of a cube's faces, a pair whose vertex normals
+    /// agree, and not a folded pair, a smooth-shaded one, a trapezoid, nor texture coordinates that are not
+    /// affine over it.
     #[test]
     fn parallelograms_are_found_where_nothing_changes() {
         use crate::geometry::builtin_meshes::{cube, rectangle};
@@ -1064,7 +1126,9 @@ mod tests {
         assert_eq!(quad(Vec3::new(0.2, 1.0, 0.0), Vec2::Y, None).parallelogram(0, true), None, "a trapezoid");
         assert_eq!(quad(Vec3::Y, Vec2::new(0.3, 1.0), None).parallelogram(0, true), None, "uv not affine");
         assert_eq!(quad(Vec3::Y, Vec2::new(0.3, 1.0), None).parallelogram(0, false), Some(1), "uv unused");
-        assert_eq!(quad(Vec3::Y, Vec2::Y, Some(vec![Vec3::Z; 4])).parallelogram(0, true), None, "smooth-shaded");
+        let tilted = Vec3::new(0.1, 0.0, 1.0).normalize();
+        assert_eq!(quad(Vec3::Y, Vec2::Y, Some(vec![Vec3::Z, Vec3::Z, tilted, Vec3::Z])).parallelogram(0, true), None, "smooth-shaded");
+        assert_eq!(quad(Vec3::Y, Vec2::Y, Some(vec![Vec3::Z; 4])).parallelogram(0, true), Some(1), "normals that agree");
         // Texture coordinates over a parallelogram's far half, extrapolated from the first triangle.
         let q = quad(Vec3::Y, Vec2::Y, None);
         // The texture coordinates as a function of the point agree, on both halves and outside them.

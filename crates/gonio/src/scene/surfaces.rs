@@ -1,9 +1,10 @@
 //! The surfaces a packet of rays found, in lanes: what the path tracer's phases read at each vertex.
 //!
-//! Packet traversal keeps only each ray's distance and slot. Where the slot holds a triangle (or a
-//! parallelogram) of a flat-shaded mesh (the common case: every built-in `rectangle`, `cube` and
-//! face-normal mesh), the point is o + t d, computed in lanes, the shading frame, constant over the
-//! triangle, is copied, and where the material reads texture coordinates they are an affine function of
+//! Packet traversal keeps only each ray's distance and slot. Where the slot holds a flat-shaded triangle
+//! (or parallelogram) (the common case: every built-in `rectangle`, `cube` and face-normal mesh, and the
+//! planar parts of meshes with vertex normals: [`Mesh::flat_frame`](crate::geometry::mesh::Mesh::flat_frame)),
+//! the point is o + t d, computed in lanes, the shading frame, constant over the triangle, and the
+//! geometric normal are copied, and where the material reads texture coordinates they are an affine function of
 //! the point ([`UvMap`](crate::geometry::mesh::UvMap), one per such slot). (2026-12: the point from the barycentrics had the triangles
 //! hit gathered into a `Triangle8` and tested again, for every flat lane: 5.7 % of a Cornell box render;
 //! and the texture coordinates from the barycentrics, by the mesh's vertices, a further 2 % of a
@@ -159,6 +160,7 @@ impl Scene {
                 if let Some(frame) = mesh.flat_frame(r.prim) {
                     flat_uv |= u32::from(textured) << lane;
                     out.set_frame(lane, frame);
+                    out.n.set(lane, mesh.geometric_normal(r.prim));
                     flat |= 1 << lane;
                     continue;
                 }
@@ -182,10 +184,9 @@ impl Scene {
             (out.uv[0][lane], out.uv[1][lane]) = (si.uv.x, si.uv.y);
         }
         if flat != 0 {
-            // The point, and the geometric normal: the frame's (flat-shaded).
+            // The point.
             let m = Mask8::from_bitmask(flat);
             out.p.store(V3::select(m, ray_point(rays.o, rays.d, hits.t), out.p.lanes()));
-            out.n.store(V3::select(m, out.ns.lanes(), out.n.lanes()));
             for lane in bits(flat_uv) {
                 let r = self.prims.slots[hits.slot[lane] as usize];
                 if let Some(map) = self.prims.uv_maps.get(r.uv_map as usize) {
@@ -348,11 +349,29 @@ mod tests {
         assert!((f.s.cross(f.t) - f.n).length() < 1e-5 && f.s.dot(f.n).abs() < 1e-5, "{f:?}");
     }
 
+    /// A mesh file with vertex normals behind [`SCENE`]'s shapes: a quad whose normals agree (flat-shaded
+    /// with them) and a triangle whose normals differ (smooth-shaded).
+    const NORMALS_OBJ: &str = "v 0.3 -0.9 -1.0\nv 1.8 -0.9 -1.0\nv 1.8 0.9 -1.0\nv 0.3 0.9 -1.0\n\
+        v -1.8 -0.9 -1.2\nv -0.3 -0.9 -1.2\nv -1.05 0.9 -0.8\n\
+        vn 0 0 1\nvn 0.3 0 1\nvn -0.3 0 1\nvn 0 0.2 1\n\
+        f 1//1 2//1 3//1\nf 1//1 3//1 4//1\nf 5//2 6//3 7//4\n";
+
     /// Each lane of [`Scene::surfaces`] is the interaction [`Scene::intersect`] finds for its ray alone: the
-    /// same shape, primitive, point, normals, frame and texture coordinates, bit for bit.
+    /// same shape, primitive, point, normals, frame and texture coordinates, bit for bit (with a mesh file
+    /// of vertex normals added, flat- and smooth-shaded triangles).
     #[test]
     fn lanes_match_single_rays() {
-        let scene = Scene::build(mitsuba_xml::load_str(SCENE, "t.xml", Path::new("."), &[]).unwrap()).unwrap();
+        let obj = std::env::temp_dir().join(format!("gonio-surfaces-{}.obj", std::process::id()));
+        std::fs::write(&obj, NORMALS_OBJ).unwrap();
+        let with_obj =
+            SCENE.replace("</scene>", &format!(r#"<shape type="obj"><string name="filename" value="{}"/></shape></scene>"#, obj.display()));
+        let scene = mitsuba_xml::load_str(&with_obj, "t.xml", Path::new("."), &[]).and_then(Scene::build);
+        std::fs::remove_file(&obj).unwrap();
+        let scene = scene.unwrap();
+        let Some(Shape::Mesh(file_mesh)) = scene.shapes.last() else { panic!("the mesh file's shape") };
+        assert!(file_mesh.flat_frame(0).is_some() && file_mesh.flat_frame(1).is_some() && file_mesh.flat_frame(2).is_none());
+        let file_shape = scene.shapes.len() as u32 - 1;
+        let (mut with_normals_flat, mut with_normals_smooth) = (0, 0);
         let mut rng = Pcg32::new(3, 9);
         let (mut flat, mut other, mut emitting) = (0, 0, 0);
         for _ in 0..200 {
@@ -369,12 +388,23 @@ mod tests {
                 assert_eq!(got, want, "lane {lane}");
                 assert_eq!(s.emits & (1 << lane) != 0, scene.shape_lights[want.shape as usize].is_some(), "lane {lane}");
                 emitting += usize::from(s.emits & (1 << lane) != 0);
-                match scene.shapes[want.shape as usize] {
+                match &scene.shapes[want.shape as usize] {
+                    Shape::Mesh(m) if want.shape == file_shape => {
+                        if m.flat_frame(want.prim).is_some() {
+                            with_normals_flat += 1;
+                        } else {
+                            with_normals_smooth += 1;
+                        }
+                    }
                     Shape::Mesh(_) => flat += 1,
                     _ => other += 1,
                 }
             }
         }
         assert!(flat > 300 && other > 100 && emitting > 20, "{flat} mesh, {other} other and {emitting} emitter hits");
+        assert!(
+            with_normals_flat > 20 && with_normals_smooth > 20,
+            "{with_normals_flat} flat and {with_normals_smooth} smooth hits on the mesh with normals"
+        );
     }
 }
