@@ -292,17 +292,30 @@ impl Mesh {
     }
 
     /// Geometric normal, shading normal and uv at barycentrics (b₁, b₂) of triangle `tri` (uv only with
-    /// `uv`, else zero).
+    /// `uv`, else zero). The shading normal of a flat-shaded triangle is its flat frame's
+    /// ([`Mesh::flat_frames`]), so that sampled points and hits agree.
     #[inline]
     fn surface_at(&self, tri: u32, b: Vec2, uv: bool) -> (Vec3, Vec3, Vec2) {
         let ng = self.tri_normals[tri as usize];
         let uv = if uv { self.uv_at(tri, b) } else { Vec2::ZERO };
-        let Some(ns) = &self.normals else { return (ng, ng, uv) };
+        let ns = match self.flat_frame(tri) {
+            Some(frame) => frame.n,
+            None => self.interpolated_normal(tri, b),
+        };
+        (ng, ns, uv)
+    }
+
+    /// The vertex normals of triangle `tri` interpolated at barycentrics (b₁, b₂) and normalised (after
+    /// `flip_normals`); the geometric normal without vertex normals or where they sum to zero.
+    #[inline]
+    fn interpolated_normal(&self, tri: u32, b: Vec2) -> Vec3 {
+        let ng = self.tri_normals[tri as usize];
+        let Some(ns) = &self.normals else { return ng };
         let idx = self.indices[tri as usize];
         let n = ns[idx[0] as usize] * (1.0 - b.x - b.y) + ns[idx[1] as usize] * b.x + ns[idx[2] as usize] * b.y;
         // Vertex normals are not flipped in storage; `flip_normals` reverses them here.
         let n = if self.flip_normals { -n } else { n };
-        (ng, n.try_normalize().unwrap_or(ng), uv)
+        n.try_normalize().unwrap_or(ng)
     }
 
     #[must_use]
@@ -878,8 +891,10 @@ mod tests {
                 let si = m.interaction(0, &ray, &PrimHit { t: 1.0, uv: b }, false);
                 assert_eq!(si.shading, frame);
                 assert_eq!(si.n, m.geometric_normal(0));
-                let (_, interpolated, _) = m.surface_at(0, b, false);
+                let interpolated = m.interpolated_normal(0, b);
                 assert!((si.shading.n - interpolated).abs().max_element() <= FLAT_NORMAL_TOLERANCE, "{b}: {:?}", si.shading.n);
+                // A point sampled on it (as on an area light) carries the normal a hit there sees.
+                assert_eq!(m.sample_position(0.5, b).n, frame.n);
                 assert!(si.shading.n.dot(Vec3::Y) * if flip { -1.0 } else { 1.0 } > 0.99);
             }
         }
