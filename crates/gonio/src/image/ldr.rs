@@ -6,34 +6,54 @@ use std::path::Path;
 
 use ::image::{DynamicImage, ImageFormat};
 
-use super::{linear_to_srgb, srgb_to_linear, Format, Image};
+use super::{linear_to_srgb, srgb8_table, srgb_to_linear, Bytes8, Format, Image, Stored};
 use crate::error::{Error, Result};
 
-pub(super) fn decode(path: &Path, bytes: &[u8], format: Format) -> Result<Image> {
+/// The file as the `image` crate decodes it.
+fn decode_dynamic(path: &Path, bytes: &[u8], format: Format) -> Result<DynamicImage> {
     let image_format = match format {
         Format::Hdr => ImageFormat::Hdr,
         Format::Png => ImageFormat::Png,
         Format::Jpeg => ImageFormat::Jpeg,
         Format::Exr => unreachable!("EXR is decoded by the exr module"),
     };
-    let decoded = ::image::load_from_memory_with_format(bytes, image_format)
-        .map_err(|e| Error::format(path, format!("{image_format:?} data"), e.to_string()))?;
+    ::image::load_from_memory_with_format(bytes, image_format)
+        .map_err(|e| Error::format(path, format!("{image_format:?} data"), e.to_string()))
+}
+
+pub(super) fn decode(path: &Path, bytes: &[u8], format: Format) -> Result<Image> {
+    Ok(match decode_stored(path, bytes, format)? {
+        Stored::Linear(image) => image,
+        Stored::Bytes(b) => {
+            let table = srgb8_table();
+            Image { width: b.width, height: b.height, data: b.data.iter().map(|&v| table[usize::from(v)]).collect() }
+        }
+    })
+}
+
+/// [`decode`], but an 8-bit file as its samples.
+pub(super) fn decode_stored(path: &Path, bytes: &[u8], format: Format) -> Result<Stored> {
+    let decoded = decode_dynamic(path, bytes, format)?;
     let (width, height) = (decoded.width() as usize, decoded.height() as usize);
-    let data: Vec<f32> = match decoded {
-        DynamicImage::ImageRgb32F(_) | DynamicImage::ImageRgba32F(_) => decoded.into_rgb32f().into_raw(),
+    let stored = match decoded {
+        DynamicImage::ImageRgb32F(_) | DynamicImage::ImageRgba32F(_) => {
+            Stored::Linear(Image { width, height, data: decoded.into_rgb32f().into_raw() })
+        }
         DynamicImage::ImageLuma16(_) | DynamicImage::ImageLumaA16(_) | DynamicImage::ImageRgb16(_) | DynamicImage::ImageRgba16(_) => {
             // A table would be 64 K entries; the curve is cheap enough per sample.
-            decoded.into_rgb16().into_raw().into_iter().map(|v| srgb_to_linear(f32::from(v) / 65535.0)).collect()
+            let data = decoded.into_rgb16().into_raw().into_iter().map(|v| srgb_to_linear(f32::from(v) / 65535.0)).collect();
+            Stored::Linear(Image { width, height, data })
         }
-        _ => {
-            let table: Vec<f32> = (0..=255u8).map(|v| srgb_to_linear(f32::from(v) / 255.0)).collect();
-            decoded.into_rgb8().into_raw().into_iter().map(|v| table[usize::from(v)]).collect()
-        }
+        _ => Stored::Bytes(Bytes8 { width, height, data: decoded.into_rgb8().into_raw() }),
     };
-    if data.len() != 3 * width * height {
+    let len = match &stored {
+        Stored::Linear(image) => image.data.len(),
+        Stored::Bytes(b) => b.data.len(),
+    };
+    if len != 3 * width * height {
         return Err(Error::format(path, "pixels", "decoder returned the wrong number of samples"));
     }
-    Ok(Image { width, height, data })
+    Ok(stored)
 }
 
 pub(super) fn encode_png(path: &Path, img: &Image) -> Result<Vec<u8>> {

@@ -136,6 +136,58 @@ fn format_from_magic(bytes: &[u8]) -> Option<Format> {
     }
 }
 
+/// An 8-bit image as its samples: row-major, top row first, three bytes (R, G, B) per pixel, sRGB-encoded
+/// unless the reader says otherwise.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Bytes8 {
+    pub width: usize,
+    pub height: usize,
+    pub data: Vec<u8>,
+}
+
+/// An image as a texture keeps it ([`read_stored_image`]).
+#[derive(Clone, Debug, PartialEq)]
+pub enum Stored {
+    /// Linear RGB floats (EXR, HDR, 16-bit PNG).
+    Linear(Image),
+    /// 8-bit PNG and JPEG: a quarter of the memory of linear floats, decoded at each lookup through a
+    /// table of 256 ([`srgb8_table`]), which gives the floats [`read_image`] gives, bit for bit.
+    Bytes(Bytes8),
+}
+
+/// The linear value of each 8-bit sRGB sample: `srgb_to_linear(v / 255)`.
+#[must_use]
+pub fn srgb8_table() -> &'static [f32; 256] {
+    static TABLE: std::sync::OnceLock<[f32; 256]> = std::sync::OnceLock::new();
+    TABLE.get_or_init(|| std::array::from_fn(|v| srgb_to_linear(v as f32 / 255.0)))
+}
+
+/// Reads an image file as a texture keeps it: 8-bit files as their samples, others as [`read_image`]
+/// does.
+pub fn read_stored_image(path: &Path) -> Result<Stored> {
+    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let format = format_of(path, &bytes)?;
+    let stored = guard(path, || match format {
+        Format::Exr => exr::decode(path, &bytes).map(Stored::Linear),
+        Format::Hdr | Format::Png | Format::Jpeg => ldr::decode_stored(path, &bytes, format),
+    })?;
+    let (width, height) = match &stored {
+        Stored::Linear(image) => (image.width, image.height),
+        Stored::Bytes(b) => (b.width, b.height),
+    };
+    if width == 0 || height == 0 {
+        return Err(Error::format(path, "header", "image has no pixels"));
+    }
+    Ok(stored)
+}
+
+/// The format of the file `path` holding `bytes`: by its magic bytes, else by its extension.
+fn format_of(path: &Path, bytes: &[u8]) -> Result<Format> {
+    format_from_magic(bytes)
+        .or_else(|| format_from_extension(path))
+        .ok_or_else(|| Error::format(path, "header", format!("not a recognised image file; accepted: {READ_EXTENSIONS}")))
+}
+
 /// Reads an image file into linear RGB. See the module docs for the formats.
 pub fn read_image(path: &Path) -> Result<Image> {
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
@@ -145,9 +197,7 @@ pub fn read_image(path: &Path) -> Result<Image> {
 /// Decodes the content of an image file into linear RGB; `path` names it in errors and, when the magic
 /// bytes are not recognised, gives the format by its extension.
 pub fn decode_image(path: &Path, bytes: &[u8]) -> Result<Image> {
-    let format = format_from_magic(bytes)
-        .or_else(|| format_from_extension(path))
-        .ok_or_else(|| Error::format(path, "header", format!("not a recognised image file; accepted: {READ_EXTENSIONS}")))?;
+    let format = format_of(path, bytes)?;
     let image = guard(path, || match format {
         Format::Exr => exr::decode(path, bytes),
         Format::Hdr | Format::Png | Format::Jpeg => ldr::decode(path, bytes, format),
