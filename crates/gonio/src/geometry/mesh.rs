@@ -310,12 +310,28 @@ impl Mesh {
     #[inline]
     fn interpolated_normal(&self, tri: u32, b: Vec2) -> Vec3 {
         let ng = self.tri_normals[tri as usize];
-        let Some(ns) = &self.normals else { return ng };
-        let idx = self.indices[tri as usize];
-        let n = ns[idx[0] as usize] * (1.0 - b.x - b.y) + ns[idx[1] as usize] * b.x + ns[idx[2] as usize] * b.y;
-        // Vertex normals are not flipped in storage; `flip_normals` reverses them here.
-        let n = if self.flip_normals { -n } else { n };
-        n.try_normalize().unwrap_or(ng)
+        let Some([n0, n1, n2]) = self.vertex_normals(tri) else { return ng };
+        smooth_normal::<f32>([n0.into(), n1.into(), n2.into()], b.x, b.y, self.normal_sign(), ng.into()).into()
+    }
+
+    /// The vertex normals of triangle `tri` as stored (before `flip_normals`: [`Self::normal_sign`]), where
+    /// the mesh has them.
+    #[inline]
+    #[must_use]
+    pub fn vertex_normals(&self, tri: u32) -> Option<[Vec3; 3]> {
+        let ns = self.normals.as_ref()?;
+        Some(self.indices[tri as usize].map(|i| ns[i as usize]))
+    }
+
+    /// −1 where `flip_normals` reverses the vertex normals, else 1.
+    #[inline]
+    #[must_use]
+    pub fn normal_sign(&self) -> f32 {
+        if self.flip_normals {
+            -1.0
+        } else {
+            1.0
+        }
     }
 
     #[must_use]
@@ -339,15 +355,25 @@ impl Mesh {
     /// the triangle's edges (pbrt-v4 §6.5.3); without them, or for a degenerate parameterisation, Mitsuba
     /// takes the first edge p₁ − p₀ (observed with Mitsuba 3.9.1).
     fn shading_frame(&self, tri: u32, ns: Vec3) -> Frame {
+        Frame::from_normal_and_dp_du(ns, self.dp_du(tri))
+    }
+
+    /// ∂p/∂u of triangle `tri`, up to a positive factor, as [`Self::shading_frame`] takes it.
+    #[inline]
+    #[must_use]
+    pub fn dp_du(&self, tri: u32) -> Vec3 {
         let [p0, p1, p2] = self.vertices(tri);
         let edge = p1 - p0;
-        let Some(uvs) = &self.uvs else { return Frame::from_normal_and_dp_du(ns, edge) };
+        let Some(uvs) = &self.uvs else { return edge };
         let idx = self.indices[tri as usize];
         let (uv0, uv1, uv2) = (uvs[idx[0] as usize], uvs[idx[1] as usize], uvs[idx[2] as usize]);
         let (duv1, duv2) = (uv1 - uv0, uv2 - uv0);
         let det = duv1.x * duv2.y - duv1.y * duv2.x;
-        let dp_du = if det == 0.0 { edge } else { ((p1 - p0) * duv2.y - (p2 - p0) * duv1.y) / det };
-        Frame::from_normal_and_dp_du(ns, dp_du)
+        if det == 0.0 {
+            edge
+        } else {
+            ((p1 - p0) * duv2.y - (p2 - p0) * duv1.y) / det
+        }
     }
 
     /// The shading frame of triangle `tri` where it is flat-shaded ([`Mesh::flat_frames`]; without vertex
@@ -525,6 +551,18 @@ pub fn barycentric_point<R: Real>(p0: V3<R>, e1: V3<R>, e2: V3<R>, b1: R, b2: R)
     p0.add(e1.scale(b1)).add(e2.scale(b2))
 }
 
+/// The shading normal at barycentrics (b₁, b₂) of a triangle with vertex normals `n` (as stored; `sign`
+/// −1 reverses them, for `flip_normals`): their interpolation, normalised, or `ng` where it has no length
+/// (as glam's `try_normalize` decides) — in lanes, and for one triangle ([`Mesh::interaction`]).
+#[inline(always)]
+#[must_use]
+pub fn smooth_normal<R: Real>(n: [V3<R>; 3], b1: R, b2: R, sign: R, ng: V3<R>) -> V3<R> {
+    let one = R::splat(1.0);
+    let sum = n[0].scale(one - b1 - b2).add(n[1].scale(b1)).add(n[2].scale(b2)).scale(sign);
+    let rcp = one / sum.length();
+    V3::select(rcp.gt(R::splat(0.0)) & rcp.lt(R::splat(f32::INFINITY)), sum.scale(rcp), ng)
+}
+
 /// The point of triangle (p₀, p₁, p₂) at barycentrics (1 − √u₁, u₂ √u₁) — uniform by area for uniform
 /// (u₁, u₂) (the square-root warp, pbrt-v4 §6.5.4) — in lanes.
 #[inline(always)]
@@ -695,6 +733,29 @@ pub struct Hit8 {
 }
 
 impl Triangle8 {
+    /// Lane `from_lane` of `from` into lane `lane`.
+    #[inline(always)]
+    pub fn copy_lane(&mut self, lane: usize, from: &Triangle8, from_lane: usize) {
+        for axis in 0..3 {
+            self.p0[axis][lane] = from.p0[axis][from_lane];
+            self.e2[axis][lane] = from.e2[axis][from_lane];
+            self.neg_e1[axis][lane] = from.neg_e1[axis][from_lane];
+            self.m[axis][lane] = from.m[axis][from_lane];
+        }
+        self.diagonal[lane] = from.diagonal[from_lane];
+    }
+
+    /// Ray `i` of `rays` against the triangle in lane `i`, in every lane at once, with no distance limit:
+    /// the lanes hit, and their points p₀ + b₁ e₁ + b₂ e₂ and barycentrics (b₁, b₂) — those of
+    /// [`Self::intersect_lane`] and [`Mesh::interaction`] for the ray alone, bit for bit.
+    #[inline(always)]
+    #[must_use]
+    pub fn points_of_rays(&self, o: V3<Float8>, d: V3<Float8>) -> (Mask8, V3<Float8>, Float8, Float8) {
+        let (p0, e2, ne1, m) = (lane_rows(&self.p0), lane_rows(&self.e2), lane_rows(&self.neg_e1), lane_rows(&self.m));
+        let (hit, _, b1, b2) = intersect_triangle_lanes(o, d, p0, e2, ne1, m, Float8::load(&self.diagonal), Float8::splat(f32::INFINITY));
+        (hit, barycentric_point(p0, ne1.neg(), e2, b1, b2), b1, b2)
+    }
+
     /// Put the triangle (p₀, e₁ = p₁ − p₀, e₂ = p₂ − p₀) in lane `lane`, or with `parallelogram` the
     /// parallelogram p₀ + b₁ e₁ + b₂ e₂, b₁, b₂ in [0, 1].
     pub fn set(&mut self, lane: usize, [p0, e1, e2]: [Vec3; 3], parallelogram: bool) {

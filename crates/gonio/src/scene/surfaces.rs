@@ -12,15 +12,21 @@
 //! grazing incidence it can lie beyond the triangle's edge by a few 10⁻⁵ of t, within the ray offset
 //! too. Mitsuba's `rectangle` takes o + t d in its own space.)
 //! Spheres need only the distance, which the packet test computed as the scalar test does: their points,
-//! normals and frames ([`sphere_tangents`], Mitsuba's ∂p/∂u frame) are computed in lanes too. Other shapes (disks, smooth-shaded meshes) build their
-//! interaction one lane at a time, as [`Scene::interaction_at`] does for a single ray. 2026-12: building interactions one lane at a time
-//! had been a tenth of a Cornell box render.
+//! normals and frames ([`sphere_tangents`], Mitsuba's ∂p/∂u frame) are computed in lanes too. Smooth-shaded
+//! triangles are gathered from the leaves' packets and tested again in lanes for their barycentrics; the
+//! point, the interpolated normal ([`smooth_normal`]) and the ∂p/∂u frame follow in lanes, the same
+//! numbers as for one ray (2026-12: one lane at a time they were a tenth of a material-preview render).
+//! Other shapes (disks, cylinders) build their interaction one lane at a time, as [`Scene::interaction_at`]
+//! does for a single ray. 2026-12: building interactions one lane at a time had been a tenth of a
+//! Cornell box render.
 
 use super::{Scene, EMPTY_SLOT};
 use crate::geometry::bvh::{bits, Hits8, LANES};
+use crate::geometry::mesh::{smooth_normal, Triangle8};
 use crate::geometry::ray::{ray_point, RayLanes};
 use crate::geometry::sphere::{sphere_surface, sphere_tangents};
 use crate::geometry::{Ray, Shape, SurfaceInteraction};
+use crate::math::frame::tangents_along;
 use crate::math::lanes::V3;
 use crate::math::simd::{Float8, Mask8};
 use crate::math::Frame;
@@ -117,6 +123,19 @@ impl Surfaces8 {
     }
 }
 
+/// The lanes of a packet on smooth-shaded triangles ([`Scene::surfaces_into`]): their triangles gathered
+/// from the packets of the BVH's leaves, vertex normals (as stored), ∂p/∂u, normal signs, and which of
+/// them read texture coordinates.
+#[derive(Default)]
+struct SmoothLanes {
+    lanes: u32,
+    textured: u32,
+    triangles: Triangle8,
+    normals: [Rows3; 3],
+    dp_du: Rows3,
+    sign: [f32; LANES],
+}
+
 impl Scene {
     /// The surfaces at the closest hits `hits` of the rays `rays` in `lanes` (from
     /// [`Scene::intersect_rays`]), as [`Scene::interaction_at`] would build them one by one: the same
@@ -144,6 +163,7 @@ impl Scene {
         // Lanes on spheres (their centres, radii and pole axes), those with flipped normals, and those textured.
         let (mut centers, mut radii, mut poles, mut round, mut flipped, mut round_uv) =
             (Rows3::default(), [1.0f32; LANES], Rows3::default(), 0u32, 0u32, 0u32);
+        let mut smooth = SmoothLanes::default();
         let (o, d) = ([rays.o.x, rays.o.y, rays.o.z].map(Float8::to_array), [rays.d.x, rays.d.y, rays.d.z].map(Float8::to_array));
         for lane in bits(lanes) {
             let slot = hits.slot[lane];
@@ -162,6 +182,20 @@ impl Scene {
                     out.set_frame(lane, frame);
                     out.n.set(lane, mesh.geometric_normal(r.prim));
                     flat |= 1 << lane;
+                    continue;
+                }
+                if let Some(normals) = mesh.vertex_normals(r.prim) {
+                    // Smooth-shaded triangles are never paired into parallelograms.
+                    debug_assert!(r.corner.is_none());
+                    smooth.triangles.copy_lane(lane, &self.prims.triangles[slot as usize / LANES], slot as usize % LANES);
+                    for (rows, n) in smooth.normals.iter_mut().zip(normals) {
+                        rows.set(lane, n);
+                    }
+                    smooth.dp_du.set(lane, mesh.dp_du(r.prim));
+                    smooth.sign[lane] = mesh.normal_sign();
+                    out.n.set(lane, mesh.geometric_normal(r.prim));
+                    smooth.lanes |= 1 << lane;
+                    smooth.textured |= u32::from(textured) << lane;
                     continue;
                 }
             }
@@ -191,6 +225,25 @@ impl Scene {
                 let r = self.prims.slots[hits.slot[lane] as usize];
                 if let Some(map) = self.prims.uv_maps.get(r.uv_map as usize) {
                     let uv = map.at(out.p.get(lane));
+                    (out.uv[0][lane], out.uv[1][lane]) = (uv.x, uv.y);
+                }
+            }
+        }
+        if smooth.lanes != 0 {
+            // The hit found again in lanes, as `interaction_at` finds it for one ray, and the surface there.
+            let (hit, p, b1, b2) = smooth.triangles.points_of_rays(rays.o, rays.d);
+            let normals = smooth.normals.map(|rows| rows.lanes());
+            let ns = smooth_normal(normals, b1, b2, Float8::load(&smooth.sign), out.n.lanes());
+            let (s, t) = tangents_along(ns, smooth.dp_du.lanes());
+            let m = Mask8::from_bitmask(smooth.lanes) & hit;
+            for (rows, v) in [(&mut out.p, p), (&mut out.s, s), (&mut out.t, t), (&mut out.ns, ns)] {
+                rows.store(V3::select(m, v, rows.lanes()));
+            }
+            let (b1, b2) = (b1.to_array(), b2.to_array());
+            for lane in bits(smooth.textured & m.bitmask()) {
+                let r = self.prims.slots[hits.slot[lane] as usize];
+                if let Shape::Mesh(mesh) = &self.shapes[r.shape as usize] {
+                    let uv = mesh.uv_at(r.prim, Vec2::new(b1[lane], b2[lane]));
                     (out.uv[0][lane], out.uv[1][lane]) = (uv.x, uv.y);
                 }
             }
@@ -354,17 +407,25 @@ mod tests {
     const NORMALS_OBJ: &str = "v 0.3 -0.9 -1.0\nv 1.8 -0.9 -1.0\nv 1.8 0.9 -1.0\nv 0.3 0.9 -1.0\n\
         v -1.8 -0.9 -1.2\nv -0.3 -0.9 -1.2\nv -1.05 0.9 -0.8\n\
         vn 0 0 1\nvn 0.3 0 1\nvn -0.3 0 1\nvn 0 0.2 1\n\
-        f 1//1 2//1 3//1\nf 1//1 3//1 4//1\nf 5//2 6//3 7//4\n";
+        vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvt 0.2 0.1\nvt 0.9 0.3\nvt 0.4 0.8\n\
+        f 1/1/1 2/2/1 3/3/1\nf 1/1/1 3/3/1 4/4/1\nf 5/5/2 6/6/3 7/7/4\n";
 
     /// Each lane of [`Scene::surfaces`] is the interaction [`Scene::intersect`] finds for its ray alone: the
     /// same shape, primitive, point, normals, frame and texture coordinates, bit for bit (with a mesh file
-    /// of vertex normals added, flat- and smooth-shaded triangles).
+    /// of vertex normals and texture coordinates added, textured, its normals flipped: flat- and
+    /// smooth-shaded triangles).
     #[test]
     fn lanes_match_single_rays() {
         let obj = std::env::temp_dir().join(format!("gonio-surfaces-{}.obj", std::process::id()));
         std::fs::write(&obj, NORMALS_OBJ).unwrap();
-        let with_obj =
-            SCENE.replace("</scene>", &format!(r#"<shape type="obj"><string name="filename" value="{}"/></shape></scene>"#, obj.display()));
+        let with_obj = SCENE.replace(
+            "</scene>",
+            &format!(
+                r#"<shape type="obj"><string name="filename" value="{}"/><boolean name="flip_normals" value="true"/>
+                <bsdf type="diffuse"><texture type="checkerboard" name="reflectance"/></bsdf></shape></scene>"#,
+                obj.display()
+            ),
+        );
         let scene = mitsuba_xml::load_str(&with_obj, "t.xml", Path::new("."), &[]).and_then(Scene::build);
         std::fs::remove_file(&obj).unwrap();
         let scene = scene.unwrap();
