@@ -542,10 +542,19 @@ fn direct_is_the_path_tracer_at_depth_two() {
             format!(r#"<shape type="sphere"><point name="center" x="{x}" y="{y}" z="0"/><float name="radius" value="0.5"/>{bsdf}</shape>"#)
         })
         .collect();
+    // A mesh light from a file whose flat vertex normals oppose its winding: it emits on their side, in
+    // lanes as for one ray.
+    let obj = std::env::temp_dir().join(format!("gonio-test-direct-{}.obj", std::process::id()));
+    std::fs::write(&obj, "v -0.4 -0.4 2\nv 0.4 -0.4 2\nv 0.4 0.4 2\nv -0.4 0.4 2\nvn 0 0 -1\nf 1//1 2//1 3//1\nf 1//1 3//1 4//1\n")
+        .unwrap();
+    let obj_light = format!(
+        r#"<shape type="obj"><string name="filename" value="{}"/><emitter type="area"><rgb name="radiance" value="3"/></emitter></shape>"#,
+        obj.display()
+    );
     for hide in [false, true] {
         let xml = format!(
             r#"<scene version="3.0.0"><integrator type="direct"><boolean name="hide_emitters" value="{hide}"/></integrator>{sensor}
-            {shapes}
+            {shapes}{obj_light}
             <shape type="rectangle"><transform name="to_world"><scale value="10"/><translate z="-1"/></transform>
                 <bsdf type="roughplastic"><string name="distribution" value="ggx"/></bsdf></shape>
             <shape type="rectangle"><transform name="to_world"><scale x="0.5" y="0.3"/><rotate x="1" angle="160"/><translate y="2" z="1"/></transform>
@@ -569,4 +578,5 @@ fn direct_is_the_path_tracer_at_depth_two() {
         assert!(lit > samples.len() / 2, "hide_emitters {hide}: the scene is lit ({lit} of {} samples)", samples.len());
         assert_eq!(differ, 0, "hide_emitters {hide}: {differ} of {} samples differ", samples.len());
     }
+    std::fs::remove_file(&obj).unwrap();
 }

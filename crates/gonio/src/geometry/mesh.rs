@@ -405,32 +405,41 @@ impl Mesh {
         }
     }
 
-    /// The first half of [`Self::sample_position`] for a flat-shaded mesh (no vertex normals): the triangle
-    /// chosen by `uc`, as its vertices and unit normal, and the density by area. The point in it is
-    /// [`uniform_triangle_point`] (in lanes, for the renderer's packets). `None` for smooth-shaded meshes.
+    /// Whether every triangle is flat-shaded ([`Mesh::flat_frames`]): always without vertex normals.
+    fn all_flat(&self) -> bool {
+        self.normals.is_none() || (!self.flat_frames.is_empty() && self.flat_frames.iter().all(Option::is_some))
+    }
+
+    /// The first half of [`Self::sample_position`] for a mesh whose triangles are all flat-shaded: the
+    /// triangle chosen by `uc`, as its vertices, unit geometric normal and shading normal, and the density
+    /// by area. The point in it is [`uniform_triangle_point`] (in lanes, for the renderer's packets).
+    /// `None` for meshes with smooth-shaded triangles.
     #[inline]
     #[must_use]
-    pub fn sample_flat_triangle(&self, uc: f32) -> Option<([Vec3; 3], Vec3, f32)> {
-        if self.normals.is_some() {
+    pub fn sample_flat_triangle(&self, uc: f32) -> Option<([Vec3; 3], Vec3, Vec3, f32)> {
+        if !self.all_flat() {
             return None;
         }
         let tri = self.areas.sample_index(uc) as u32;
-        Some((self.vertices(tri), self.tri_normals[tri as usize], 1.0 / self.area))
+        let (ng, ns, _) = self.surface_at(tri, Vec2::ZERO, false);
+        Some((self.vertices(tri), ng, ns, 1.0 / self.area))
     }
 
-    /// [`Self::sample_flat_triangle`] in lanes, for a flat-shaded mesh of at most eight triangles of
-    /// positive total area (a `rectangle` is two); `None` for others.
+    /// [`Self::sample_flat_triangle`] in lanes, for a mesh of at most eight flat-shaded triangles of
+    /// positive total area (a `rectangle` is two, as is a quad of a mesh file with normals); `None` for
+    /// others.
     #[must_use]
     pub fn flat_triangles8(&self) -> Option<FlatTriangles8> {
         let n = self.triangle_count();
-        if self.normals.is_some() || n > LANES || !(self.area > 0.0) {
+        if !self.all_flat() || n > LANES || !(self.area > 0.0) {
             return None;
         }
         let mut t = FlatTriangles8 {
             thresholds: [f32::INFINITY; LANES],
             threshold_count: 0,
             vertices: [[[0.0; LANES]; 3]; 3],
-            normals: [[0.0; LANES]; 3],
+            geometric: [[0.0; LANES]; 3],
+            shading: [[0.0; LANES]; 3],
             density: 1.0 / self.area,
         };
         for (k, th) in self.areas.index_thresholds().into_iter().enumerate() {
@@ -442,8 +451,9 @@ impl Mesh {
                     rows[axis][tri] = v[axis];
                 }
             }
+            let (ng, ns, _) = self.surface_at(tri as u32, Vec2::ZERO, false);
             for axis in 0..3 {
-                t.normals[axis][tri] = self.tri_normals[tri][axis];
+                (t.geometric[axis][tri], t.shading[axis][tri]) = (ng[axis], ns[axis]);
             }
         }
         Some(t)
@@ -458,14 +468,8 @@ impl Mesh {
         let b = Vec2::new(1.0 - su, u.y * su);
         let [p0, p1, p2] = self.vertices(tri);
         let p = uniform_triangle_point::<f32>(p0.into(), p1.into(), p2.into(), u.x, u.y).into();
-        // The texture coordinates are not needed here: flat meshes skip their interpolation.
-        let (ng, ns) = if self.normals.is_none() {
-            let ng = self.tri_normals[tri as usize];
-            (ng, ng)
-        } else {
-            let (ng, ns, _) = self.surface_at(tri, b, false);
-            (ng, ns)
-        };
+        // The texture coordinates are not needed here.
+        let (ng, ns, _) = self.surface_at(tri, b, false);
         PositionSample { p, n: ns, ng, pdf_area: 1.0 / self.area }
     }
 }
@@ -483,17 +487,18 @@ pub struct FlatTriangles8 {
     threshold_count: usize,
     /// `vertices[v][axis][triangle]`.
     vertices: [[[f32; LANES]; 3]; 3],
-    /// `normals[axis][triangle]`: the unit geometric normals.
-    normals: [[f32; LANES]; 3],
+    /// `geometric[axis][triangle]`: the unit geometric normals; `shading`, the shading normals.
+    geometric: [[f32; LANES]; 3],
+    shading: [[f32; LANES]; 3],
     /// 1 / the mesh's area.
     pub density: f32,
 }
 
 impl FlatTriangles8 {
-    /// The triangle chosen by `uc` in each lane, as its vertices and unit normal.
+    /// The triangle chosen by `uc` in each lane, as its vertices, unit geometric normal and shading normal.
     #[inline(always)]
     #[must_use]
-    pub fn sample(&self, uc: Float8) -> ([V3<Float8>; 3], V3<Float8>) {
+    pub fn sample(&self, uc: Float8) -> ([V3<Float8>; 3], V3<Float8>, V3<Float8>) {
         let (zero, one) = (Float8::splat(0.0), Float8::splat(1.0));
         // The index: how many thresholds lie at or below uc (at most seven; the +∞ after them never do, and
         // are not compared: a rectangle has one threshold).
@@ -504,7 +509,7 @@ impl FlatTriangles8 {
             let v = lane_rows(r);
             V3::new(v.x.permute(index), v.y.permute(index), v.z.permute(index))
         };
-        ([row(&self.vertices[0]), row(&self.vertices[1]), row(&self.vertices[2])], row(&self.normals))
+        ([row(&self.vertices[0]), row(&self.vertices[1]), row(&self.vertices[2])], row(&self.geometric), row(&self.shading))
     }
 }
 
@@ -992,16 +997,22 @@ mod tests {
         }
     }
 
-    /// The lanes choose the triangle [`Mesh::sample_flat_triangle`] chooses, with its vertices and normal,
+    /// The lanes choose the triangle [`Mesh::sample_flat_triangle`] chooses, with its vertices and normals,
     /// for random u and for u at and next to every CDF step, on meshes of one to eight triangles of unequal
-    /// areas.
+    /// areas, without vertex normals and with flat ones (here against the winding: the shading normal is
+    /// theirs, as for a hit).
     #[test]
     fn flat_triangles8_choose_as_the_cdf() {
         let mut rng = crate::sampling::Pcg32::new(11, 3);
-        for n in 1..=8usize {
+        for (n, with_normals) in (1..=8usize).flat_map(|n| [(n, false), (n, true)]) {
             let positions: Vec<Vec3> = (0..3 * n).map(|_| Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 3.0).collect();
             let indices: Vec<[u32; 3]> = (0..n as u32).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect();
-            let mesh = Mesh::new(positions, None, None, indices, &Transform::IDENTITY, true, false, "test").unwrap();
+            let flat = |t: usize| {
+                let [a, b, c] = [0, 1, 2].map(|k| positions[3 * t + k]);
+                (c - a).cross(b - a).normalize()
+            };
+            let normals = with_normals.then(|| (0..3 * n).map(|i| flat(i / 3)).collect());
+            let mesh = Mesh::new(positions.clone(), normals, None, indices, &Transform::IDENTITY, !with_normals, false, "test").unwrap();
             let table = mesh.flat_triangles8().expect("a small flat mesh");
             let mut us: Vec<f32> = (0..64).map(|_| rng.next_f32()).collect();
             for t in mesh.areas.index_thresholds() {
@@ -1010,20 +1021,28 @@ mod tests {
             us.extend([0.0, 1.0 - f32::EPSILON / 2.0]);
             for chunk in us.chunks(8) {
                 let uc = Float8::from_fn(|i| chunk.get(i).copied().unwrap_or(0.0));
-                let (vertices, normal) = table.sample(uc);
+                let (vertices, ng, ns) = table.sample(uc);
                 for (i, &u) in chunk.iter().enumerate() {
-                    let (want, want_n, density) = mesh.sample_flat_triangle(u).unwrap();
+                    let (want, want_ng, want_ns, density) = mesh.sample_flat_triangle(u).unwrap();
                     for (v, w) in vertices.iter().zip(want) {
                         assert_eq!(Vec3::new(v.x.lane(i), v.y.lane(i), v.z.lane(i)), w, "n = {n}, u = {u}");
                     }
-                    assert_eq!(Vec3::new(normal.x.lane(i), normal.y.lane(i), normal.z.lane(i)), want_n);
+                    assert_eq!(Vec3::new(ng.x.lane(i), ng.y.lane(i), ng.z.lane(i)), want_ng);
+                    assert_eq!(Vec3::new(ns.x.lane(i), ns.y.lane(i), ns.z.lane(i)), want_ns);
                     assert_eq!(table.density, density);
+                    // The shading normal is the one a point sampled on the triangle carries.
+                    let on = mesh.sample_position(u, Vec2::new(0.3, 0.6));
+                    assert_eq!((on.ng, on.n), (want_ng, want_ns));
+                    assert!(want_ng.dot(want_ns) > if with_normals { -1.0001 } else { 0.9999 }, "{want_ng} {want_ns}");
+                    if with_normals {
+                        assert!(want_ng.dot(want_ns) < -0.9999);
+                    }
                 }
             }
         }
         let smooth = Mesh::new(
             vec![Vec3::ZERO, Vec3::X, Vec3::Y],
-            Some(vec![Vec3::Z; 3]),
+            Some(vec![Vec3::Z, Vec3::new(0.1, 0.0, 1.0).normalize(), Vec3::Z]),
             None,
             vec![[0, 1, 2]],
             &Transform::IDENTITY,

@@ -437,7 +437,8 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
             // The light, chosen per lane. For an area light on a flat mesh (the common case) the triangle, and
             // the point on it in lanes; other lights sample in full per lane.
             let (mut wi, mut li, mut light_pdf) = (Rows3::default(), Rows3::default(), [0.0f32; W]);
-            let (mut tri, mut tri_n, mut pdf_area) = ([Rows3::default(); 3], Rows3::default(), Float8::splat(0.0));
+            let (mut tri, mut tri_n, mut tri_ns, mut pdf_area) =
+                ([Rows3::default(); 3], Rows3::default(), Rows3::default(), Float8::splat(0.0));
             let (mut sampled, mut on_mesh, mut delta) = (0u32, 0u32, 0u32);
             let mut shadow = RayRows::default();
             let u_light = p.rng.next_f32(smooth);
@@ -488,11 +489,12 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
                 let (Light::Area(area), Some(tris)) = (&scene.lights[index], &scene.light_triangles[index]) else {
                     continue;
                 };
-                let (vertices, n) = tris.sample(u_c);
+                let (vertices, ng, ns) = tris.sample(u_c);
                 for (rows, v) in tri.iter_mut().zip(vertices) {
                     rows.store(V3::select(m, v, rows.lanes()));
                 }
-                tri_n.store(V3::select(m, n, tri_n.lanes()));
+                tri_n.store(V3::select(m, ng, tri_n.lanes()));
+                tri_ns.store(V3::select(m, ns, tri_ns.lanes()));
                 pdf_area = Float8::select(m, Float8::splat(tris.density), pdf_area);
                 li.store(V3::select(m, V3::splat(Vec3::from_array(area.radiance.0)), li.lanes()));
                 on_mesh |= same;
@@ -505,12 +507,13 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
                 let light = &scene.lights[index];
                 if let Light::Area(area) = light {
                     if let Shape::Mesh(mesh) = &scene.shapes[area.shape as usize] {
-                        if let Some((vertices, n, density)) = mesh.sample_flat_triangle(uc) {
+                        if let Some((vertices, ng, ns, density)) = mesh.sample_flat_triangle(uc) {
                             if !area.radiance.is_black() {
                                 for (rows, v) in tri.iter_mut().zip(vertices) {
                                     rows.set(lane, v);
                                 }
-                                tri_n.set(lane, n);
+                                tri_n.set(lane, ng);
+                                tri_ns.set(lane, ns);
                                 pdf_area = Float8::select(Mask8::from_bitmask(1 << lane), Float8::splat(density), pdf_area);
                                 li.set_rgb(lane, area.radiance);
                                 on_mesh |= 1 << lane;
@@ -535,7 +538,8 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
                 let q = uniform_triangle_point(tri[0].lanes(), tri[1].lanes(), tri[2].lanes(), u_x, u_y);
                 let ng = tri_n.lanes();
                 let (pdf, by_area) = solid_angle_density(sp, q, ng, pdf_area);
-                let (dir, facing) = towards(sp, q, ng, pdf);
+                // Emission faces the shading normal (a mesh file's flat normals may oppose its winding).
+                let (dir, facing) = towards(sp, q, tri_ns.lanes(), pdf);
                 let ray = spawn_ray_to_lanes(sp, sn, q, ng);
                 let ok = by_area & facing & Mask8::from_bitmask(on_mesh);
                 let m = ok.bitmask();

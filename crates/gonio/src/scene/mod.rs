@@ -55,7 +55,7 @@ pub struct Scene {
     pub lights: Vec<Light>,
     /// Index of the environment light (`constant` or `envmap`), seen by rays that escape.
     pub environment: Option<u32>,
-    /// Per light: an area light that emits on a flat mesh of at most eight triangles, as lanes
+    /// Per light: an area light that emits on a mesh of at most eight flat-shaded triangles, as lanes
     /// ([`Mesh::flat_triangles8`](crate::geometry::mesh::Mesh::flat_triangles8)), for the path tracer's
     /// next-event estimation.
     pub light_triangles: Vec<Option<FlatTriangles8>>,
