@@ -291,18 +291,16 @@ impl Mesh {
         intersect_triangle(p0, e1, e2, ray)
     }
 
-    /// Geometric normal, shading normal and uv at barycentrics (b₁, b₂) of triangle `tri` (uv only with
-    /// `uv`, else zero). The shading normal of a flat-shaded triangle is its flat frame's
+    /// Geometric and shading normal at barycentrics (b₁, b₂) of triangle `tri`, as a hit there sees them
+    /// ([`Self::interaction`]): the shading normal of a flat-shaded triangle is its flat frame's
     /// ([`Mesh::flat_frames`]), so that sampled points and hits agree.
     #[inline]
-    fn surface_at(&self, tri: u32, b: Vec2, uv: bool) -> (Vec3, Vec3, Vec2) {
-        let ng = self.tri_normals[tri as usize];
-        let uv = if uv { self.uv_at(tri, b) } else { Vec2::ZERO };
+    fn normals_at(&self, tri: u32, b: Vec2) -> (Vec3, Vec3) {
         let ns = match self.flat_frame(tri) {
             Some(frame) => frame.n,
             None => self.interpolated_normal(tri, b),
         };
-        (ng, ns, uv)
+        (self.tri_normals[tri as usize], ns)
     }
 
     /// The vertex normals of triangle `tri` interpolated at barycentrics (b₁, b₂) and normalised (after
@@ -339,13 +337,13 @@ impl Mesh {
         let [p0, e1, e2] = self.triangle_edges(tri);
         let b = hit.uv;
         let p = barycentric_point::<f32>(p0.into(), e1.into(), e2.into(), b.x, b.y).into();
-        let (ng, ns, uv) = self.surface_at(tri, b, uv);
         let _ = ray;
         let shading = match self.flat_frame(tri) {
             Some(&f) => f,
-            None => self.shading_frame(tri, ns),
+            None => self.shading_frame(tri, self.interpolated_normal(tri, b)),
         };
-        SurfaceInteraction { t: hit.t, p, n: ng, shading, uv, shape: 0, prim: tri }
+        let uv = if uv { self.uv_at(tri, b) } else { Vec2::ZERO };
+        SurfaceInteraction { t: hit.t, p, n: self.tri_normals[tri as usize], shading, uv, shape: 0, prim: tri }
     }
 
     /// The shading frame around `ns`, oriented as Mitsuba 3 orients it (`src/shapes/mesh.cpp`,
@@ -421,7 +419,7 @@ impl Mesh {
             return None;
         }
         let tri = self.areas.sample_index(uc) as u32;
-        let (ng, ns, _) = self.surface_at(tri, Vec2::ZERO, false);
+        let (ng, ns) = self.normals_at(tri, Vec2::ZERO);
         Some((self.vertices(tri), ng, ns, 1.0 / self.area))
     }
 
@@ -451,7 +449,7 @@ impl Mesh {
                     rows[axis][tri] = v[axis];
                 }
             }
-            let (ng, ns, _) = self.surface_at(tri as u32, Vec2::ZERO, false);
+            let (ng, ns) = self.normals_at(tri as u32, Vec2::ZERO);
             for axis in 0..3 {
                 (t.geometric[axis][tri], t.shading[axis][tri]) = (ng[axis], ns[axis]);
             }
@@ -468,8 +466,7 @@ impl Mesh {
         let b = Vec2::new(1.0 - su, u.y * su);
         let [p0, p1, p2] = self.vertices(tri);
         let p = uniform_triangle_point::<f32>(p0.into(), p1.into(), p2.into(), u.x, u.y).into();
-        // The texture coordinates are not needed here.
-        let (ng, ns, _) = self.surface_at(tri, b, false);
+        let (ng, ns) = self.normals_at(tri, b);
         PositionSample { p, n: ns, ng, pdf_area: 1.0 / self.area }
     }
 }

@@ -6,7 +6,7 @@ use std::path::Path;
 
 use ::image::{DynamicImage, ImageFormat};
 
-use super::{linear_to_srgb, srgb8_table, srgb_to_linear, Bytes8, Format, Image, Stored};
+use super::{linear_to_srgb, srgb_to_linear, Bytes8, Format, Image, Stored};
 use crate::error::{Error, Result};
 
 /// The file as the `image` crate decodes it.
@@ -21,17 +21,7 @@ fn decode_dynamic(path: &Path, bytes: &[u8], format: Format) -> Result<DynamicIm
         .map_err(|e| Error::format(path, format!("{image_format:?} data"), e.to_string()))
 }
 
-pub(super) fn decode(path: &Path, bytes: &[u8], format: Format) -> Result<Image> {
-    Ok(match decode_stored(path, bytes, format)? {
-        Stored::Linear(image) => image,
-        Stored::Bytes(b) => {
-            let table = srgb8_table();
-            Image { width: b.width, height: b.height, data: b.data.iter().map(|&v| table[usize::from(v)]).collect() }
-        }
-    })
-}
-
-/// [`decode`], but an 8-bit file as its samples.
+/// The file's pixels: 8-bit files as their samples, others as linear floats (integer samples sRGB-decoded).
 pub(super) fn decode_stored(path: &Path, bytes: &[u8], format: Format) -> Result<Stored> {
     let decoded = decode_dynamic(path, bytes, format)?;
     let (width, height) = (decoded.width() as usize, decoded.height() as usize);
@@ -46,11 +36,7 @@ pub(super) fn decode_stored(path: &Path, bytes: &[u8], format: Format) -> Result
         }
         _ => Stored::Bytes(Bytes8 { width, height, data: decoded.into_rgb8().into_raw() }),
     };
-    let len = match &stored {
-        Stored::Linear(image) => image.data.len(),
-        Stored::Bytes(b) => b.data.len(),
-    };
-    if len != 3 * width * height {
+    if stored.samples() != 3 * width * height {
         return Err(Error::format(path, "pixels", "decoder returned the wrong number of samples"));
     }
     Ok(stored)

@@ -162,22 +162,55 @@ pub fn srgb8_table() -> &'static [f32; 256] {
     TABLE.get_or_init(|| std::array::from_fn(|v| srgb_to_linear(v as f32 / 255.0)))
 }
 
+impl Stored {
+    /// Width and height in pixels.
+    fn size(&self) -> (usize, usize) {
+        match self {
+            Stored::Linear(image) => (image.width, image.height),
+            Stored::Bytes(b) => (b.width, b.height),
+        }
+    }
+
+    /// The number of samples held (three per pixel).
+    fn samples(&self) -> usize {
+        match self {
+            Stored::Linear(image) => image.data.len(),
+            Stored::Bytes(b) => b.data.len(),
+        }
+    }
+
+    /// As linear RGB floats: 8-bit samples through [`srgb8_table`].
+    #[must_use]
+    pub fn into_linear(self) -> Image {
+        match self {
+            Stored::Linear(image) => image,
+            Stored::Bytes(b) => {
+                let table = srgb8_table();
+                Image { width: b.width, height: b.height, data: b.data.iter().map(|&v| table[usize::from(v)]).collect() }
+            }
+        }
+    }
+}
+
 /// Reads an image file as a texture keeps it: 8-bit files as their samples, others as [`read_image`]
 /// does.
 pub fn read_stored_image(path: &Path) -> Result<Stored> {
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
-    let format = format_of(path, &bytes)?;
+    decode_stored_image(path, &bytes)
+}
+
+/// [`decode_image`], but an 8-bit file as its samples.
+fn decode_stored_image(path: &Path, bytes: &[u8]) -> Result<Stored> {
+    let format = format_of(path, bytes)?;
     let stored = guard(path, || match format {
-        Format::Exr => exr::decode(path, &bytes).map(Stored::Linear),
-        Format::Hdr | Format::Png | Format::Jpeg => ldr::decode_stored(path, &bytes, format),
+        Format::Exr => exr::decode(path, bytes).map(Stored::Linear),
+        Format::Hdr | Format::Png | Format::Jpeg => ldr::decode_stored(path, bytes, format),
     })?;
-    let (width, height) = match &stored {
-        Stored::Linear(image) => (image.width, image.height),
-        Stored::Bytes(b) => (b.width, b.height),
-    };
+    let (width, height) = stored.size();
     if width == 0 || height == 0 {
         return Err(Error::format(path, "header", "image has no pixels"));
     }
+    debug_assert_eq!(stored.samples(), 3 * width * height);
     Ok(stored)
 }
 
@@ -197,16 +230,7 @@ pub fn read_image(path: &Path) -> Result<Image> {
 /// Decodes the content of an image file into linear RGB; `path` names it in errors and, when the magic
 /// bytes are not recognised, gives the format by its extension.
 pub fn decode_image(path: &Path, bytes: &[u8]) -> Result<Image> {
-    let format = format_of(path, bytes)?;
-    let image = guard(path, || match format {
-        Format::Exr => exr::decode(path, bytes),
-        Format::Hdr | Format::Png | Format::Jpeg => ldr::decode(path, bytes, format),
-    })?;
-    if image.width == 0 || image.height == 0 {
-        return Err(Error::format(path, "header", "image has no pixels"));
-    }
-    debug_assert_eq!(image.data.len(), 3 * image.width * image.height);
-    Ok(image)
+    decode_stored_image(path, bytes).map(Stored::into_linear)
 }
 
 /// Writes `img` to `path`, atomically (see the module docs): `.exr` as float32 linear RGB, `.png` as

@@ -73,7 +73,6 @@ enum Texels {
 
 impl Bitmap {
     pub fn from_props(p: &Props) -> Result<Self> {
-        let at = p.at_param("filename").to_string();
         let filename = p.string("filename")?.ok_or_else(|| Error::spec(p.at(), "`bitmap` needs a `filename`"))?;
         let raw = p.bool("raw", false)?;
         let texels = match read_stored_image(Path::new(&filename))? {
@@ -106,19 +105,8 @@ impl Bitmap {
                 return Err(Error::spec(p.at_param("wrap_mode"), format!("`wrap_mode` must be repeat, mirror or clamp, got `{other}`")))
             }
         };
-        let bitmap = Bitmap { texels, bilinear, wrap, to_uv: p.transform("to_uv")? };
-        if bitmap.size().0 == 0 || bitmap.size().1 == 0 {
-            return Err(Error::spec(at, format!("`{filename}` has no pixels")));
-        }
-        Ok(bitmap)
-    }
-
-    /// Width and height in texels.
-    fn size(&self) -> (usize, usize) {
-        match &self.texels {
-            Texels::Linear(image) => (image.width, image.height),
-            Texels::Bytes { image, .. } => (image.width, image.height),
-        }
+        // `read_stored_image` refuses an image without pixels.
+        Ok(Bitmap { texels, bilinear, wrap, to_uv: p.transform("to_uv")? })
     }
 
     #[must_use]
