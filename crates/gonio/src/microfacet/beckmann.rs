@@ -131,8 +131,10 @@ pub fn visible_slope_x<R: Real>(sin_theta: R, cos_theta: R, u: R) -> R {
     // tan θ = 0 and cot θ = ∞ at normal incidence.
     let tan_theta = sin_theta / cos_theta;
     let cot_theta = cos_theta / sin_theta;
-    // Beyond 10, erfc and e^{−x²} are 0 in f32 (NaN passes).
+    // Beyond 10, erfc and e^{−x²} are 0 in f32 (NaN passes). A lane with ωo below the surface (cot θ < 0)
+    // is one whose sample the caller rejects; it is taken at the horizon so that erfc's domain holds.
     let cot = R::select(cot_theta.gt(R::splat(10.0)), R::splat(10.0), cot_theta);
+    let cot = R::select(cot.lt(R::splat(0.0)), R::splat(0.0), cot);
     let c = one - erfc_lanes(cot);
     let (hi, lo) = square_split(cot);
     let norm = one / (one + c + tan_theta * exp_split(-hi, -lo) * FRAC_1_SQRT_PI);
