@@ -20,11 +20,12 @@
 
 use super::interaction::{PositionSample, SurfaceInteraction};
 use super::{Bounds3, PrimHit, Ray};
-use crate::math::frame::tangents_along;
+use crate::math::frame::{tangents, tangents_along};
+use crate::math::trig::sin_cos_turn;
 use crate::math::lanes::{Real, V3};
 use crate::math::simd::Float8;
 use crate::math::{Frame, Transform};
-use crate::sampling::warp::sample_uniform_sphere;
+use crate::sampling::warp::{sample_uniform_sphere, uniform_sphere};
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
@@ -128,27 +129,12 @@ impl Sphere {
 
     /// A point on the sphere sampled from reference point `p`: uniformly in the cone of directions the
     /// sphere subtends when `p` is outside (pbrt-v4 §6.2.4), else uniformly by area. The density is in
-    /// solid angle at `p`.
+    /// solid angle at `p`. [`sample_sphere_from`] at one lane.
     #[must_use]
     pub fn sample_from(&self, p: Vec3, u: Vec2) -> Option<(PositionSample, f32)> {
-        let Some((axis, cos_max, one_minus_cos)) = self.cone(p) else {
-            let ps = self.sample_position(u);
-            let d = ps.p - p;
-            let cos = ps.n.dot(-d.normalize_or_zero()).abs();
-            return (cos > 0.0).then(|| (ps, ps.pdf_area * d.length_squared() / cos));
-        };
-        let local = crate::sampling::warp::sample_uniform_cone(u, cos_max);
-        let w = Frame::from_normal(axis).to_world(local);
-        let ray = Ray::new(p, w, f32::INFINITY);
-        let t = match self.intersect(&ray) {
-            Some(h) => h.t,
-            // Grazing directions can miss by rounding: take the closest point of the ray.
-            None => (self.center - p).dot(w),
-        };
-        let outward = (ray.at(t) - self.center).normalize();
-        let n = if self.flip_normals { -outward } else { outward };
-        let ps = PositionSample { p: self.center + outward * self.radius, n, ng: n, pdf_area: 1.0 / self.area() };
-        Some((ps, 1.0 / (2.0 * PI * one_minus_cos)))
+        let (q, n, pdf, valid) = sample_sphere_from::<f32>(self.center.into(), self.radius, self.flip_normals, p.into(), u.x, u.y);
+        let n = Vec3::from(n);
+        valid.then(|| (PositionSample { p: q.into(), n, ng: n, pdf_area: 1.0 / self.area() }, pdf))
     }
 
     /// The solid-angle density with which [`Self::sample_from`] at `p` produces the surface point `q`.
@@ -175,6 +161,48 @@ impl Sphere {
         let n = if self.flip_normals { -outward } else { outward };
         PositionSample { p: self.center + outward * self.radius, n, ng: n, pdf_area: 1.0 / self.area() }
     }
+}
+
+/// [`Sphere::sample_from`] in lanes, each lane with a sphere of its own (centre, radius, and whether its
+/// normals point inwards): from the points `p` with the numbers (`ux`, `uy`), the point, its normal (the
+/// shading and the geometric one), the solid-angle density at `p`, and whether the sample is valid.
+/// Outside the sphere, the direction is drawn uniformly in the cone it subtends (pbrt-v4 §6.2.4: z = 1 −
+/// ux (1 − cos θmax) about the axis to the centre, φ = 2π uy by [`sin_cos_turn`]) and the point is where it
+/// meets the sphere (or, for a grazing direction that misses by rounding, the ray's point closest to the
+/// centre), re-projected onto the surface; inside (or on) it, the point is uniform by area.
+#[inline(always)]
+#[must_use]
+pub fn sample_sphere_from<R: Real>(center: V3<R>, radius: R, inward: R::Mask, p: V3<R>, ux: R, uy: R) -> (V3<R>, V3<R>, R, R::Mask) {
+    let (zero, one) = (R::splat(0.0), R::splat(1.0));
+    let r2 = radius * radius;
+    let to_center = center.sub(p);
+    let dc2 = to_center.dot(to_center);
+    // 2026-11: 1.0001 r² keeps points on (or rounding-close to) the surface on the area-sampling path.
+    let outside = dc2.gt(r2 * 1.0001);
+    // The cone: 1 − cos θmax as sin²θmax / (1 + cos θmax), which keeps its precision for small or distant
+    // spheres.
+    let sin2 = r2 / dc2;
+    let cos_max = (one - sin2).max(zero).sqrt();
+    let one_minus_cos = sin2 / (one + cos_max);
+    let axis = to_center.scale(one / dc2.sqrt());
+    let z = one - ux * (one - cos_max);
+    let rho = (one - z * z).max(zero).sqrt();
+    let (sin_phi, cos_phi) = sin_cos_turn(uy);
+    let (s, t) = tangents(axis);
+    let w = s.scale(rho * cos_phi).add(t.scale(rho * sin_phi)).add(axis.scale(z));
+    let (t_hit, hit) = intersect_sphere(p, w, center, radius, R::splat(f32::INFINITY));
+    let t_cone = R::select(hit, t_hit, to_center.dot(w));
+    let (_, cone_outward) = sphere_surface(p, w, t_cone, center, radius);
+    let cone_pdf = one / (one_minus_cos * (2.0 * PI));
+    // By area, the density converted to solid angle at `p`.
+    let area_outward = uniform_sphere(ux, uy);
+    let d = center.add(area_outward.scale(radius)).sub(p);
+    let dist2 = d.dot(d);
+    let cos = area_outward.dot(d).abs() / dist2.sqrt();
+    let area_pdf = dist2 / (cos * r2 * (4.0 * PI));
+    let outward = V3::select(outside, cone_outward, area_outward);
+    let n = V3::select(inward, outward.neg(), outward);
+    (center.add(outward.scale(radius)), n, R::select(outside, cone_pdf, area_pdf), outside | cos.gt(zero))
 }
 
 /// The point at distance `t` along the ray (o, d) re-projected onto the sphere, and the outward unit normal
@@ -293,6 +321,50 @@ mod tests {
             let (ps, pdf) = s.sample_from(Vec3::ZERO, rng.next_vec2()).unwrap();
             assert!(((ps.p - s.center).length() - 1.0).abs() < 1e-5 && ps.p.z < 4.0 + 1e-3);
             assert!((pdf / expected - 1.0).abs() < 1e-4 && (s.pdf_from(Vec3::ZERO, ps.p, ps.n) - pdf).abs() < 1e-3 * pdf);
+        }
+    }
+
+    /// In lanes, each lane with a sphere of its own (from outside, from inside, with normals in and out),
+    /// the samples are the single calls' bit for bit; inside, the density is the area density over the
+    /// solid angle (|q − p|² / (cos · area)) and the normal faces as the flag says.
+    #[test]
+    fn lanes_sample_each_lanes_sphere_as_single_calls() {
+        use crate::math::lanes::F32x8;
+        let mut rng = crate::sampling::Pcg32::new(9, 2);
+        let mut next = || rng.next_f32();
+        let spheres: Vec<Sphere> = (0..8)
+            .map(|i| Sphere::new(Vec3::new(i as f32, 1.0, 2.0), 0.5 + 0.2 * i as f32, Transform::IDENTITY, i % 3 == 0).unwrap())
+            .collect();
+        for round in 0..50 {
+            // Lanes 0–2 inside their sphere, the others outside.
+            let p: Vec<Vec3> = spheres
+                .iter()
+                .enumerate()
+                .map(|(i, s)| {
+                    let d = Vec3::new(next() - 0.5, next() - 0.5, next() - 0.5).normalize();
+                    s.center + d * s.radius * if i < 3 { 0.9 * next() } else { 1.5 + 4.0 * next() }
+                })
+                .collect();
+            let (ux, uy): (Vec<f32>, Vec<f32>) = (0..8).map(|_| (next(), next())).unzip();
+            let centers: Vec<Vec3> = spheres.iter().map(|s| s.center).collect();
+            let lanes = |f: &dyn Fn(usize) -> f32| F32x8::load(&(0..8).map(f).collect::<Vec<f32>>());
+            let radius = lanes(&|i| spheres[i].radius);
+            let inward = lanes(&|i| f32::from(u8::from(spheres[i].flip_normals))).gt(F32x8::splat(0.0));
+            let (q, n, pdf, valid) = sample_sphere_from(V3::load(&centers), radius, inward, V3::load(&p), lanes(&|i| ux[i]), lanes(&|i| uy[i]));
+            for (i, s) in spheres.iter().enumerate() {
+                let single = s.sample_from(p[i], Vec2::new(ux[i], uy[i]));
+                assert_eq!(single.is_some(), valid.get(i), "round {round} lane {i}");
+                let Some((ps, single_pdf)) = single else { continue };
+                assert_eq!((q.lane(i).to_array(), n.lane(i).to_array()), (ps.p.to_array(), ps.n.to_array()), "round {round} lane {i}");
+                assert_eq!(pdf.0[i].to_bits(), single_pdf.to_bits(), "round {round} lane {i}");
+                let outward = (ps.p - s.center) / s.radius;
+                assert!((ps.n - if s.flip_normals { -outward } else { outward }).length() < 1e-6);
+                if i < 3 {
+                    let d = ps.p - p[i];
+                    let expect = d.length_squared() / (outward.dot(d.normalize()).abs() * s.area());
+                    assert!((single_pdf / expect - 1.0).abs() < 1e-4, "inside: {single_pdf} against {expect}");
+                }
+            }
         }
     }
 

@@ -29,6 +29,7 @@ use crate::geometry::bvh::{bits, groups};
 use crate::geometry::mesh::uniform_triangle_point;
 use crate::geometry::ray::{offset_origin_lanes, spawn_ray_to_lanes, RayLanes};
 use crate::geometry::shape::solid_angle_density;
+use crate::geometry::sphere::sample_sphere_from;
 use crate::geometry::{Ray, Shape};
 use crate::light::area::towards;
 use crate::light::selection::SelectionSums;
@@ -435,11 +436,12 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
         p.sums_at = if n_lights > 0 { smooth } else { 0 };
         if n_lights > 0 && smooth != 0 {
             // The light, chosen per lane. For an area light on a flat mesh (the common case) the triangle, and
-            // the point on it in lanes; other lights sample in full per lane.
+            // the point on it in lanes; environments and spheres in lanes; other lights in full per lane.
             let (mut wi, mut li, mut light_pdf) = (Rows3::default(), Rows3::default(), [0.0f32; W]);
             let (mut tri, mut tri_n, mut tri_ns, mut pdf_area) =
                 ([Rows3::default(); 3], Rows3::default(), Rows3::default(), Float8::splat(0.0));
             let (mut sampled, mut on_mesh, mut delta) = (0u32, 0u32, 0u32);
+            let (mut sph_center, mut sph_radius, mut sph_inward, mut on_sphere) = (Rows3::default(), Float8::splat(1.0), 0u32, 0u32);
             let mut shadow = RayRows::default();
             let u_light = p.rng.next_f32(smooth);
             let (u_c, u_x, u_y) = (p.rng.next_f32(smooth), p.rng.next_f32(smooth), p.rng.next_f32(smooth));
@@ -451,7 +453,8 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
             }
             let chosen_lanes = Float8::load(&chosen);
             // The lanes that chose the same light, in lanes where it is an environment (constant or a map:
-            // `ConstantLight::sample_li`, `EnvMap::sample_lanes`; the surfaces' normals are never zero) or a
+            // `ConstantLight::sample_li`, `EnvMap::sample_lanes`; the surfaces' normals are never zero), a
+            // sphere (its centre and radius gathered, then `sample_sphere_from` for all of them at once) or a
             // small flat mesh (a `rectangle` light, say: its triangles chosen and loaded in lanes).
             let (sp, sn) = (hit.p.lanes(), hit.n.lanes());
             let mut rest = smooth;
@@ -485,6 +488,19 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
                     sampled |= ok.bitmask();
                     rest &= !same;
                     continue;
+                }
+                if let Light::Area(area) = &scene.lights[index] {
+                    if let Shape::Sphere(sphere) = &scene.shapes[area.shape as usize] {
+                        if !area.radiance.is_black() {
+                            sph_center.store(V3::select(m, V3::splat(sphere.center), sph_center.lanes()));
+                            sph_radius = Float8::select(m, Float8::splat(sphere.radius), sph_radius);
+                            sph_inward |= if sphere.flip_normals { same } else { 0 };
+                            li.store(V3::select(m, V3::splat(Vec3::from_array(area.radiance.0)), li.lanes()));
+                            on_sphere |= same;
+                        }
+                        rest &= !same;
+                        continue;
+                    }
                 }
                 let (Light::Area(area), Some(tris)) = (&scene.lights[index], &scene.light_triangles[index]) else {
                     continue;
@@ -532,6 +548,18 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
                 delta |= u32::from(ls.delta) << lane;
                 shadow.set(lane, &ls.shadow);
                 sampled |= 1 << lane;
+            }
+            if on_sphere != 0 {
+                // `AreaLight::sample_li` on spheres, in lanes, each lane with its sphere.
+                let inward = Mask8::from_bitmask(sph_inward);
+                let (q, n, pdf, valid) = sample_sphere_from(sph_center.lanes(), sph_radius, inward, sp, u_x, u_y);
+                let (dir, facing) = towards(sp, q, n, pdf);
+                let ok = valid & facing & Mask8::from_bitmask(on_sphere);
+                let ray = spawn_ray_to_lanes(sp, sn, q, n);
+                wi.store(V3::select(ok, dir, wi.lanes()));
+                light_pdf = Float8::select(ok, pdf, Float8::load(&light_pdf)).to_array();
+                shadow.merge(ok, &ray);
+                sampled |= ok.bitmask();
             }
             if on_mesh != 0 {
                 // `AreaLight::sample_li` on a flat mesh, in lanes.
