@@ -33,6 +33,14 @@ impl BlendBsdf {
         BlendBsdf { weight, mix: Sum::new(vec![first, second], vec![1.0 - weight, weight]) }
     }
 
+    /// The same blend with another weight in [0, 1] (a texture's value at a hit), as [`Self::new`] would
+    /// build it.
+    pub fn set_weight(&mut self, weight: f32) {
+        debug_assert!((0.0..=1.0).contains(&weight));
+        self.weight = weight;
+        self.mix.set_weights(vec![1.0 - weight, weight]);
+    }
+
     /// The two-term sum this blend is.
     #[inline(always)]
     pub(crate) fn mix(&self) -> &Sum {

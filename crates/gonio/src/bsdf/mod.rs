@@ -794,6 +794,19 @@ impl Bsdf {
         Bsdf::from_props(&Props::from_xml_bsdf(text, source)?)
     }
 
+    /// Set this model's float parameter `name` in [0, 1] (a texture's value at a hit) without building it
+    /// again, where the model has such a parameter: the blend `weight`. `false` (the model unchanged)
+    /// otherwise. The float counterpart of [`Self::reflectance_slot`].
+    pub fn set_unit_float(&mut self, name: &str, value: f32) -> bool {
+        match (self, name) {
+            (Bsdf::Blend(b), "weight") => {
+                b.set_weight(value);
+                true
+            }
+            _ => false,
+        }
+    }
+
     /// The field that holds this model's colour parameter `name`, where a texture can set it at a hit
     /// without building the model again: a reflectance in [0, 1] per channel (`Props::reflectance`) that
     /// the model reads as it is, deriving nothing from it when built. `None` where the model must be

@@ -43,11 +43,19 @@ impl Sum {
     /// In debug builds, when the lengths differ or a weight is negative.
     #[must_use]
     pub fn new(components: Vec<Bsdf>, weights: Vec<f32>) -> Self {
-        debug_assert_eq!(components.len(), weights.len());
+        let mut sum = Sum { components, weights: Vec::new(), probs: Vec::new() };
+        sum.set_weights(weights);
+        sum
+    }
+
+    /// New weights for the same components (non-negative, as many as components), with their selection
+    /// probabilities.
+    pub(crate) fn set_weights(&mut self, weights: Vec<f32>) {
+        debug_assert_eq!(self.components.len(), weights.len());
         debug_assert!(weights.iter().all(|w| *w >= 0.0));
         let total: f32 = weights.iter().sum();
-        let probs = weights.iter().map(|w| if total > 0.0 { w / total } else { 0.0 }).collect();
-        Sum { components, weights, probs }
+        self.probs = weights.iter().map(|w| if total > 0.0 { w / total } else { 0.0 }).collect();
+        self.weights = weights;
     }
 
     #[must_use]

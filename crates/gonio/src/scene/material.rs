@@ -25,12 +25,14 @@ pub enum Material {
     Fixed(Bsdf),
     /// A `diffuse` whose reflectance is a texture (the common case, built without `Props`).
     TexturedDiffuse(Texture),
-    /// A model whose every texture sets a reflectance it reads as it is ([`Bsdf::reflectance_slot`]):
-    /// built once, and at a hit copied with the textures' values written into it — the model
-    /// [`Material::Textured`] would build from the same values, without `Props`.
+    /// A model whose every texture sets a reflectance it reads as it is ([`Bsdf::reflectance_slot`]) or a
+    /// float in [0, 1] it can take at once ([`Bsdf::set_unit_float`]: a blend's weight): built once, and
+    /// at a hit copied with the textures' values written into it — the model [`Material::Textured`] would
+    /// build from the same values, without `Props`. Each texture with its parameter and whether that is a
+    /// float (in `SCALAR_PARAMETERS`, read with [`Texture::eval_1`]).
     Slotted {
         model: Bsdf,
-        textures: Vec<(String, Texture)>,
+        textures: Vec<(String, Texture, bool)>,
     },
     /// Any other BSDF with texture parameters: the description without them, and the textures with their
     /// parameter paths. Rebuilt at every hit from a copy of the template (`Props` tracks which parameters
@@ -55,11 +57,13 @@ impl Material {
         // where every texture has a slot in it.
         let model = material.try_at(Vec2::splat(0.5))?.into_owned();
         let slotted = textures.iter().all(|(path, _)| match path.as_slice() {
-            [name] => !SCALAR_PARAMETERS.contains(&name.as_str()) && model.clone().reflectance_slot(name).is_some(),
+            [name] if SCALAR_PARAMETERS.contains(&name.as_str()) => model.clone().set_unit_float(name, 0.5),
+            [name] => model.clone().reflectance_slot(name).is_some(),
             _ => false,
         });
         if slotted {
-            let textures = textures.iter().map(|(path, t)| (path[0].clone(), t.clone())).collect();
+            let textures =
+                textures.iter().map(|(path, t)| (path[0].clone(), t.clone(), SCALAR_PARAMETERS.contains(&path[0].as_str()))).collect();
             return Ok(Material::Slotted { model, textures });
         }
         Ok(material)
@@ -85,13 +89,23 @@ impl Material {
             Material::TexturedDiffuse(t) => Cow::Owned(Bsdf::Diffuse(Diffuse::new(Self::texel(t, uv)))),
             Material::Slotted { model, textures } => {
                 let mut model = model.clone();
-                for (name, t) in textures {
-                    let value = t.eval(uv);
-                    // `Props::reflectance`'s range, so that a value out of it fails as the rebuilt model would.
-                    if !value.0.iter().all(|c| (0.0..=1.0).contains(c)) {
-                        return Err(crate::error::Error::spec("", format!("texture value {value:?} of `{name}` outside [0, 1]")));
+                for (name, t, float) in textures {
+                    // The range of `Props::reflectance` and of the floats' `float_in`, so that a value out of
+                    // it fails as the rebuilt model would.
+                    let outside = |v: &dyn std::fmt::Debug| crate::error::Error::spec("", format!("texture value {v:?} of `{name}` outside [0, 1]"));
+                    if *float {
+                        let value = t.eval_1(uv);
+                        if !(0.0..=1.0).contains(&value) {
+                            return Err(outside(&value));
+                        }
+                        model.set_unit_float(name, value);
+                    } else {
+                        let value = t.eval(uv);
+                        if !value.0.iter().all(|c| (0.0..=1.0).contains(c)) {
+                            return Err(outside(&value));
+                        }
+                        *model.reflectance_slot(name).expect("slots checked when the material was built") = value;
                     }
-                    *model.reflectance_slot(name).expect("slots checked when the material was built") = value;
                 }
                 Cow::Owned(model)
             }
@@ -229,11 +243,12 @@ mod tests {
 
     /// Every texture the slotted form writes gives the model that building it again from the texture's
     /// values gives, bit for bit, over each model's reflectances (one and two textures at once), and a
-    /// value out of [0, 1] gives the same black diffuse; models whose textures have no slot (a roughness,
-    /// energy compensation, a nested model) are built again.
+    /// value out of [0, 1] gives the same black diffuse (a colour's and a blend weight's); models whose
+    /// textures have no slot (a roughness, energy compensation, a nested model) are built again.
     #[test]
     fn slotted_textures_give_the_rebuilt_models() {
         let (a, b) = ("0.9, 0.25, 0.5", "0.1, 0.7, 1");
+        let blend = r#"<bsdf type="diffuse"/><bsdf type="roughconductor"><string name="material" value="Cu"/></bsdf>"#;
         let cases: Vec<(&str, &str, Vec<Textured<'_>>)> = vec![
             ("conductor", r#"<string name="material" value="Au"/>"#, vec![("specular_reflectance", a, b)]),
             ("roughconductor", r#"<float name="alpha" value="0.3"/>"#, vec![("specular_reflectance", a, b)]),
@@ -245,6 +260,8 @@ mod tests {
             ("roughplastic", "", vec![("diffuse_reflectance", a, b)]),
             ("roughplastic", r#"<string name="distribution" value="ggx"/>"#, vec![("specular_reflectance", a, b)]),
             ("roughplastic", "", vec![("diffuse_reflectance", a, "0.5, 1.5, 0.5")]),
+            ("blendbsdf", blend, vec![("weight", "0.2", "0.7")]),
+            ("blendbsdf", blend, vec![("weight", "1.5", "0.3")]),
         ];
         for (plugin, extra, textured) in &cases {
             let p = props(plugin, extra, textured);
@@ -260,6 +277,8 @@ mod tests {
         let p = props("roughplastic", "", &[("diffuse_reflectance", a, "0.5, 1.5, 0.5")]);
         let m = Material::from_props(&p).unwrap();
         let black = Bsdf::Diffuse(Diffuse::new(crate::spectrum::Rgb::ZERO));
+        assert!((0..64).any(|i| *m.at(Vec2::new(i as f32 / 64.0, 0.3)) == black));
+        let m = Material::from_props(&props("blendbsdf", blend, &[("weight", "1.5", "0.3")])).unwrap();
         assert!((0..64).any(|i| *m.at(Vec2::new(i as f32 / 64.0, 0.3)) == black));
 
         for (plugin, extra, textured) in [
