@@ -106,6 +106,7 @@ bench: cli python
 	$(CARGO) bench -p gonio
 	GONIO_BIN=target/release/gonio $(VPY) bench/render_vs_mitsuba.py
 	$(VPY) bench/suite.py --gonio target/release/gonio --json bench/.cache/suite.json
+	$(VPY) bench/real_scenes.py --gonio target/release/gonio
 	$(VPY) bench/variance.py --gonio target/release/gonio --json bench/.cache/variance.json
 	$(VPY) bench/python_bsdf_vs_mitsuba.py
 	$(VPY) bench/distributed.py
