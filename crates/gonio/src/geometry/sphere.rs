@@ -21,9 +21,9 @@
 use super::interaction::{PositionSample, SurfaceInteraction};
 use super::{Bounds3, PrimHit, Ray};
 use crate::math::frame::{tangents, tangents_along};
-use crate::math::trig::sin_cos_turn;
 use crate::math::lanes::{Real, V3};
 use crate::math::simd::Float8;
+use crate::math::trig::sin_cos_turn;
 use crate::math::{Frame, Transform};
 use crate::sampling::warp::{sample_uniform_sphere, uniform_sphere};
 use glam::{Vec2, Vec3};
@@ -350,7 +350,8 @@ mod tests {
             let lanes = |f: &dyn Fn(usize) -> f32| F32x8::load(&(0..8).map(f).collect::<Vec<f32>>());
             let radius = lanes(&|i| spheres[i].radius);
             let inward = lanes(&|i| f32::from(u8::from(spheres[i].flip_normals))).gt(F32x8::splat(0.0));
-            let (q, n, pdf, valid) = sample_sphere_from(V3::load(&centers), radius, inward, V3::load(&p), lanes(&|i| ux[i]), lanes(&|i| uy[i]));
+            let (q, n, pdf, valid) =
+                sample_sphere_from(V3::load(&centers), radius, inward, V3::load(&p), lanes(&|i| ux[i]), lanes(&|i| uy[i]));
             for (i, s) in spheres.iter().enumerate() {
                 let single = s.sample_from(p[i], Vec2::new(ux[i], uy[i]));
                 assert_eq!(single.is_some(), valid.get(i), "round {round} lane {i}");

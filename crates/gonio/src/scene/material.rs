@@ -92,7 +92,8 @@ impl Material {
                 for (name, t, float) in textures {
                     // The range of `Props::reflectance` and of the floats' `float_in`, so that a value out of
                     // it fails as the rebuilt model would.
-                    let outside = |v: &dyn std::fmt::Debug| crate::error::Error::spec("", format!("texture value {v:?} of `{name}` outside [0, 1]"));
+                    let outside =
+                        |v: &dyn std::fmt::Debug| crate::error::Error::spec("", format!("texture value {v:?} of `{name}` outside [0, 1]"));
                     if *float {
                         let value = t.eval_1(uv);
                         if !(0.0..=1.0).contains(&value) {
