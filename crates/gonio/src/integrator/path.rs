@@ -32,6 +32,7 @@ use crate::geometry::shape::solid_angle_density;
 use crate::geometry::sphere::sample_sphere_from;
 use crate::geometry::{Ray, Shape};
 use crate::light::area::towards;
+use crate::light::point::point_source_lanes;
 use crate::light::selection::SelectionSums;
 use crate::light::Light;
 use crate::math::lanes::{Real, V3};
@@ -436,12 +437,14 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
         p.sums_at = if n_lights > 0 { smooth } else { 0 };
         if n_lights > 0 && smooth != 0 {
             // The light, chosen per lane. For an area light on a flat mesh (the common case) the triangle, and
-            // the point on it in lanes; environments and spheres in lanes; other lights in full per lane.
+            // the point on it in lanes; environments, point lights and spheres in lanes; other lights in full
+            // per lane.
             let (mut wi, mut li, mut light_pdf) = (Rows3::default(), Rows3::default(), [0.0f32; W]);
             let (mut tri, mut tri_n, mut tri_ns, mut pdf_area) =
                 ([Rows3::default(); 3], Rows3::default(), Rows3::default(), Float8::splat(0.0));
             let (mut sampled, mut on_mesh, mut delta) = (0u32, 0u32, 0u32);
             let (mut sph_center, mut sph_radius, mut sph_inward, mut on_sphere) = (Rows3::default(), Float8::splat(1.0), 0u32, 0u32);
+            let (mut pt_position, mut on_point) = (Rows3::default(), 0u32);
             let mut shadow = RayRows::default();
             let u_light = p.rng.next_f32(smooth);
             let (u_c, u_x, u_y) = (p.rng.next_f32(smooth), p.rng.next_f32(smooth), p.rng.next_f32(smooth));
@@ -454,8 +457,9 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
             let chosen_lanes = Float8::load(&chosen);
             // The lanes that chose the same light, in lanes where it is an environment (constant or a map:
             // `ConstantLight::sample_li`, `EnvMap::sample_lanes`; the surfaces' normals are never zero), a
-            // sphere (its centre and radius gathered, then `sample_sphere_from` for all of them at once) or a
-            // small flat mesh (a `rectangle` light, say: its triangles chosen and loaded in lanes).
+            // point light or a sphere (their positions, centres and radii gathered, then `point_source_lanes`
+            // and `sample_sphere_from` for all of them at once) or a small flat mesh (a `rectangle` light, say:
+            // its triangles chosen and loaded in lanes).
             let (sp, sn) = (hit.p.lanes(), hit.n.lanes());
             let mut rest = smooth;
             for (first, same) in groups(smooth, |l| chosen_lanes.eq(Float8::splat(chosen[l])).bitmask()) {
@@ -486,6 +490,15 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
                     light_pdf = Float8::select(ok, s.pdf, Float8::load(&light_pdf)).to_array();
                     shadow.merge(ok, &ray);
                     sampled |= ok.bitmask();
+                    rest &= !same;
+                    continue;
+                }
+                if let Light::Point(point) = &scene.lights[index] {
+                    if !point.intensity.is_black() {
+                        pt_position.store(V3::select(m, V3::splat(point.position), pt_position.lanes()));
+                        li.store(V3::select(m, V3::splat(Vec3::from_array(point.intensity.0)), li.lanes()));
+                        on_point |= same;
+                    }
                     rest &= !same;
                     continue;
                 }
@@ -548,6 +561,17 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
                 delta |= u32::from(ls.delta) << lane;
                 shadow.set(lane, &ls.shadow);
                 sampled |= 1 << lane;
+            }
+            if on_point != 0 {
+                // `PointLight::sample_li` in lanes, each lane with its light: a delta sample.
+                let (dir, inv_dist2, valid, ray) = point_source_lanes(pt_position.lanes(), sp, sn);
+                let ok = valid & Mask8::from_bitmask(on_point);
+                li.store(V3::select(ok, li.lanes().scale(inv_dist2), li.lanes()));
+                wi.store(V3::select(ok, dir, wi.lanes()));
+                light_pdf = Float8::select(ok, Float8::splat(1.0), Float8::load(&light_pdf)).to_array();
+                shadow.merge(ok, &ray);
+                sampled |= ok.bitmask();
+                delta |= ok.bitmask();
             }
             if on_sphere != 0 {
                 // `AreaLight::sample_li` on spheres, in lanes, each lane with its sphere.

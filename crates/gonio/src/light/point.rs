@@ -9,7 +9,8 @@
 //! Irradiance-carrying radiance at distance d: I / d² (a delta distribution in direction).
 
 use super::LightSample;
-use crate::geometry::ray::spawn_ray_to;
+use crate::geometry::ray::{spawn_ray_to_lanes, RayLanes};
+use crate::math::lanes::{Real, V3};
 use crate::spectrum::Rgb;
 use glam::Vec3;
 
@@ -36,11 +37,24 @@ pub(crate) fn sample_point_source(position: Vec3, intensity: Rgb, p: Vec3, n: Ve
     if !(dist2 > 0.0) {
         return None;
     }
-    let wi = d / dist2.sqrt();
-    let shadow = if n == Vec3::ZERO {
-        crate::geometry::Ray::new(p, wi, dist2.sqrt() * (1.0 - 1e-5))
+    let (wi, inv_dist2, shadow) = if n == Vec3::ZERO {
+        let wi = d / dist2.sqrt();
+        (wi, 1.0 / dist2, crate::geometry::Ray::new(p, wi, dist2.sqrt() * (1.0 - 1e-5)))
     } else {
-        spawn_ray_to(p, n, position, Vec3::ZERO)
+        let (wi, inv_dist2, _, shadow) = point_source_lanes::<f32>(position.into(), p.into(), n.into());
+        (wi.into(), inv_dist2, crate::geometry::Ray::new(shadow.o.into(), shadow.d.into(), shadow.tmax))
     };
-    Some(LightSample { wi, li: intensity / dist2, pdf: 1.0, delta: true, shadow })
+    Some(LightSample { wi, li: intensity * inv_dist2, pdf: 1.0, delta: true, shadow })
+}
+
+/// [`sample_point_source`] at surface points `p` (normals `n`, not zero) in lanes, each lane with its
+/// source at `position`: the direction to it, 1 / distance² (the intensity's factor), whether the point
+/// is not at the source, and the shadow ray.
+#[inline(always)]
+#[must_use]
+pub fn point_source_lanes<R: Real>(position: V3<R>, p: V3<R>, n: V3<R>) -> (V3<R>, R, R::Mask, RayLanes<R>) {
+    let d = position.sub(p);
+    let dist2 = d.dot(d);
+    let zero = R::splat(0.0);
+    (d.div(dist2.sqrt()), R::splat(1.0) / dist2, dist2.gt(zero), spawn_ray_to_lanes(p, n, position, V3::new(zero, zero, zero)))
 }
