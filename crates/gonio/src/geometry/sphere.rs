@@ -112,21 +112,6 @@ impl Sphere {
         self.pole_axis
     }
 
-    /// For a reference point outside the sphere: `1 − cos θmax` of the cone of directions it subtends,
-    /// computed as sin²θmax / (1 + cos θmax) to keep precision for small or distant spheres.
-    fn cone(&self, p: Vec3) -> Option<(Vec3, f32, f32)> {
-        let to_center = self.center - p;
-        let dc2 = to_center.length_squared();
-        let r2 = self.radius * self.radius;
-        // 2026-11: 1.0001 r² keeps points on (or rounding-close to) the surface on the area-sampling path.
-        if dc2 <= r2 * 1.0001 {
-            return None;
-        }
-        let sin2 = r2 / dc2;
-        let cos_max = (1.0 - sin2).max(0.0).sqrt();
-        Some((to_center / dc2.sqrt(), cos_max, sin2 / (1.0 + cos_max)))
-    }
-
     /// A point on the sphere sampled from reference point `p`: uniformly in the cone of directions the
     /// sphere subtends when `p` is outside (pbrt-v4 §6.2.4), else uniformly by area. The density is in
     /// solid angle at `p`. [`sample_sphere_from`] at one lane.
@@ -140,9 +125,10 @@ impl Sphere {
     /// The solid-angle density with which [`Self::sample_from`] at `p` produces the surface point `q`.
     #[must_use]
     pub fn pdf_from(&self, p: Vec3, q: Vec3, n: Vec3) -> f32 {
-        match self.cone(p) {
-            Some((_, _, one_minus_cos)) => 1.0 / (2.0 * PI * one_minus_cos),
-            None => {
+        let to_center = self.center - p;
+        match sphere_cone::<f32>(to_center.length_squared(), self.radius * self.radius) {
+            (true, _, cone_pdf) => cone_pdf,
+            (false, ..) => {
                 let d = q - p;
                 let cos = n.dot(d.normalize_or_zero()).abs();
                 if cos == 0.0 {
@@ -163,6 +149,20 @@ impl Sphere {
     }
 }
 
+/// The cone of directions a sphere of squared radius `r2` subtends from a point at squared distance `dc2`
+/// from its centre, in lanes: whether the point is outside (2026-11: beyond 1.0001 r², so that points on,
+/// or rounding-close to, the surface take the area-sampling path), cos θmax, and the uniform density in
+/// the cone, 1 / (2π (1 − cos θmax)), with 1 − cos θmax as sin²θmax / (1 + cos θmax) to keep its
+/// precision for small or distant spheres. Shared by the sampling and [`Sphere::pdf_from`].
+#[inline(always)]
+fn sphere_cone<R: Real>(dc2: R, r2: R) -> (R::Mask, R, R) {
+    let one = R::splat(1.0);
+    let sin2 = r2 / dc2;
+    let cos_max = (one - sin2).max(R::splat(0.0)).sqrt();
+    let one_minus_cos = sin2 / (one + cos_max);
+    (dc2.gt(r2 * 1.0001), cos_max, one / (one_minus_cos * (2.0 * PI)))
+}
+
 /// [`Sphere::sample_from`] in lanes, each lane with a sphere of its own (centre, radius, and whether its
 /// normals point inwards): from the points `p` with the numbers (`ux`, `uy`), the point, its normal (the
 /// shading and the geometric one), the solid-angle density at `p`, and whether the sample is valid.
@@ -177,13 +177,7 @@ pub fn sample_sphere_from<R: Real>(center: V3<R>, radius: R, inward: R::Mask, p:
     let r2 = radius * radius;
     let to_center = center.sub(p);
     let dc2 = to_center.dot(to_center);
-    // 2026-11: 1.0001 r² keeps points on (or rounding-close to) the surface on the area-sampling path.
-    let outside = dc2.gt(r2 * 1.0001);
-    // The cone: 1 − cos θmax as sin²θmax / (1 + cos θmax), which keeps its precision for small or distant
-    // spheres.
-    let sin2 = r2 / dc2;
-    let cos_max = (one - sin2).max(zero).sqrt();
-    let one_minus_cos = sin2 / (one + cos_max);
+    let (outside, cos_max, cone_pdf) = sphere_cone(dc2, r2);
     let axis = to_center.scale(one / dc2.sqrt());
     let z = one - ux * (one - cos_max);
     let rho = (one - z * z).max(zero).sqrt();
@@ -193,7 +187,6 @@ pub fn sample_sphere_from<R: Real>(center: V3<R>, radius: R, inward: R::Mask, p:
     let (t_hit, hit) = intersect_sphere(p, w, center, radius, R::splat(f32::INFINITY));
     let t_cone = R::select(hit, t_hit, to_center.dot(w));
     let (_, cone_outward) = sphere_surface(p, w, t_cone, center, radius);
-    let cone_pdf = one / (one_minus_cos * (2.0 * PI));
     // By area, the density converted to solid angle at `p`.
     let area_outward = uniform_sphere(ux, uy);
     let d = center.add(area_outward.scale(radius)).sub(p);

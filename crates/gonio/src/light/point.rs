@@ -32,24 +32,22 @@ impl PointLight {
 /// [`PointLight`] and [`super::spot::SpotLight`] (which scales it by its falloff).
 #[must_use]
 pub(crate) fn sample_point_source(position: Vec3, intensity: Rgb, p: Vec3, n: Vec3) -> Option<LightSample> {
-    let d = position - p;
-    let dist2 = d.length_squared();
-    if !(dist2 > 0.0) {
+    let (wi, inv_dist2, valid, shadow) = point_source_lanes::<f32>(position.into(), p.into(), n.into());
+    if !valid {
         return None;
     }
-    let (wi, inv_dist2, shadow) = if n == Vec3::ZERO {
-        let wi = d / dist2.sqrt();
-        (wi, 1.0 / dist2, crate::geometry::Ray::new(p, wi, dist2.sqrt() * (1.0 - 1e-5)))
+    let wi = Vec3::from(wi);
+    let shadow = if n == Vec3::ZERO {
+        crate::geometry::Ray::new(p, wi, (position - p).length() * (1.0 - 1e-5))
     } else {
-        let (wi, inv_dist2, _, shadow) = point_source_lanes::<f32>(position.into(), p.into(), n.into());
-        (wi.into(), inv_dist2, crate::geometry::Ray::new(shadow.o.into(), shadow.d.into(), shadow.tmax))
+        crate::geometry::Ray::new(shadow.o.into(), shadow.d.into(), shadow.tmax)
     };
     Some(LightSample { wi, li: intensity * inv_dist2, pdf: 1.0, delta: true, shadow })
 }
 
-/// [`sample_point_source`] at surface points `p` (normals `n`, not zero) in lanes, each lane with its
-/// source at `position`: the direction to it, 1 / distance² (the intensity's factor), whether the point
-/// is not at the source, and the shadow ray.
+/// [`sample_point_source`] at points `p` (normals `n`) in lanes, each lane with its source at `position`:
+/// the direction to it, 1 / distance² (the intensity's factor), whether the point is not at the source,
+/// and the shadow ray from the surface (for a zero normal, in a medium, the caller's own ray).
 #[inline(always)]
 #[must_use]
 pub fn point_source_lanes<R: Real>(position: V3<R>, p: V3<R>, n: V3<R>) -> (V3<R>, R, R::Mask, RayLanes<R>) {
