@@ -514,11 +514,12 @@ fn filters_blur_an_edge_by_their_weights() {
     }
 }
 
-/// `direct` with one light and one BSDF sample renders through the path tracer's packets at max_depth 2
-/// (`integrator::radiance`); the scalar `direct` integrator (`integrator::direct_each`) is its reference:
-/// every camera sample's radiance the same bit for bit, over every light type, smooth, glossy, delta and
-/// layered models, composites, textures, with and without `hide_emitters`. A difference in the estimator,
-/// its MIS weights or the order of its random numbers fails here.
+/// `direct` renders through the path tracer's packets at max_depth 2 (`integrator::radiance`), with any
+/// numbers of light and BSDF samples; the scalar `direct` integrator (`integrator::direct_each`) is its
+/// reference: every camera sample's radiance the same bit for bit, over every light type, smooth, glossy,
+/// delta and layered models, composites, textures, with and without `hide_emitters`, with one sample of
+/// each, several of either, and none of either. A difference in the estimator, its MIS weights (with the
+/// sample counts) or the order of its random numbers fails here.
 #[test]
 fn direct_is_the_path_tracer_at_depth_two() {
     use gonio::integrator::{direct_each, radiance, CameraSample};
@@ -551,9 +552,11 @@ fn direct_is_the_path_tracer_at_depth_two() {
         r#"<shape type="obj"><string name="filename" value="{}"/><emitter type="area"><rgb name="radiance" value="3"/></emitter></shape>"#,
         obj.display()
     );
-    for hide in [false, true] {
+    let counts = [(1, 1, false), (1, 1, true), (4, 0, false), (2, 3, true), (0, 2, false), (3, 1, false), (1, 0, true), (0, 0, false)];
+    for (ne, nb, hide) in counts {
         let xml = format!(
-            r#"<scene version="3.0.0"><integrator type="direct"><boolean name="hide_emitters" value="{hide}"/></integrator>{sensor}
+            r#"<scene version="3.0.0"><integrator type="direct"><boolean name="hide_emitters" value="{hide}"/>
+                <integer name="emitter_samples" value="{ne}"/><integer name="bsdf_samples" value="{nb}"/></integrator>{sensor}
             {shapes}{obj_light}
             <shape type="rectangle"><transform name="to_world"><scale value="10"/><translate z="-1"/></transform>
                 <bsdf type="roughplastic"><string name="distribution" value="ggx"/></bsdf></shape>
@@ -572,11 +575,14 @@ fn direct_is_the_path_tracer_at_depth_two() {
             (0..24).flat_map(|y| (0..24).flat_map(move |x| (0..4).map(move |k| CameraSample { x, y, k }))).collect();
         let (mut packets, mut each) = (vec![gonio::spectrum::Rgb::ZERO; samples.len()], vec![gonio::spectrum::Rgb::ZERO; samples.len()]);
         radiance(&s, 7, &samples, &mut packets);
-        direct_each(&s, 7, &samples, &mut each, 1, 1, hide);
+        direct_each(&s, 7, &samples, &mut each, ne, nb, hide);
         let differ = packets.iter().zip(&each).filter(|(a, b)| a.0.map(f32::to_bits) != b.0.map(f32::to_bits)).count();
         let lit = each.iter().filter(|l| l.0.iter().any(|&v| v > 0.0)).count();
-        assert!(lit > samples.len() / 2, "hide_emitters {hide}: the scene is lit ({lit} of {} samples)", samples.len());
-        assert_eq!(differ, 0, "hide_emitters {hide}: {differ} of {} samples differ", samples.len());
+        let case = format!("emitter_samples {ne}, bsdf_samples {nb}, hide_emitters {hide}");
+        // With samples, the lights light most camera samples; without, only the emitters seen are lit.
+        let least = if ne + nb > 0 { samples.len() / 2 } else { 1 };
+        assert!(lit >= least, "{case}: the scene is lit ({lit} of {} samples)", samples.len());
+        assert_eq!(differ, 0, "{case}: {differ} of {} samples differ", samples.len());
     }
     std::fs::remove_file(&obj).unwrap();
 }

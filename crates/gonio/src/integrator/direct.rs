@@ -9,9 +9,9 @@
 //! | `bsdf_samples`    | integer | 1       | BSDF samples per camera sample            |
 //! | `hide_emitters`   | boolean | false   | emitters seen directly by the camera are black |
 //!
-//! With one sample of each (the default) this is the path tracer's estimator at `max_depth` 2, random
-//! numbers and all: [`super::radiance`] renders it with the path tracer's packets, and this scalar form,
-//! which other sample counts run, is their reference (test `direct_is_the_path_tracer_at_depth_two`).
+//! This is the path tracer's estimator at `max_depth` 2 with these sample counts at its one vertex, random
+//! numbers and all: [`super::radiance`] renders it with the path tracer's packets, and this scalar form is
+//! their reference (test `direct_is_the_path_tracer_at_depth_two`).
 
 use super::{emitter_hit, sample_emitter, BsdfSampled};
 use crate::bsdf::{BsdfFlags, BsdfModel};

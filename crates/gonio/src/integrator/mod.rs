@@ -99,23 +99,22 @@ pub fn start_lanes(scene: &Scene, mixed: &[u64; 8], samples: &[CameraSample; 8],
 pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [Rgb]) {
     match scene.integrator {
         IntegratorKind::Path { max_depth, rr_depth, hide_emitters } => {
-            path::radiance(scene, seed, samples, out, path::Settings { max_depth, rr_depth, hide_emitters });
+            path::radiance(scene, seed, samples, out, path::Settings::path(max_depth, rr_depth, hide_emitters));
         }
-        // One light and one BSDF sample per camera sample is the path tracer's estimator at max_depth 2,
-        // with the same random numbers in the same order: the same image bit for bit (test
-        // `direct_is_the_path_tracer_at_depth_two`), rendered in packets (2026-12-05: 2.3× faster than the
-        // scalar loop on the benchmark's area-lights-shapes).
-        IntegratorKind::Direct { emitter_samples: 1, bsdf_samples: 1, hide_emitters } => {
-            path::radiance(scene, seed, samples, out, path::Settings { max_depth: 2, rr_depth: i32::MAX, hide_emitters });
-        }
+        // The path tracer's estimator at max_depth 2 with the integrator's sample counts, with the random
+        // numbers of the scalar `direct::radiance` in the same order: the same image bit for bit (test
+        // `direct_is_the_path_tracer_at_depth_two`), rendered in packets (2026-12-05: with one sample of
+        // each 2.3× faster than the scalar loop on the benchmark's area-lights-shapes; with 4 light
+        // samples and none of the BSDF, Mitsuba's `scenes/hello.xml`, 2.49 -> 1.25 s CPU).
         IntegratorKind::Direct { emitter_samples, bsdf_samples, hide_emitters } => {
-            direct_each(scene, seed, samples, out, emitter_samples, bsdf_samples, hide_emitters)
+            let settings = path::Settings { max_depth: 2, rr_depth: i32::MAX, hide_emitters, light_samples: emitter_samples, bsdf_samples };
+            path::radiance(scene, seed, samples, out, settings);
         }
     }
 }
 
-/// The `direct` integrator one camera sample at a time ([`direct::radiance`]): what [`radiance`] runs for
-/// other sample counts than one of each, and the scalar reference the packets are tested against.
+/// The `direct` integrator one camera sample at a time ([`direct::radiance`]): the scalar reference the
+/// packets are tested against.
 pub fn direct_each(
     scene: &Scene,
     seed: u64,

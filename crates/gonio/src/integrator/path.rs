@@ -34,10 +34,11 @@ use crate::geometry::{Ray, Shape};
 use crate::light::area::towards;
 use crate::light::point::point_source_lanes;
 use crate::light::selection::SelectionSums;
-use crate::light::Light;
+use crate::light::{Light, LightSample};
 use crate::math::lanes::{Real, V3};
 use crate::math::simd::{Float8, Mask8};
 use crate::math::{Vec2, Vec3};
+use crate::sampling::mis::power_heuristic_lanes;
 use crate::sampling::warp::uniform_sphere;
 use crate::sampling::Pcg32x8;
 use crate::scene::surfaces::{Rows3, Surfaces8};
@@ -54,6 +55,19 @@ pub struct Settings {
     pub max_depth: i32,
     pub rr_depth: i32,
     pub hide_emitters: bool,
+    /// Light and BSDF samples at a vertex, combined by the power heuristic with these counts (Veach &
+    /// Guibas 1995, eq. 8): the `direct` integrator's `emitter_samples` and `bsdf_samples`; the path tracer
+    /// takes one of each. Other than one BSDF sample needs `max_depth` 2: the path cannot go on along several.
+    pub light_samples: u32,
+    pub bsdf_samples: u32,
+}
+
+impl Settings {
+    /// The path tracer's: one light and one BSDF sample per vertex.
+    #[must_use]
+    pub fn path(max_depth: i32, rr_depth: i32, hide_emitters: bool) -> Self {
+        Settings { max_depth, rr_depth, hide_emitters, light_samples: 1, bsdf_samples: 1 }
+    }
 }
 
 /// Rays as rows of lanes.
@@ -209,15 +223,6 @@ fn lanes_where(f: impl Fn(usize) -> bool) -> u32 {
     (0..W).fold(0, |m, i| m | u32::from(f(i)) << i)
 }
 
-/// [`power_heuristic`] with one sample of each technique, in lanes.
-#[inline(always)]
-fn power_heuristic_1(f: Float8, g: Float8) -> Float8 {
-    let (zero, one) = (Float8::splat(0.0), Float8::splat(1.0));
-    let w = (f * f) / (f * f + g * g);
-    let w = Float8::select(f.eq(zero) & g.eq(zero), zero, w);
-    Float8::select(f.abs().eq(Float8::splat(f32::INFINITY)), one, w)
-}
-
 /// The packet shades once at least this many of its lanes hold a surface: while fewer do (paths escaped
 /// or ended at the trace), the free lanes take camera samples and their rays are traced first. The
 /// shading phases cost about the same for a few lanes as for eight, a trace of a few rays less than one of
@@ -249,11 +254,12 @@ fn sample_where(model: &Bsdf, wo: V3<Float8>, uc: Float8, ux: Float8, uy: Float8
     model.sample_lanes_where(wo, uc, ux, uy, m)
 }
 
-/// Trace the rays of lanes `lanes` into `hit` (their lanes of it; the others keep theirs), add the emission
-/// they find, and end the paths that escaped or reached the longest length.
+/// Trace the rays of lanes `lanes` into `hit` (their lanes of it; the others keep theirs) and add the
+/// emission they find, divided by `share` (the number of BSDF samples taken together: 1 but at the `direct`
+/// integrator's several). Returns the lanes whose paths end there: escaped, or at the longest length.
 #[inline(always)]
-fn trace(scene: &Scene, p: &mut Packet, lanes: u32, hit: &mut Surfaces8, out: &mut [Rgb], settings: Settings) {
-    let Settings { max_depth, hide_emitters, .. } = settings;
+fn trace(scene: &Scene, p: &mut Packet, lanes: u32, hit: &mut Surfaces8, settings: Settings, share: f32) -> u32 {
+    let Settings { max_depth, hide_emitters, light_samples, bsdf_samples, .. } = settings;
     let rays = RayLanes { o: p.o.lanes(), d: p.d.lanes(), tmax: Float8::load(&p.tmax) };
     let found = scene.intersect_rays(&rays, lanes);
     scene.surfaces_into(&rays, &found, lanes, hit);
@@ -266,7 +272,7 @@ fn trace(scene: &Scene, p: &mut Packet, lanes: u32, hit: &mut Surfaces8, out: &m
     let first = lanes & lanes_where(|i| p.depth[i] == 0);
     let shown = lanes & !(if hide_emitters { first } else { 0 });
     // An environment seen (constant or a map), in lanes: `emitter_hit`'s Le · w, with w the power heuristic
-    // against light sampling, one sample of each (1 after a delta lobe and for camera rays).
+    // against light sampling (1 after a delta lobe, for camera rays and without light samples).
     let (mut sky, mut sky_le) = (0u32, [Float8::splat(0.0); 3]);
     let environment = scene.environment.map(|i| &scene.lights[i as usize]);
     let seen = match environment {
@@ -282,11 +288,13 @@ fn trace(scene: &Scene, p: &mut Packet, lanes: u32, hit: &mut Surfaces8, out: &m
         // The probability of choosing the environment at the vertex the ray left, where it is weighted
         // (not for camera rays nor after a delta lobe, whose lanes keep weight 1).
         let env = scene.environment.unwrap_or(0) as usize;
-        let unweighted = first | p.delta;
+        let unweighted = first | p.delta | if light_samples == 0 { lanes } else { 0 };
         let pmf = Float8::from_fn(|l| if sky & !unweighted & (1 << l) != 0 { p.pmf(scene, l, env) } else { 1.0 });
         let light_pdf = pdf * pmf;
         let unweighted = Mask8::from_bitmask(unweighted);
-        let w = Float8::select(unweighted, Float8::splat(1.0), power_heuristic_1(Float8::load(&p.pdf), light_pdf));
+        let (n_bsdf, n_light) = (Float8::splat(bsdf_samples as f32), Float8::splat(light_samples as f32));
+        let w = power_heuristic_lanes(n_bsdf, Float8::load(&p.pdf), n_light, light_pdf);
+        let w = Float8::select(unweighted, Float8::splat(1.0), w);
         sky_le = radiance.map(|c| w * c);
     }
     // Other emitters seen, lane by lane: emitting surfaces.
@@ -296,8 +304,8 @@ fn trace(scene: &Scene, p: &mut Packet, lanes: u32, hit: &mut Surfaces8, out: &m
             from: p.from.get(lane),
             pdf: p.pdf[lane],
             delta: p.delta & (1 << lane) != 0,
-            n_bsdf: 1.0,
-            n_light: 1.0,
+            n_bsdf: bsdf_samples as f32,
+            n_light: light_samples as f32,
             sums: p.sums(lane),
         });
         let si = (hit.found & (1 << lane) != 0).then(|| hit.interaction(lane, t[lane]));
@@ -308,26 +316,423 @@ fn trace(scene: &Scene, p: &mut Packet, lanes: u32, hit: &mut Surfaces8, out: &m
     let (mut l, beta) = (load_rgb(&p.l), load_rgb(&p.beta));
     let m = Mask8::from_bitmask(lanes);
     for c in 0..3 {
-        l[c] = Float8::select(m, l[c] + beta[c] * le[c], l[c]);
+        let found = beta[c] * le[c];
+        let found = if share == 1.0 { found } else { found / Float8::splat(share) };
+        l[c] = Float8::select(m, l[c] + found, l[c]);
     }
     store_rgb(&mut p.l, l);
     // A vertex at `depth` can extend the path only if the next one is within max_depth.
     let longest = if max_depth >= 0 { lanes_where(|i| p.depth[i] >= max_depth - 1) } else { 0 };
-    for lane in bits(lanes & (!hit.found | longest)) {
-        p.finish(lane, out);
+    lanes & (!hit.found | longest)
+}
+
+/// The packet's surfaces as the shading phases see them: the reflectance of the diffuse lanes, the models of
+/// the others grouped by instance, the shading frames and ωo in them.
+struct Shading<'a> {
+    rho: [Float8; 3],
+    diffuse: u32,
+    /// The lanes whose model has a smooth component.
+    smooth: u32,
+    models: [Option<Cow<'a, Bsdf>>; W],
+    /// The groups of lanes of one model instance (lanes, first lane), `n_groups` of them.
+    groups: [(u32, usize); W],
+    n_groups: usize,
+    /// The shading frames (s, t, n).
+    frame: (V3<Float8>, V3<Float8>, V3<Float8>),
+    wo: V3<Float8>,
+}
+
+impl Shading<'_> {
+    fn groups(&self) -> &[(u32, usize)] {
+        &self.groups[..self.n_groups]
     }
+
+    fn model(&self, lane: usize) -> &Bsdf {
+        self.models[lane].as_deref().expect("a model for every non-diffuse lane")
+    }
+
+    fn to_local(&self, v: V3<Float8>) -> V3<Float8> {
+        to_local(self.frame.0, self.frame.1, self.frame.2, v)
+    }
+}
+
+/// The live lanes' materials at their surfaces in `hit`: diffuse ones are evaluated in lanes, the others by
+/// their model.
+#[inline(always)]
+fn shading<'a>(scene: &'a Scene, p: &Packet, hit: &Surfaces8) -> Shading<'a> {
+    // The lanes on one shape, or on shapes of one constant reflectance (`Scene::material_class`), share their material:
+    // a constant or checkerboard reflectance is found for them together, other materials lane by lane.
+    let (mut rho, mut rho_rows, mut diffuse, mut diffuse_rows) = ([Float8::splat(0.0); 3], Rows3::default(), 0u32, 0u32);
+    let mut models: [Option<Cow<'_, Bsdf>>; W] = Default::default();
+    let (u, v) = (Float8::load(&hit.uv[0]), Float8::load(&hit.uv[1]));
+    // Without a branch per lane (a lane without a hit holds shape 0 or the shape of an earlier hit in it
+    // (`Scene::surfaces_into`): a valid index either way, and an out-of-range one would read as no class).
+    let class: [u32; W] = std::array::from_fn(|l| {
+        let c = scene.material_class.get(hit.shape[l] as usize).copied().unwrap_or(u32::MAX);
+        if p.live & (1 << l) != 0 {
+            c
+        } else {
+            u32::MAX
+        }
+    });
+    for (first, same) in groups(p.live, |l| p.live & lanes_where(|k| class[k] == class[l])) {
+        let material = &scene.materials[hit.shape[first] as usize];
+        if let Some(r) = material.diffuse_reflectance_lanes(u, v) {
+            let m = Mask8::from_bitmask(same);
+            rho = std::array::from_fn(|c| Float8::select(m, r[c], rho[c]));
+            diffuse |= same;
+            continue;
+        }
+        for lane in bits(same) {
+            let uv = Vec2::new(hit.uv[0][lane], hit.uv[1][lane]);
+            match material.diffuse_reflectance(uv) {
+                Some(r) => {
+                    rho_rows.set_rgb(lane, r);
+                    diffuse_rows |= 1 << lane;
+                }
+                None => models[lane] = Some(material.at(uv)),
+            }
+        }
+    }
+    if diffuse_rows != 0 {
+        let (m, r) = (Mask8::from_bitmask(diffuse_rows), load_rgb(&rho_rows));
+        rho = std::array::from_fn(|c| Float8::select(m, r[c], rho[c]));
+        diffuse |= diffuse_rows;
+    }
+    // The other lanes grouped by model instance (lanes on one shape share their material's model; a
+    // textured material's model is its own lane's): each group calls its model once, in lanes
+    // (`Bsdf::f_lanes_where` and friends: the model's kernel, or its single calls lane by lane).
+    let (mut groups_of, mut n_groups) = ([(0u32, 0usize); W], 0usize);
+    let mut grouped = 0u32;
+    for lane in bits(p.live & !diffuse) {
+        if grouped & (1 << lane) != 0 {
+            continue;
+        }
+        let same = match models[lane] {
+            Some(Cow::Borrowed(model)) => bits(p.live & !diffuse & !grouped)
+                .filter(|&l| matches!(models[l], Some(Cow::Borrowed(m)) if std::ptr::eq(m, model)))
+                .fold(0u32, |m, l| m | 1 << l),
+            _ => 1 << lane,
+        };
+        groups_of[n_groups] = (same, lane);
+        n_groups += 1;
+        grouped |= same;
+    }
+    let frame = (hit.s.lanes(), hit.t.lanes(), hit.ns.lanes());
+    let wo = to_local(frame.0, frame.1, frame.2, p.d.lanes().neg());
+    // The lanes whose model has a smooth component: next-event estimation serves them.
+    let smooth = diffuse
+        | bits(p.live & !diffuse).fold(0, |m, lane| m | (u32::from(models[lane].as_ref().is_some_and(|b| b.flags().has_smooth())) << lane));
+    Shading { rho, diffuse, smooth, models, groups: groups_of, n_groups, frame, wo }
+}
+
+/// Next-event estimation on the lanes whose model has a smooth component: `light_samples` times, a light
+/// chosen (`LightSelection::sample`) and sampled, its contribution weighted against the BSDF samples by the
+/// power heuristic.
+#[inline(always)]
+fn next_event(scene: &Scene, p: &mut Packet, hit: &Surfaces8, sh: &Shading<'_>, settings: Settings) {
+    let (smooth, n, n_lights) = (sh.smooth, settings.light_samples, scene.lights.len());
+    // The lanes whose light choice at this vertex (the `from` of the rays sampled next) is kept.
+    p.sums_at = if n_lights > 0 && n > 0 { smooth } else { 0 };
+    if smooth == 0 || n == 0 {
+        return;
+    }
+    let beta = load_rgb(&p.beta);
+    if n_lights == 0 {
+        // No light: L += β · 0, as a path traced alone does.
+        let (mut l, smooth) = (load_rgb(&p.l), Mask8::from_bitmask(smooth));
+        for c in 0..3 {
+            l[c] = Float8::select(smooth, l[c] + beta[c] * Float8::splat(0.0), l[c]);
+        }
+        store_rgb(&mut p.l, l);
+        return;
+    }
+    for _ in 0..n {
+        light_sample(scene, p, hit, sh, settings, beta);
+    }
+}
+
+/// The light samples of a packet's lanes as the lights draw them: direction, radiance arriving (before
+/// the samples' scale, such as a point light's 1/d²), solid-angle density and shadow ray, in the lanes of
+/// `sampled` (`delta` those from a delta light).
+#[derive(Default)]
+struct LightSamples {
+    wi: Rows3,
+    li: Rows3,
+    pdf: [f32; W],
+    shadow: RayRows,
+    sampled: u32,
+    delta: u32,
+}
+
+impl LightSamples {
+    /// Lanes `m` receive radiance `li`.
+    #[inline(always)]
+    fn set_li(&mut self, m: Mask8, li: V3<Float8>) {
+        self.li.store(V3::select(m, li, self.li.lanes()));
+    }
+
+    /// Lanes `ok` have a sample: direction `wi` of density `pdf`, tested along `shadow`.
+    #[inline(always)]
+    fn accept(&mut self, ok: Mask8, wi: V3<Float8>, pdf: Float8, shadow: &RayLanes<Float8>) {
+        self.wi.store(V3::select(ok, wi, self.wi.lanes()));
+        self.pdf = Float8::select(ok, pdf, Float8::load(&self.pdf)).to_array();
+        self.shadow.merge(ok, shadow);
+        self.sampled |= ok.bitmask();
+    }
+
+    /// Lane `lane` has the sample `ls`, drawn by its light alone.
+    #[inline(always)]
+    fn set(&mut self, lane: usize, ls: &LightSample) {
+        self.wi.set(lane, ls.wi);
+        self.li.set_rgb(lane, ls.li);
+        self.pdf[lane] = ls.pdf;
+        self.delta |= u32::from(ls.delta) << lane;
+        self.shadow.set(lane, &ls.shadow);
+        self.sampled |= 1 << lane;
+    }
+}
+
+/// One light sample of [`next_event`] for each lane of `sh.smooth`: L += β · f · Lᵢ · |cos θi| · w /
+/// (p_light · light_samples).
+#[inline(always)]
+fn light_sample(scene: &Scene, p: &mut Packet, hit: &Surfaces8, sh: &Shading<'_>, settings: Settings, beta: [Float8; 3]) {
+    let smooth = sh.smooth;
+    // The light, chosen per lane. For an area light on a flat mesh (the common case) the triangle, and
+    // the point on it in lanes; environments, point lights and spheres in lanes; other lights in full
+    // per lane.
+    let mut drawn = LightSamples::default();
+    let (mut tri, mut tri_n, mut tri_ns, mut pdf_area) = ([Rows3::default(); 3], Rows3::default(), Rows3::default(), Float8::splat(0.0));
+    let mut on_mesh = 0u32;
+    let (mut sph_center, mut sph_radius, mut sph_inward, mut on_sphere) = (Rows3::default(), Float8::splat(1.0), 0u32, 0u32);
+    let (mut pt_position, mut on_point) = (Rows3::default(), 0u32);
+    let u_light = p.rng.next_f32(smooth);
+    let (u_c, u_x, u_y) = (p.rng.next_f32(smooth), p.rng.next_f32(smooth), p.rng.next_f32(smooth));
+    // The light of each lane and the probability of its choice (`LightSelection::sample`).
+    let (u_light, mut chosen, mut pmf) = (u_light.to_array(), [0.0f32; W], [1.0f32; W]);
+    for lane in bits(smooth) {
+        let (index, q, sums) = scene.light_selection.sample(&scene.lights, hit.p.get(lane), u_light[lane]);
+        (chosen[lane], pmf[lane], p.sums[lane]) = (index as f32, q, sums);
+    }
+    let chosen_lanes = Float8::load(&chosen);
+    // The lanes that chose the same light, in lanes where it is an environment (constant or a map:
+    // `ConstantLight::sample_li`, `EnvMap::sample_lanes`; the surfaces' normals are never zero), a
+    // point light or a sphere (their positions, centres and radii gathered, then `point_source_lanes`
+    // and `sample_sphere_from` for all of them at once) or a small flat mesh (a `rectangle` light, say:
+    // its triangles chosen and loaded in lanes).
+    let (sp, sn) = (hit.p.lanes(), hit.n.lanes());
+    let mut rest = smooth;
+    for (first, same) in groups(smooth, |l| chosen_lanes.eq(Float8::splat(chosen[l])).bitmask()) {
+        let index = chosen[first] as usize;
+        let m = Mask8::from_bitmask(same);
+        if let Light::Constant(constant) = &scene.lights[index] {
+            if !constant.radiance.is_black() {
+                let dir = uniform_sphere(u_x, u_y);
+                let ray = RayLanes { o: offset_origin_lanes(sp, sn, dir), d: dir, tmax: Float8::splat(f32::INFINITY) };
+                drawn.set_li(m, V3::splat(Vec3::from_array(constant.radiance.0)));
+                drawn.accept(m, dir, Float8::splat(constant.pdf_li(Vec3::Z)), &ray);
+            }
+            rest &= !same;
+            continue;
+        }
+        if let Light::EnvMap(env) = &scene.lights[index] {
+            // `EnvMap::sample_li` in lanes (the surfaces' normals are never zero), where the sample
+            // carries light.
+            let s = env.sample_lanes(u_c, u_x, u_y, same);
+            let zero = Float8::splat(0.0);
+            let ok = s.valid & m & (s.li[0].ne(zero) | s.li[1].ne(zero) | s.li[2].ne(zero));
+            let ray = RayLanes { o: offset_origin_lanes(sp, sn, s.wi), d: s.wi, tmax: Float8::splat(f32::INFINITY) };
+            drawn.set_li(ok, V3::new(s.li[0], s.li[1], s.li[2]));
+            drawn.accept(ok, s.wi, s.pdf, &ray);
+            rest &= !same;
+            continue;
+        }
+        if let Light::Point(point) = &scene.lights[index] {
+            if !point.intensity.is_black() {
+                pt_position.store(V3::select(m, V3::splat(point.position), pt_position.lanes()));
+                drawn.set_li(m, V3::splat(Vec3::from_array(point.intensity.0)));
+                on_point |= same;
+            }
+            rest &= !same;
+            continue;
+        }
+        if let Light::Area(area) = &scene.lights[index] {
+            if let Shape::Sphere(sphere) = &scene.shapes[area.shape as usize] {
+                if !area.radiance.is_black() {
+                    sph_center.store(V3::select(m, V3::splat(sphere.center), sph_center.lanes()));
+                    sph_radius = Float8::select(m, Float8::splat(sphere.radius), sph_radius);
+                    sph_inward |= if sphere.flip_normals { same } else { 0 };
+                    drawn.set_li(m, V3::splat(Vec3::from_array(area.radiance.0)));
+                    on_sphere |= same;
+                }
+                rest &= !same;
+                continue;
+            }
+        }
+        let (Light::Area(area), Some(tris)) = (&scene.lights[index], &scene.light_triangles[index]) else {
+            continue;
+        };
+        let (vertices, ng, ns) = tris.sample(u_c);
+        for (rows, v) in tri.iter_mut().zip(vertices) {
+            rows.store(V3::select(m, v, rows.lanes()));
+        }
+        tri_n.store(V3::select(m, ng, tri_n.lanes()));
+        tri_ns.store(V3::select(m, ns, tri_ns.lanes()));
+        pdf_area = Float8::select(m, Float8::splat(tris.density), pdf_area);
+        drawn.set_li(m, V3::splat(Vec3::from_array(area.radiance.0)));
+        on_mesh |= same;
+        rest &= !same;
+    }
+    let (uc_rows, ux_rows, uy_rows) = (u_c.to_array(), u_x.to_array(), u_y.to_array());
+    for lane in bits(rest) {
+        let index = chosen[lane] as usize;
+        let (uc, u) = (uc_rows[lane], Vec2::new(ux_rows[lane], uy_rows[lane]));
+        let light = &scene.lights[index];
+        if let Light::Area(area) = light {
+            if let Shape::Mesh(mesh) = &scene.shapes[area.shape as usize] {
+                if let Some((vertices, ng, ns, density)) = mesh.sample_flat_triangle(uc) {
+                    if !area.radiance.is_black() {
+                        for (rows, v) in tri.iter_mut().zip(vertices) {
+                            rows.set(lane, v);
+                        }
+                        tri_n.set(lane, ng);
+                        tri_ns.set(lane, ns);
+                        pdf_area = Float8::select(Mask8::from_bitmask(1 << lane), Float8::splat(density), pdf_area);
+                        drawn.li.set_rgb(lane, area.radiance);
+                        on_mesh |= 1 << lane;
+                    }
+                    continue;
+                }
+            }
+        }
+        let Some(ls) = light.sample_li(&scene.shapes, hit.p.get(lane), hit.n.get(lane), uc, u) else { continue };
+        if !(ls.pdf > 0.0) || ls.li.is_black() {
+            continue;
+        }
+        drawn.set(lane, &ls);
+    }
+    if on_point != 0 {
+        // `PointLight::sample_li` in lanes, each lane with its light: a delta sample.
+        let (dir, inv_dist2, valid, ray) = point_source_lanes(pt_position.lanes(), sp, sn);
+        let ok = valid & Mask8::from_bitmask(on_point);
+        drawn.set_li(ok, drawn.li.lanes().scale(inv_dist2));
+        drawn.accept(ok, dir, Float8::splat(1.0), &ray);
+        drawn.delta |= ok.bitmask();
+    }
+    if on_sphere != 0 {
+        // `AreaLight::sample_li` on spheres, in lanes, each lane with its sphere.
+        let inward = Mask8::from_bitmask(sph_inward);
+        let (q, n, pdf, valid) = sample_sphere_from(sph_center.lanes(), sph_radius, inward, sp, u_x, u_y);
+        let (dir, facing) = towards(sp, q, n, pdf);
+        let ok = valid & facing & Mask8::from_bitmask(on_sphere);
+        let ray = spawn_ray_to_lanes(sp, sn, q, n);
+        drawn.accept(ok, dir, pdf, &ray);
+    }
+    if on_mesh != 0 {
+        // `AreaLight::sample_li` on a flat mesh, in lanes.
+        let q = uniform_triangle_point(tri[0].lanes(), tri[1].lanes(), tri[2].lanes(), u_x, u_y);
+        let ng = tri_n.lanes();
+        let (pdf, by_area) = solid_angle_density(sp, q, ng, pdf_area);
+        // Emission faces the shading normal (a mesh file's flat normals may oppose its winding).
+        let (dir, facing) = towards(sp, q, tri_ns.lanes(), pdf);
+        let ray = spawn_ray_to_lanes(sp, sn, q, ng);
+        let ok = by_area & facing & Mask8::from_bitmask(on_mesh);
+        drawn.accept(ok, dir, pdf, &ray);
+    }
+    let LightSamples { wi, li, pdf: mut light_pdf, shadow, sampled, delta } = drawn;
+    for (v, p) in light_pdf.iter_mut().zip(pmf) {
+        *v *= p;
+    }
+    let wi_local = sh.to_local(wi.lanes());
+    // f and the BSDF's density: in lanes for diffuse surfaces, by the model for the others.
+    let (rho, wo) = (sh.rho, sh.wo);
+    let mut f = diffuse_f(rho, wo, wi_local);
+    let mut bsdf_pdf = diffuse_pdf(wo, wi_local);
+    for &(lanes, first) in sh.groups() {
+        let lanes = lanes & sampled;
+        if lanes == 0 {
+            continue;
+        }
+        let m = Mask8::from_bitmask(lanes);
+        let model = sh.model(first);
+        let fk = f_where(model, wo, wi_local, m);
+        for c in 0..3 {
+            f[c] = Float8::select(m, fk[c], f[c]);
+        }
+        let pdf = Float8::select(Mask8::from_bitmask(delta), Float8::splat(0.0), pdf_where(model, wo, wi_local, m));
+        bsdf_pdf = Float8::select(m, pdf, bsdf_pdf);
+    }
+    // Shadow rays where the sample carries light.
+    let nonzero = (f[0].ne(Float8::splat(0.0)) | f[1].ne(Float8::splat(0.0)) | f[2].ne(Float8::splat(0.0))).bitmask();
+    let tested = sampled & nonzero;
+    let rays = RayLanes { o: shadow.o.lanes(), d: shadow.d.lanes(), tmax: Float8::load(&shadow.tmax) };
+    let visible = tested & !scene.occluded_rays(&rays, tested);
+    // L += β · f · Lᵢ · |cos θi| · w / (p_light · n), or β · 0 where the sample carries nothing (as a path
+    // traced alone adds it: a non-finite β spoils the sample either way); w is 1 for a delta light and
+    // without BSDF samples.
+    let light_pdf = Float8::load(&light_pdf);
+    let (n_light, n_bsdf) = (settings.light_samples as f32, settings.bsdf_samples as f32);
+    let w = power_heuristic_lanes(Float8::splat(n_light), light_pdf, Float8::splat(n_bsdf), bsdf_pdf);
+    let unweighted = delta | if n_bsdf == 0.0 { smooth } else { 0 };
+    let w = Float8::select(Mask8::from_bitmask(unweighted), Float8::splat(1.0), w);
+    let scale = wi_local.z.abs() * w / light_pdf;
+    let li = load_rgb(&li);
+    let mut l = load_rgb(&p.l);
+    let (visible, smooth) = (Mask8::from_bitmask(visible), Mask8::from_bitmask(smooth));
+    for c in 0..3 {
+        let ne = Float8::select(visible, f[c] * li[c] * scale, Float8::splat(0.0));
+        let ne = if n_light == 1.0 { ne } else { ne / Float8::splat(n_light) };
+        l[c] = Float8::select(smooth, l[c] + beta[c] * ne, l[c]);
+    }
+    store_rgb(&mut p.l, l);
+}
+
+/// BSDF sampling at the packet's surfaces: in lanes for diffuse surfaces, by the model for the others. Each
+/// live lane's next ray is set, with how it was sampled (for weighting the emitter it finds) and the
+/// accumulated relative index of refraction η. Returns the lanes with a sample, the samples' weights
+/// f · |cos θi| / p and η.
+#[inline(always)]
+fn sample_bsdf(p: &mut Packet, hit: &Surfaces8, sh: &Shading<'_>) -> (u32, [Float8; 3], Float8) {
+    let (uc, ux, uy) = (p.rng.next_f32(p.live), p.rng.next_f32(p.live), p.rng.next_f32(p.live));
+    let (diffuse, wo) = (sh.diffuse, sh.wo);
+    let ds = diffuse_sample(sh.rho, wo, ux, uy);
+    let mut valid = ds.valid.bitmask() & diffuse;
+    let (mut s_wi, mut s_pdf, mut s_eta, mut s_weight) = (ds.wi, ds.pdf, ds.eta, ds.weight);
+    let mut s_delta = 0u32;
+    for &(lanes, first) in sh.groups() {
+        let m = Mask8::from_bitmask(lanes);
+        let s = sample_where(sh.model(first), wo, uc, ux, uy, m);
+        s_wi = V3::select(m, s.wi, s_wi);
+        for (w, k) in s_weight.iter_mut().zip(s.weight) {
+            *w = Float8::select(m, k, *w);
+        }
+        (s_pdf, s_eta) = (Float8::select(m, s.pdf, s_pdf), Float8::select(m, s.eta, s_eta));
+        valid |= (s.valid & m).bitmask();
+        s_delta |= (s.is_delta() & m).bitmask();
+    }
+    let eta = Float8::load(&p.eta) * s_eta;
+    let wi = to_world(sh.frame.0, sh.frame.1, sh.frame.2, s_wi);
+    let sp = hit.p.lanes();
+    p.o.store(offset_origin_lanes(sp, hit.n.lanes(), wi));
+    p.d.store(wi);
+    p.tmax = [f32::INFINITY; W];
+    p.from.store(sp);
+    p.pdf = s_pdf.to_array();
+    p.eta = eta.to_array();
+    p.delta = s_delta;
+    (valid, s_weight, eta)
 }
 
 /// The radiance of each camera sample (`out[i]` for `samples[i]`), eight paths at a time.
 pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [Rgb], settings: Settings) {
-    let Settings { max_depth, rr_depth, .. } = settings;
+    let Settings { max_depth, rr_depth, bsdf_samples, .. } = settings;
     if max_depth == 0 {
         out.fill(Rgb::ZERO);
         return;
     }
-    let n_lights = scene.lights.len();
     let mut p = Packet::new();
-    let mut hit = Surfaces8::default();
+    // The surfaces the packet shades, and those the `direct` integrator's several BSDF samples find.
+    let (mut hit, mut found) = (Surfaces8::default(), Surfaces8::default());
     let mut next = 0;
     loop {
         // Trace until enough lanes hold a surface to shade (`MIN_READY`) or the samples run out: lanes
@@ -353,7 +758,9 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
             if pending == 0 {
                 break;
             }
-            trace(scene, &mut p, pending, &mut hit, out, settings);
+            for lane in bits(trace(scene, &mut p, pending, &mut hit, settings, 1.0)) {
+                p.finish(lane, out);
+            }
             pending = 0;
             if p.live.count_ones() >= MIN_READY || next == samples.len() {
                 break;
@@ -363,327 +770,35 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
             return;
         }
 
-        // The materials: diffuse ones are evaluated in lanes, the others by their model. The lanes on one
-        // shape, or on shapes of one constant reflectance (`Scene::material_class`), share their material:
-        // a constant or checkerboard reflectance is found for them together, other materials lane by lane.
-        let (mut rho, mut rho_rows, mut diffuse, mut diffuse_rows) = ([Float8::splat(0.0); 3], Rows3::default(), 0u32, 0u32);
-        let mut models: [Option<Cow<'_, Bsdf>>; W] = Default::default();
-        let (u, v) = (Float8::load(&hit.uv[0]), Float8::load(&hit.uv[1]));
-        // Without a branch per lane (a lane without a hit holds shape 0 or the shape of an earlier hit in it
-        // (`Scene::surfaces_into`): a valid index either way, and an out-of-range one would read as no class).
-        let class: [u32; W] = std::array::from_fn(|l| {
-            let c = scene.material_class.get(hit.shape[l] as usize).copied().unwrap_or(u32::MAX);
-            if p.live & (1 << l) != 0 {
-                c
-            } else {
-                u32::MAX
+        let sh = shading(scene, &p, &hit);
+        next_event(scene, &mut p, &hit, &sh, settings);
+        if bsdf_samples != 1 {
+            // The `direct` integrator's BSDF samples, other than one: each is traced here for the emission
+            // it finds, and the paths end (max_depth 2).
+            debug_assert_eq!(max_depth, 2, "several BSDF samples at a vertex end the path there");
+            for (i, depth) in p.depth.iter_mut().enumerate() {
+                *depth += (p.live >> i & 1) as i32;
             }
-        });
-        for (first, same) in groups(p.live, |l| p.live & lanes_where(|k| class[k] == class[l])) {
-            let material = &scene.materials[hit.shape[first] as usize];
-            if let Some(r) = material.diffuse_reflectance_lanes(u, v) {
-                let m = Mask8::from_bitmask(same);
-                rho = std::array::from_fn(|c| Float8::select(m, r[c], rho[c]));
-                diffuse |= same;
-                continue;
+            let beta = load_rgb(&p.beta);
+            for _ in 0..bsdf_samples {
+                let (valid, weight, _) = sample_bsdf(&mut p, &hit, &sh);
+                store_rgb(&mut p.beta, std::array::from_fn(|c| beta[c] * weight[c]));
+                let traced = p.live & valid;
+                trace(scene, &mut p, traced, &mut found, settings, bsdf_samples as f32);
             }
-            for lane in bits(same) {
-                let uv = Vec2::new(hit.uv[0][lane], hit.uv[1][lane]);
-                match material.diffuse_reflectance(uv) {
-                    Some(r) => {
-                        rho_rows.set_rgb(lane, r);
-                        diffuse_rows |= 1 << lane;
-                    }
-                    None => models[lane] = Some(material.at(uv)),
-                }
+            for lane in bits(p.live) {
+                p.finish(lane, out);
             }
+            continue;
         }
-        if diffuse_rows != 0 {
-            let (m, r) = (Mask8::from_bitmask(diffuse_rows), load_rgb(&rho_rows));
-            rho = std::array::from_fn(|c| Float8::select(m, r[c], rho[c]));
-            diffuse |= diffuse_rows;
-        }
-        // The other lanes grouped by model instance (lanes on one shape share their material's model; a
-        // textured material's model is its own lane's): each group calls its model once, in lanes
-        // (`Bsdf::f_lanes_where` and friends: the model's kernel, or its single calls lane by lane).
-        let (mut groups_of, mut n_groups) = ([(0u32, 0usize); W], 0usize);
-        let mut grouped = 0u32;
-        for lane in bits(p.live & !diffuse) {
-            if grouped & (1 << lane) != 0 {
-                continue;
-            }
-            let same = match models[lane] {
-                Some(Cow::Borrowed(model)) => bits(p.live & !diffuse & !grouped)
-                    .filter(|&l| matches!(models[l], Some(Cow::Borrowed(m)) if std::ptr::eq(m, model)))
-                    .fold(0u32, |m, l| m | 1 << l),
-                _ => 1 << lane,
-            };
-            groups_of[n_groups] = (same, lane);
-            n_groups += 1;
-            grouped |= same;
-        }
-        let groups_of = &groups_of[..n_groups];
-        let model_of = |lane: usize| models[lane].as_deref().expect("a model for every non-diffuse lane");
-        let (fs, ft, fn_) = (hit.s.lanes(), hit.t.lanes(), hit.ns.lanes());
-        let wo = to_local(fs, ft, fn_, p.d.lanes().neg());
-        let mut beta = load_rgb(&p.beta);
-
-        // Next-event estimation (on lanes whose model has a smooth component): a light chosen uniformly and
-        // sampled, its contribution weighted against BSDF sampling by the power heuristic.
-        let smooth = diffuse
-            | bits(p.live & !diffuse)
-                .fold(0, |m, lane| m | (u32::from(models[lane].as_ref().is_some_and(|b| b.flags().has_smooth())) << lane));
-        // The lanes whose light choice at this vertex (the `from` of the rays sampled below) is kept.
-        p.sums_at = if n_lights > 0 { smooth } else { 0 };
-        if n_lights > 0 && smooth != 0 {
-            // The light, chosen per lane. For an area light on a flat mesh (the common case) the triangle, and
-            // the point on it in lanes; environments, point lights and spheres in lanes; other lights in full
-            // per lane.
-            let (mut wi, mut li, mut light_pdf) = (Rows3::default(), Rows3::default(), [0.0f32; W]);
-            let (mut tri, mut tri_n, mut tri_ns, mut pdf_area) =
-                ([Rows3::default(); 3], Rows3::default(), Rows3::default(), Float8::splat(0.0));
-            let (mut sampled, mut on_mesh, mut delta) = (0u32, 0u32, 0u32);
-            let (mut sph_center, mut sph_radius, mut sph_inward, mut on_sphere) = (Rows3::default(), Float8::splat(1.0), 0u32, 0u32);
-            let (mut pt_position, mut on_point) = (Rows3::default(), 0u32);
-            let mut shadow = RayRows::default();
-            let u_light = p.rng.next_f32(smooth);
-            let (u_c, u_x, u_y) = (p.rng.next_f32(smooth), p.rng.next_f32(smooth), p.rng.next_f32(smooth));
-            // The light of each lane and the probability of its choice (`LightSelection::sample`).
-            let (u_light, mut chosen, mut pmf) = (u_light.to_array(), [0.0f32; W], [1.0f32; W]);
-            for lane in bits(smooth) {
-                let (index, q, sums) = scene.light_selection.sample(&scene.lights, hit.p.get(lane), u_light[lane]);
-                (chosen[lane], pmf[lane], p.sums[lane]) = (index as f32, q, sums);
-            }
-            let chosen_lanes = Float8::load(&chosen);
-            // The lanes that chose the same light, in lanes where it is an environment (constant or a map:
-            // `ConstantLight::sample_li`, `EnvMap::sample_lanes`; the surfaces' normals are never zero), a
-            // point light or a sphere (their positions, centres and radii gathered, then `point_source_lanes`
-            // and `sample_sphere_from` for all of them at once) or a small flat mesh (a `rectangle` light, say:
-            // its triangles chosen and loaded in lanes).
-            let (sp, sn) = (hit.p.lanes(), hit.n.lanes());
-            let mut rest = smooth;
-            for (first, same) in groups(smooth, |l| chosen_lanes.eq(Float8::splat(chosen[l])).bitmask()) {
-                let index = chosen[first] as usize;
-                let m = Mask8::from_bitmask(same);
-                if let Light::Constant(constant) = &scene.lights[index] {
-                    if !constant.radiance.is_black() {
-                        let dir = uniform_sphere(u_x, u_y);
-                        let ray = RayLanes { o: offset_origin_lanes(sp, sn, dir), d: dir, tmax: Float8::splat(f32::INFINITY) };
-                        li.store(V3::select(m, V3::splat(Vec3::from_array(constant.radiance.0)), li.lanes()));
-                        wi.store(V3::select(m, dir, wi.lanes()));
-                        light_pdf = Float8::select(m, Float8::splat(constant.pdf_li(Vec3::Z)), Float8::load(&light_pdf)).to_array();
-                        shadow.merge(m, &ray);
-                        sampled |= same;
-                    }
-                    rest &= !same;
-                    continue;
-                }
-                if let Light::EnvMap(env) = &scene.lights[index] {
-                    // `EnvMap::sample_li` in lanes (the surfaces' normals are never zero), where the sample
-                    // carries light.
-                    let s = env.sample_lanes(u_c, u_x, u_y, same);
-                    let zero = Float8::splat(0.0);
-                    let ok = s.valid & m & (s.li[0].ne(zero) | s.li[1].ne(zero) | s.li[2].ne(zero));
-                    let ray = RayLanes { o: offset_origin_lanes(sp, sn, s.wi), d: s.wi, tmax: Float8::splat(f32::INFINITY) };
-                    li.store(V3::select(ok, V3::new(s.li[0], s.li[1], s.li[2]), li.lanes()));
-                    wi.store(V3::select(ok, s.wi, wi.lanes()));
-                    light_pdf = Float8::select(ok, s.pdf, Float8::load(&light_pdf)).to_array();
-                    shadow.merge(ok, &ray);
-                    sampled |= ok.bitmask();
-                    rest &= !same;
-                    continue;
-                }
-                if let Light::Point(point) = &scene.lights[index] {
-                    if !point.intensity.is_black() {
-                        pt_position.store(V3::select(m, V3::splat(point.position), pt_position.lanes()));
-                        li.store(V3::select(m, V3::splat(Vec3::from_array(point.intensity.0)), li.lanes()));
-                        on_point |= same;
-                    }
-                    rest &= !same;
-                    continue;
-                }
-                if let Light::Area(area) = &scene.lights[index] {
-                    if let Shape::Sphere(sphere) = &scene.shapes[area.shape as usize] {
-                        if !area.radiance.is_black() {
-                            sph_center.store(V3::select(m, V3::splat(sphere.center), sph_center.lanes()));
-                            sph_radius = Float8::select(m, Float8::splat(sphere.radius), sph_radius);
-                            sph_inward |= if sphere.flip_normals { same } else { 0 };
-                            li.store(V3::select(m, V3::splat(Vec3::from_array(area.radiance.0)), li.lanes()));
-                            on_sphere |= same;
-                        }
-                        rest &= !same;
-                        continue;
-                    }
-                }
-                let (Light::Area(area), Some(tris)) = (&scene.lights[index], &scene.light_triangles[index]) else {
-                    continue;
-                };
-                let (vertices, ng, ns) = tris.sample(u_c);
-                for (rows, v) in tri.iter_mut().zip(vertices) {
-                    rows.store(V3::select(m, v, rows.lanes()));
-                }
-                tri_n.store(V3::select(m, ng, tri_n.lanes()));
-                tri_ns.store(V3::select(m, ns, tri_ns.lanes()));
-                pdf_area = Float8::select(m, Float8::splat(tris.density), pdf_area);
-                li.store(V3::select(m, V3::splat(Vec3::from_array(area.radiance.0)), li.lanes()));
-                on_mesh |= same;
-                rest &= !same;
-            }
-            let (uc_rows, ux_rows, uy_rows) = (u_c.to_array(), u_x.to_array(), u_y.to_array());
-            for lane in bits(rest) {
-                let index = chosen[lane] as usize;
-                let (uc, u) = (uc_rows[lane], Vec2::new(ux_rows[lane], uy_rows[lane]));
-                let light = &scene.lights[index];
-                if let Light::Area(area) = light {
-                    if let Shape::Mesh(mesh) = &scene.shapes[area.shape as usize] {
-                        if let Some((vertices, ng, ns, density)) = mesh.sample_flat_triangle(uc) {
-                            if !area.radiance.is_black() {
-                                for (rows, v) in tri.iter_mut().zip(vertices) {
-                                    rows.set(lane, v);
-                                }
-                                tri_n.set(lane, ng);
-                                tri_ns.set(lane, ns);
-                                pdf_area = Float8::select(Mask8::from_bitmask(1 << lane), Float8::splat(density), pdf_area);
-                                li.set_rgb(lane, area.radiance);
-                                on_mesh |= 1 << lane;
-                            }
-                            continue;
-                        }
-                    }
-                }
-                let Some(ls) = light.sample_li(&scene.shapes, hit.p.get(lane), hit.n.get(lane), uc, u) else { continue };
-                if !(ls.pdf > 0.0) || ls.li.is_black() {
-                    continue;
-                }
-                wi.set(lane, ls.wi);
-                li.set_rgb(lane, ls.li);
-                light_pdf[lane] = ls.pdf;
-                delta |= u32::from(ls.delta) << lane;
-                shadow.set(lane, &ls.shadow);
-                sampled |= 1 << lane;
-            }
-            if on_point != 0 {
-                // `PointLight::sample_li` in lanes, each lane with its light: a delta sample.
-                let (dir, inv_dist2, valid, ray) = point_source_lanes(pt_position.lanes(), sp, sn);
-                let ok = valid & Mask8::from_bitmask(on_point);
-                li.store(V3::select(ok, li.lanes().scale(inv_dist2), li.lanes()));
-                wi.store(V3::select(ok, dir, wi.lanes()));
-                light_pdf = Float8::select(ok, Float8::splat(1.0), Float8::load(&light_pdf)).to_array();
-                shadow.merge(ok, &ray);
-                sampled |= ok.bitmask();
-                delta |= ok.bitmask();
-            }
-            if on_sphere != 0 {
-                // `AreaLight::sample_li` on spheres, in lanes, each lane with its sphere.
-                let inward = Mask8::from_bitmask(sph_inward);
-                let (q, n, pdf, valid) = sample_sphere_from(sph_center.lanes(), sph_radius, inward, sp, u_x, u_y);
-                let (dir, facing) = towards(sp, q, n, pdf);
-                let ok = valid & facing & Mask8::from_bitmask(on_sphere);
-                let ray = spawn_ray_to_lanes(sp, sn, q, n);
-                wi.store(V3::select(ok, dir, wi.lanes()));
-                light_pdf = Float8::select(ok, pdf, Float8::load(&light_pdf)).to_array();
-                shadow.merge(ok, &ray);
-                sampled |= ok.bitmask();
-            }
-            if on_mesh != 0 {
-                // `AreaLight::sample_li` on a flat mesh, in lanes.
-                let q = uniform_triangle_point(tri[0].lanes(), tri[1].lanes(), tri[2].lanes(), u_x, u_y);
-                let ng = tri_n.lanes();
-                let (pdf, by_area) = solid_angle_density(sp, q, ng, pdf_area);
-                // Emission faces the shading normal (a mesh file's flat normals may oppose its winding).
-                let (dir, facing) = towards(sp, q, tri_ns.lanes(), pdf);
-                let ray = spawn_ray_to_lanes(sp, sn, q, ng);
-                let ok = by_area & facing & Mask8::from_bitmask(on_mesh);
-                let m = ok.bitmask();
-                let (mut w, mut pdfs) = (wi.lanes(), Float8::load(&light_pdf));
-                w = V3::select(ok, dir, w);
-                pdfs = Float8::select(ok, pdf, pdfs);
-                wi.store(w);
-                light_pdf = pdfs.to_array();
-                shadow.merge(ok, &ray);
-                sampled |= m;
-            }
-            for (v, p) in light_pdf.iter_mut().zip(pmf) {
-                *v *= p;
-            }
-            let wi_local = to_local(fs, ft, fn_, wi.lanes());
-            // f and the BSDF's density: in lanes for diffuse surfaces, by the model for the others.
-            let mut f = diffuse_f(rho, wo, wi_local);
-            let mut bsdf_pdf = diffuse_pdf(wo, wi_local);
-            for &(lanes, first) in groups_of {
-                let lanes = lanes & sampled;
-                if lanes == 0 {
-                    continue;
-                }
-                let m = Mask8::from_bitmask(lanes);
-                let model = model_of(first);
-                let fk = f_where(model, wo, wi_local, m);
-                for c in 0..3 {
-                    f[c] = Float8::select(m, fk[c], f[c]);
-                }
-                let pdf = Float8::select(Mask8::from_bitmask(delta), Float8::splat(0.0), pdf_where(model, wo, wi_local, m));
-                bsdf_pdf = Float8::select(m, pdf, bsdf_pdf);
-            }
-            // Shadow rays where the sample carries light.
-            let nonzero = (f[0].ne(Float8::splat(0.0)) | f[1].ne(Float8::splat(0.0)) | f[2].ne(Float8::splat(0.0))).bitmask();
-            let tested = sampled & nonzero;
-            let rays = RayLanes { o: shadow.o.lanes(), d: shadow.d.lanes(), tmax: Float8::load(&shadow.tmax) };
-            let visible = tested & !scene.occluded_rays(&rays, tested);
-            // L += β · f · Lᵢ · |cos θi| · w / p_light, or β · 0 where the sample carries nothing (as a path
-            // traced alone adds it: a non-finite β spoils the sample either way).
-            let light_pdf = Float8::load(&light_pdf);
-            let w = Float8::select(Mask8::from_bitmask(delta), Float8::splat(1.0), power_heuristic_1(light_pdf, bsdf_pdf));
-            let scale = wi_local.z.abs() * w / light_pdf;
-            let li = load_rgb(&li);
-            let mut l = load_rgb(&p.l);
-            let (visible, smooth) = (Mask8::from_bitmask(visible), Mask8::from_bitmask(smooth));
-            for c in 0..3 {
-                let ne = Float8::select(visible, f[c] * li[c] * scale, Float8::splat(0.0));
-                l[c] = Float8::select(smooth, l[c] + beta[c] * ne, l[c]);
-            }
-            store_rgb(&mut p.l, l);
-        } else if smooth != 0 {
-            // No light: L += β · 0, as a path traced alone does.
-            let (mut l, smooth) = (load_rgb(&p.l), Mask8::from_bitmask(smooth));
-            for c in 0..3 {
-                l[c] = Float8::select(smooth, l[c] + beta[c] * Float8::splat(0.0), l[c]);
-            }
-            store_rgb(&mut p.l, l);
-        }
-
-        // BSDF sampling: in lanes for diffuse surfaces, by the model for the others.
-        let (uc, ux, uy) = (p.rng.next_f32(p.live), p.rng.next_f32(p.live), p.rng.next_f32(p.live));
-        let ds = diffuse_sample(rho, wo, ux, uy);
-        let mut valid = ds.valid.bitmask() & diffuse;
-        let (mut s_wi, mut s_pdf, mut s_eta, mut s_weight) = (ds.wi, ds.pdf, ds.eta, ds.weight);
-        let mut s_delta = 0u32;
-        for &(lanes, first) in groups_of {
-            let m = Mask8::from_bitmask(lanes);
-            let s = sample_where(model_of(first), wo, uc, ux, uy, m);
-            s_wi = V3::select(m, s.wi, s_wi);
-            for (w, k) in s_weight.iter_mut().zip(s.weight) {
-                *w = Float8::select(m, k, *w);
-            }
-            (s_pdf, s_eta) = (Float8::select(m, s.pdf, s_pdf), Float8::select(m, s.eta, s_eta));
-            valid |= (s.valid & m).bitmask();
-            s_delta |= (s.is_delta() & m).bitmask();
-        }
+        let (valid, weight, eta) = sample_bsdf(&mut p, &hit, &sh);
         for lane in bits(p.live & !valid) {
             p.finish(lane, out);
         }
+        let mut beta = load_rgb(&p.beta);
         for c in 0..3 {
-            beta[c] = beta[c] * s_weight[c];
+            beta[c] = beta[c] * weight[c];
         }
-        let eta = Float8::load(&p.eta) * s_eta;
-        let wi = to_world(fs, ft, fn_, s_wi);
-        let sp = hit.p.lanes();
-        p.o.store(offset_origin_lanes(sp, hit.n.lanes(), wi));
-        p.d.store(wi);
-        p.tmax = [f32::INFINITY; W];
-        p.from.store(sp);
-        p.pdf = s_pdf.to_array();
-        p.eta = eta.to_array();
-        p.delta = s_delta;
         // Russian roulette.
         let beta_max = beta[0].max(beta[1]).max(beta[2]);
         let q = (beta_max * eta * eta).min(Float8::splat(0.95));

@@ -92,6 +92,7 @@ impl LightSelection {
     }
 
     /// The estimated importance of light `index` at `x` (module docs), ≥ 0 and finite.
+    #[inline]
     fn importance(&self, lights: &[Light], index: usize, x: Vec3) -> f32 {
         let value = match self.estimates[index] {
             Estimate::Distant(e) => e,
@@ -123,6 +124,7 @@ impl LightSelection {
     /// `x`, with which [`Self::pmf_with`] gives the probability of any other light there without
     /// estimating every light again.
     #[must_use]
+    #[inline]
     pub fn sample(&self, lights: &[Light], x: Vec3, u: f32) -> (usize, f32, SelectionSums) {
         let n = lights.len();
         if self.is_uniform() {
@@ -167,6 +169,7 @@ impl LightSelection {
 
     /// Each light's weight at `x` (into `weights`), (1 − s) imp/Σimp + s/n with s = [`UNIFORM_SHARE`] (all
     /// uniform where every importance is 0), and the sums they were made with.
+    #[inline]
     fn weights(&self, lights: &[Light], x: Vec3, weights: &mut [f32; MAX_LIGHTS]) -> SelectionSums {
         let n = self.estimates.len();
         let mut sum = 0.0f32;

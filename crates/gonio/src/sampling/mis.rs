@@ -1,6 +1,8 @@
 //! Multiple importance sampling weights (Veach & Guibas 1995, "Optimally Combining Sampling Techniques
 //! for Monte Carlo Rendering", eq. 8 and the power heuristic with β = 2).
 
+use crate::math::lanes::Real;
+
 /// Balance heuristic weight of technique `f` against `g`: n_f p_f / (n_f p_f + n_g p_g).
 #[inline]
 #[must_use]
@@ -17,14 +19,18 @@ pub fn balance_heuristic(nf: f32, pdf_f: f32, ng: f32, pdf_g: f32) -> f32 {
 #[inline]
 #[must_use]
 pub fn power_heuristic(nf: f32, pdf_f: f32, ng: f32, pdf_g: f32) -> f32 {
+    power_heuristic_lanes(nf, pdf_f, ng, pdf_g)
+}
+
+/// [`power_heuristic`] in lanes: the same operations, so that a lane's weight equals the single call's bit
+/// for bit.
+#[inline(always)]
+#[must_use]
+pub fn power_heuristic_lanes<R: Real>(nf: R, pdf_f: R, ng: R, pdf_g: R) -> R {
     let (f, g) = (nf * pdf_f, ng * pdf_g);
-    if f.is_infinite() {
-        return 1.0;
-    }
-    if f == 0.0 && g == 0.0 {
-        return 0.0;
-    }
-    (f * f) / (f * f + g * g)
+    let (zero, one) = (R::splat(0.0), R::splat(1.0));
+    let w = R::select(f.eq(zero) & g.eq(zero), zero, (f * f) / (f * f + g * g));
+    R::select(f.abs().eq(R::splat(f32::INFINITY)), one, w)
 }
 
 #[cfg(test)]
