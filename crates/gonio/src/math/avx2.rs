@@ -342,6 +342,18 @@ impl Real for Avx8 {
     fn xor_sign(self, o: Self) -> Self {
         Avx8::xor_sign(self, o)
     }
+    #[inline(always)]
+    fn pow2(self) -> Self {
+        let n = avx!(_mm256_add_epi32(_mm256_cvttps_epi32(self.0), _mm256_set1_epi32(127)));
+        Avx8(avx!(_mm256_castsi256_ps(_mm256_slli_epi32::<23>(n))))
+    }
+    #[inline(always)]
+    fn split_exponent(self) -> (Self, Self) {
+        let bits = avx!(_mm256_castps_si256(self.0));
+        let m = avx!(_mm256_or_si256(_mm256_and_si256(bits, _mm256_set1_epi32(0x007f_ffff)), _mm256_set1_epi32(0x3f80_0000)));
+        let e = avx!(_mm256_sub_epi32(_mm256_srli_epi32::<23>(bits), _mm256_set1_epi32(127)));
+        (Avx8(avx!(_mm256_castsi256_ps(m))), Avx8(avx!(_mm256_cvtepi32_ps(e))))
+    }
     /// `minps(self, o)` is self < o ? self : o, the `f32` form's result but where `o` is NaN.
     #[inline(always)]
     fn min(self, o: Self) -> Self {

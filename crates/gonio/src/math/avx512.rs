@@ -202,6 +202,18 @@ impl Real for Avx16 {
         let sign = avx!(_mm512_and_si512(b, _mm512_set1_epi32(i32::MIN)));
         Avx16(avx!(_mm512_castsi512_ps(_mm512_xor_si512(a, sign))))
     }
+    #[inline(always)]
+    fn pow2(self) -> Self {
+        let n = avx!(_mm512_add_epi32(_mm512_cvttps_epi32(self.0), _mm512_set1_epi32(127)));
+        Avx16(avx!(_mm512_castsi512_ps(_mm512_slli_epi32::<23>(n))))
+    }
+    #[inline(always)]
+    fn split_exponent(self) -> (Self, Self) {
+        let bits = avx!(_mm512_castps_si512(self.0));
+        let m = avx!(_mm512_or_si512(_mm512_and_si512(bits, _mm512_set1_epi32(0x007f_ffff)), _mm512_set1_epi32(0x3f80_0000)));
+        let e = avx!(_mm512_sub_epi32(_mm512_srli_epi32::<23>(bits), _mm512_set1_epi32(127)));
+        (Avx16(avx!(_mm512_castsi512_ps(m))), Avx16(avx!(_mm512_cvtepi32_ps(e))))
+    }
     /// `vminps(self, o)` is self < o ? self : o, the `f32` form's result but where `o` is NaN.
     #[inline(always)]
     fn min(self, o: Self) -> Self {

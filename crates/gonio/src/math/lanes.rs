@@ -70,6 +70,12 @@ pub trait Real:
     /// `self` with its sign flipped where `o`'s sign bit is set (−0 and NaNs included): the bits
     /// `self ^ (o & sign)`.
     fn xor_sign(self, o: Self) -> Self;
+    /// 2ⁿ for a whole number n = `self` ∈ [−126, 127]: the float with that exponent and no fraction (the
+    /// bits (n + 127) << 23; other arguments give other bits).
+    fn pow2(self) -> Self;
+    /// (m, e) with `self` = m · 2ᵉ, m ∈ [1, 2) and e whole, for a positive normal `self` (its significand and
+    /// exponent bits; other arguments give other numbers).
+    fn split_exponent(self) -> (Self, Self);
     /// `f(lane)` in every lane: for scalar code (not vectorised, same results).
     fn map(self, f: impl Fn(f32) -> f32) -> Self;
     /// The piecewise-linear function through `table[k]` at k/(N − 1), on [0, 1] (arguments are clamped to
@@ -143,6 +149,15 @@ impl Real for f32 {
     #[inline(always)]
     fn xor_sign(self, o: Self) -> Self {
         f32::from_bits(self.to_bits() ^ (o.to_bits() & 0x8000_0000))
+    }
+    #[inline(always)]
+    fn pow2(self) -> Self {
+        f32::from_bits(((self as i32).wrapping_add(127) as u32) << 23)
+    }
+    #[inline(always)]
+    fn split_exponent(self) -> (Self, Self) {
+        let bits = self.to_bits();
+        (f32::from_bits(bits & 0x007f_ffff | 0x3f80_0000), ((bits >> 23) as i32 - 127) as f32)
     }
     #[inline(always)]
     fn map(self, f: impl Fn(f32) -> f32) -> Self {
@@ -381,6 +396,14 @@ impl Real for F32x8 {
     #[inline(always)]
     fn xor_sign(self, o: Self) -> Self {
         lanes!(F32x8, |i| Real::xor_sign(self.0[i], o.0[i]))
+    }
+    #[inline(always)]
+    fn pow2(self) -> Self {
+        lanes!(F32x8, |i| Real::pow2(self.0[i]))
+    }
+    #[inline(always)]
+    fn split_exponent(self) -> (Self, Self) {
+        (lanes!(F32x8, |i| Real::split_exponent(self.0[i]).0), lanes!(F32x8, |i| Real::split_exponent(self.0[i]).1))
     }
     #[inline(always)]
     fn map(self, f: impl Fn(f32) -> f32) -> Self {
@@ -671,6 +694,22 @@ pub(crate) fn check_lane_type<R: Rows>() {
     };
     const VALUES: [f32; 16] =
         [0.5, -1.5, 0.0, -0.0, f32::INFINITY, f32::NAN, 3.0e-39, 2.5, 2.0, -1.5, -0.0, 0.0, 1.0, 0.5, -7.0, f32::NEG_INFINITY];
+    // `pow2` is the power of two at every whole exponent f32 has as a normal number, and `split_exponent`
+    // takes positive normal numbers apart into exactly that power and a significand in [1, 2).
+    for e in -126..=127 {
+        let p: Vec<f32> = (0..n).map(|i| (e - i as i32).max(-126) as f32).collect();
+        let got = get(R::load(&p).pow2());
+        for i in 0..n {
+            assert_eq!(got[i].to_bits(), (2.0f64.powi(p[i] as i32) as f32).to_bits(), "pow2({})", p[i]);
+        }
+        let x: Vec<f32> = (0..n).map(|i| (2.0f64.powi(e) * (1.0 + i as f64 / n as f64 + 1e-3)) as f32).collect();
+        let (m, k) = R::load(&x).split_exponent();
+        let (m, k) = (get(m), get(k));
+        for i in 0..n {
+            assert!((1.0..2.0).contains(&m[i]) && k[i] == e as f32, "split_exponent({}) = ({}, {})", x[i], m[i], k[i]);
+            assert_eq!(m[i] as f64 * 2.0f64.powi(e), x[i] as f64, "split_exponent({})", x[i]);
+        }
+    }
     for shift in 0..16 {
         let a: Vec<f32> = (0..n).map(|i| VALUES[(i + shift) % 16]).collect();
         let b: Vec<f32> = (0..n).map(|i| VALUES[(7 * i + shift + 3) % 16]).collect();

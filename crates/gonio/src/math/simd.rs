@@ -165,6 +165,26 @@ mod imp {
             let s = both!(Float8, _mm_and_ps, o, sign);
             both!(Float8, _mm_xor_ps, self, s)
         }
+        /// 2ⁿ for whole numbers n ∈ [−126, 127] (`Real::pow2`).
+        #[inline(always)]
+        pub fn pow2(self) -> Self {
+            // SAFETY: SSE2 is part of x86_64.
+            let half =
+                |x: __m128| unsafe { _mm_castsi128_ps(_mm_slli_epi32::<23>(_mm_add_epi32(_mm_cvttps_epi32(x), _mm_set1_epi32(127)))) };
+            Float8(half(self.0), half(self.1))
+        }
+        /// (m, e) with self = m · 2ᵉ, m ∈ [1, 2), for positive normal numbers (`Real::split_exponent`).
+        #[inline(always)]
+        pub fn split_exponent(self) -> (Self, Self) {
+            // SAFETY: SSE2 is part of x86_64.
+            let half = |x: __m128| unsafe {
+                let bits = _mm_castps_si128(x);
+                let m = _mm_or_si128(_mm_and_si128(bits, _mm_set1_epi32(0x007f_ffff)), _mm_set1_epi32(0x3f80_0000));
+                (_mm_castsi128_ps(m), _mm_cvtepi32_ps(_mm_sub_epi32(_mm_srli_epi32::<23>(bits), _mm_set1_epi32(127))))
+            };
+            let (a, b) = (half(self.0), half(self.1));
+            (Float8(a.0, b.0), Float8(a.1, b.1))
+        }
         #[inline(always)]
         pub fn abs(self) -> Self {
             let sign = Float8::splat(-0.0);
@@ -316,6 +336,15 @@ mod imp {
         #[inline(always)]
         pub fn xor_sign(self, o: Self) -> Self {
             each!(Float8, |i| f32::from_bits(self.0[i].to_bits() ^ (o.0[i].to_bits() & 0x8000_0000)))
+        }
+        #[inline(always)]
+        pub fn pow2(self) -> Self {
+            each!(Float8, |i| crate::math::lanes::Real::pow2(self.0[i]))
+        }
+        #[inline(always)]
+        pub fn split_exponent(self) -> (Self, Self) {
+            use crate::math::lanes::Real;
+            (each!(Float8, |i| self.0[i].split_exponent().0), each!(Float8, |i| self.0[i].split_exponent().1))
         }
         #[inline(always)]
         pub fn abs(self) -> Self {
@@ -506,6 +535,14 @@ mod common {
         #[inline(always)]
         fn xor_sign(self, o: Self) -> Self {
             Float8::xor_sign(self, o)
+        }
+        #[inline(always)]
+        fn pow2(self) -> Self {
+            Float8::pow2(self)
+        }
+        #[inline(always)]
+        fn split_exponent(self) -> (Self, Self) {
+            Float8::split_exponent(self)
         }
         /// `f32::min`: `o` where `o < self`, and `o` where `self` is NaN — what `f32::min(self, o)` compiles to.
         #[inline(always)]

@@ -108,6 +108,15 @@ impl<R: Real> Real for Twice<R> {
         Twice(self.0.xor_sign(o.0), self.1.xor_sign(o.1))
     }
     #[inline(always)]
+    fn pow2(self) -> Self {
+        Twice(self.0.pow2(), self.1.pow2())
+    }
+    #[inline(always)]
+    fn split_exponent(self) -> (Self, Self) {
+        let (a, b) = (self.0.split_exponent(), self.1.split_exponent());
+        (Twice(a.0, b.0), Twice(a.1, b.1))
+    }
+    #[inline(always)]
     fn min(self, o: Self) -> Self {
         Twice(self.0.min(o.0), self.1.min(o.1))
     }

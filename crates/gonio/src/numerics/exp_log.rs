@@ -1,6 +1,6 @@
-//! e^x and ln x in [`Real`] lanes, from the arithmetic `Real` has (no bit manipulation: the power of two
-//! of the range reduction is found and applied by seven compare-and-scale steps, exact in binary
-//! floating point), so that one formula gives the same bits on an `f32` and in every lane type.
+//! e^x and ln x in [`Real`] lanes, from the operations `Real` has (the power of two of the range reduction
+//! made and taken apart through the exponent bits, [`Real::pow2`] and [`Real::split_exponent`]), so that one
+//! formula gives the same bits on an `f32` and in every lane type.
 
 // Constants are written with the digits of their f64 derivation; Rust stores the nearest f32.
 #![allow(clippy::excessive_precision)]
@@ -36,7 +36,7 @@ pub fn exp_split<R: Real>(hi: R, lo: R) -> R {
     // they are whenever hi is large; |r| ≤ ln 2 / 2 + rounding.
     let r = ((R::select(under, R::splat(0.0), hi) - n * LN2_HI) - n * LN2_LO) + R::select(under, R::splat(0.0), lo);
     let p = horner(r, &EXP_TAYLOR);
-    R::select(under, R::splat(0.0), scale_pow2_neg(p, n))
+    R::select(under, R::splat(0.0), p * n.pow2())
 }
 
 /// e^x for x ≤ 0 ([`exp_split`] with lo = 0; the same bound).
@@ -58,56 +58,26 @@ pub fn square_split<R: Real>(x: R) -> (R, R) {
     (xh * xh, xh * xl * 2.0 + xl * xl)
 }
 
-/// (k, 2ᵏ, 2⁻ᵏ) for the binary digits k of an exponent up to 127.
-const POW2_STEPS: [(f32, f32, f32); 7] = [
-    (64.0, 18_446_744_073_709_551_616.0, 1.0 / 18_446_744_073_709_551_616.0),
-    (32.0, 4_294_967_296.0, 1.0 / 4_294_967_296.0),
-    (16.0, 65_536.0, 1.0 / 65_536.0),
-    (8.0, 256.0, 1.0 / 256.0),
-    (4.0, 16.0, 1.0 / 16.0),
-    (2.0, 4.0, 0.25),
-    (1.0, 2.0, 0.5),
-];
-
-/// p · 2ⁿ for a whole number n ∈ [−127, 0], by multiplications with 2⁻⁶⁴, 2⁻³², …, 2⁻¹ chosen from n's
-/// binary digits (each exact while the result stays normal).
-#[inline(always)]
-fn scale_pow2_neg<R: Real>(p: R, n: R) -> R {
-    let (mut v, mut m) = (p, -n);
-    for (k, _, down) in POW2_STEPS {
-        let take = m.ge(R::splat(k));
-        v = R::select(take, v * down, v);
-        m = R::select(take, m - k, m);
-    }
-    v
-}
-
 /// 1/(2k + 1), k = 1…4: ln m = 2 atanh s = 2 (s + s³/3 + s⁵/5 + …), s = (m − 1)/(m + 1), |s| ≤ 0.1716 for
 /// m ∈ [√½, √2]; the remainder 2 s¹¹/11 ≤ 7.6·10⁻¹⁰.
 const ATANH_SERIES: [f32; 4] = [1.0 / 3.0, 1.0 / 5.0, 1.0 / 7.0, 1.0 / 9.0];
 
 /// ln x for x ∈ (0, 1], arguments below f32's smallest normal taken as that (ln = −87.34); NaN gives NaN.
-/// x = m·2ᵉ with m ∈ [√½, √2) by seven compare-and-scale steps (exact), then ln m from the atanh series and
-/// e ln 2 in two parts. Relative error ≤ 2·10⁻⁷ (test `exp_and_ln_match_f64`; near x = 1, where ln x → 0,
+/// x = m·2ᵉ with m ∈ [√½, √2) (from its exponent bits, [`Real::split_exponent`]), then ln m from the atanh
+/// series and e ln 2 in two parts. Relative error ≤ 2·10⁻⁷ (test `exp_and_ln_match_f64`; near x = 1, where ln x → 0,
 /// too).
 #[inline(always)]
 #[must_use]
 pub fn ln_unit<R: Real>(x: R) -> R {
     let tiny = R::splat(f32::MIN_POSITIVE);
-    // (A select, not `max`: NaN passes.)
-    let (mut m, mut e) = (R::select(x.lt(tiny), tiny, x), R::splat(0.0));
-    for (k, up, down) in POW2_STEPS {
-        // Below 2^(1 − k) the remaining scaling is at least 2ᵏ.
-        let take = m.lt(R::splat(2.0 * down));
-        m = R::select(take, m * up, m);
-        e = R::select(take, e - k, e);
-    }
+    // (A select, not `max`: NaN passes, and is given back at the end.)
+    let (m, e) = R::select(x.lt(tiny), tiny, x).split_exponent();
     let big = m.gt(R::splat(std::f32::consts::SQRT_2));
     let (m, e) = (R::select(big, m * 0.5, m), R::select(big, e + 1.0, e));
     let s = (m - 1.0) / (m + 1.0);
     let s2 = s * s;
     let ln_m = (s * s2 * 2.0).mad(horner(s2, &ATANH_SERIES), s * 2.0);
-    e * LN2_HI + (e * LN2_LO + ln_m)
+    R::select(x.is_nan(), x, e * LN2_HI + (e * LN2_LO + ln_m))
 }
 
 #[cfg(test)]
