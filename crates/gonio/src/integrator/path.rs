@@ -509,9 +509,10 @@ fn light_sample(scene: &Scene, p: &mut Packet, hit: &Surfaces8, sh: &Shading<'_>
     let u_light = p.rng.next_f32(smooth);
     let (u_c, u_x, u_y) = (p.rng.next_f32(smooth), p.rng.next_f32(smooth), p.rng.next_f32(smooth));
     // The light of each lane and the probability of its choice (`LightSelection::sample`).
-    let (u_light, mut chosen, mut pmf) = (u_light.to_array(), [0.0f32; W], [1.0f32; W]);
+    let (mut chosen, mut pmf) = ([0.0f32; W], [1.0f32; W]);
+    let choices = scene.light_selection.sample_lanes(&scene.lights, hit.p.lanes(), u_light, smooth);
     for lane in bits(smooth) {
-        let (index, q, sums) = scene.light_selection.sample(&scene.lights, hit.p.get(lane), u_light[lane]);
+        let (index, q, sums) = choices[lane];
         (chosen[lane], pmf[lane], p.sums[lane]) = (index as f32, q, sums);
     }
     let chosen_lanes = Float8::load(&chosen);

@@ -25,7 +25,10 @@
 //! per sample.
 
 use super::Light;
+use crate::geometry::bvh::bits;
 use crate::geometry::Shape;
+use crate::math::lanes::{Real, V3};
+use crate::math::simd::Float8;
 use glam::Vec3;
 use std::f32::consts::PI;
 
@@ -91,32 +94,31 @@ impl LightSelection {
         self.estimates.is_empty()
     }
 
-    /// The estimated importance of light `index` at `x` (module docs), ≥ 0 and finite.
+    /// The estimated importance of light `index` at `x` (module docs), ≥ 0 and finite; in lanes, each lane
+    /// the single call's number bit for bit (a spot's falloff is found lane by lane).
     #[inline]
-    fn importance(&self, lights: &[Light], index: usize, x: Vec3) -> f32 {
+    fn importance<R: Real>(&self, lights: &[Light], index: usize, x: V3<R>) -> R {
+        let zero = R::splat(0.0);
         let value = match self.estimates[index] {
-            Estimate::Distant(e) => e,
+            Estimate::Distant(e) => R::splat(e),
             Estimate::Point { position, intensity, spot } => {
                 let falloff = match spot.map(|s| &lights[s]) {
-                    Some(Light::Spot(s)) => s.falloff_at(x),
-                    _ => 1.0,
+                    Some(Light::Spot(s)) => R::from_fn(|i| s.falloff_at(Vec3::new(x.x.lane(i), x.y.lane(i), x.z.lane(i)))),
+                    _ => R::splat(1.0),
                 };
-                intensity * falloff / (x - position).length_squared()
+                let d = x.sub(V3::splat(position));
+                R::splat(intensity) * falloff / d.dot(d)
             }
             Estimate::Area { radiance, center, quarter_area, vector_area } => {
-                let d = x - center;
-                let d2 = d.length_squared();
-                let facing = if d2 > 0.0 { vector_area.dot(d) / d2.sqrt() } else { 0.0 };
-                radiance * quarter_area.max(facing) / (d2 + quarter_area)
+                let d = x.sub(V3::splat(center));
+                let d2 = d.dot(d);
+                let facing = R::select(d2.gt(zero), V3::splat(vector_area).dot(d) / d2.sqrt(), zero);
+                R::splat(radiance) * R::splat(quarter_area).max(facing) / (d2 + quarter_area)
             }
         };
-        if value.is_finite() && value > 0.0 {
-            value
-        } else if value.is_infinite() {
-            f32::MAX / (MAX_LIGHTS as f32 * 2.0)
-        } else {
-            0.0
-        }
+        let kept = value.is_finite() & value.gt(zero);
+        let infinite = value.abs().eq(R::splat(f32::INFINITY));
+        R::select(kept, value, R::select(infinite, R::splat(f32::MAX / (MAX_LIGHTS as f32 * 2.0)), zero))
     }
 
     /// Choose one of the `lights` (the scene's, which this choice was made for) for the shading point `x` with
@@ -132,18 +134,35 @@ impl LightSelection {
             return (((u * n as f32) as usize).min(n - 1), 1.0 / n as f32, SelectionSums::UNIFORM);
         }
         let mut weights = [0.0f32; MAX_LIGHTS];
-        let sums = self.weights(lights, x, &mut weights);
-        let target = u * sums.total;
-        let mut sum = 0.0;
-        for (i, w) in weights[..n].iter().enumerate() {
-            sum += w;
-            if target < sum {
-                return (i, w / sums.total, sums);
+        let sums = self.weights(lights, V3::from(x), &mut weights).lane(0);
+        let (index, pmf) = choose(&weights[..n], sums.total, u);
+        (index, pmf, sums)
+    }
+
+    /// [`Self::sample`] for eight shading points `x` (the lanes of `lanes`) with the uniform numbers `u`:
+    /// each lane's light, probability and sums, the single call's bit for bit, with the estimates made in
+    /// lanes.
+    #[inline]
+    #[must_use]
+    pub fn sample_lanes(&self, lights: &[Light], x: V3<Float8>, u: Float8, lanes: u32) -> [(usize, f32, SelectionSums); 8] {
+        let mut out = [(0, 1.0, SelectionSums::UNIFORM); 8];
+        if self.is_uniform() {
+            for lane in bits(lanes) {
+                out[lane] = self.sample(lights, Vec3::ZERO, u.lane(lane));
             }
+            return out;
         }
-        // Rounding in the sum: the last light with a positive weight.
-        let last = weights[..n].iter().rposition(|w| *w > 0.0).unwrap_or(n - 1);
-        (last, weights[last] / sums.total, sums)
+        let n = lights.len();
+        let mut weights = [Float8::splat(0.0); MAX_LIGHTS];
+        let sums = self.weights(lights, x, &mut weights);
+        let rows: [[f32; 8]; MAX_LIGHTS] = std::array::from_fn(|i| if i < n { weights[i].to_array() } else { [0.0; 8] });
+        for lane in bits(lanes) {
+            let mine: [f32; MAX_LIGHTS] = std::array::from_fn(|i| rows[i][lane]);
+            let sums = sums.lane(lane);
+            let (index, pmf) = choose(&mine[..n], sums.total, u.lane(lane));
+            out[lane] = (index, pmf, sums);
+        }
+        out
     }
 
     /// The probability that [`Self::sample`] chooses light `index` for the shading point `x`.
@@ -153,7 +172,7 @@ impl LightSelection {
             return 1.0 / lights.len() as f32;
         }
         let mut weights = [0.0f32; MAX_LIGHTS];
-        let sums = self.weights(lights, x, &mut weights);
+        let sums = self.weights(lights, V3::from(x), &mut weights);
         weights[index] / sums.total
     }
 
@@ -164,48 +183,76 @@ impl LightSelection {
         if self.is_uniform() {
             return 1.0 / lights.len() as f32;
         }
-        sums.weight(self.importance(lights, index, x), lights.len()) / sums.total
+        sums.weight(self.importance(lights, index, V3::from(x)), lights.len()) / sums.total
     }
 
     /// Each light's weight at `x` (into `weights`), (1 − s) imp/Σimp + s/n with s = [`UNIFORM_SHARE`] (all
-    /// uniform where every importance is 0), and the sums they were made with.
+    /// uniform where every importance is 0), and the sums they were made with; in lanes as at one point.
     #[inline]
-    fn weights(&self, lights: &[Light], x: Vec3, weights: &mut [f32; MAX_LIGHTS]) -> SelectionSums {
+    fn weights<R: Real>(&self, lights: &[Light], x: V3<R>, weights: &mut [R; MAX_LIGHTS]) -> SelectionSums<R> {
         let n = self.estimates.len();
-        let mut sum = 0.0f32;
+        let mut sum = R::splat(0.0);
         for (i, w) in weights[..n].iter_mut().enumerate() {
             *w = self.importance(lights, i, x);
-            sum += *w;
+            sum = sum + *w;
         }
-        let (share, scale) = if sum > 0.0 && sum.is_finite() { (UNIFORM_SHARE, (1.0 - UNIFORM_SHARE) / sum) } else { (1.0, 0.0) };
-        let mut sums = SelectionSums { share, scale, total: 0.0 };
-        let mut total = 0.0;
+        let mixed = sum.gt(R::splat(0.0)) & sum.is_finite();
+        let share = R::select(mixed, R::splat(UNIFORM_SHARE), R::splat(1.0));
+        let scale = R::select(mixed, R::splat(1.0 - UNIFORM_SHARE) / sum, R::splat(0.0));
+        let mut sums = SelectionSums { share, scale, total: R::splat(0.0) };
+        let mut total = R::splat(0.0);
         for w in &mut weights[..n] {
             *w = sums.weight(*w, n);
-            total += *w;
+            total = total + *w;
         }
         sums.total = total;
         sums
     }
 }
 
+/// The light that a uniform number `u` chooses by the `weights` (summing to `total`), and its
+/// probability: the first whose running sum passes u · total, or for rounding in the sum the last with a
+/// positive weight.
+#[inline]
+fn choose(weights: &[f32], total: f32, u: f32) -> (usize, f32) {
+    let target = u * total;
+    let mut sum = 0.0;
+    for (i, w) in weights.iter().enumerate() {
+        sum += w;
+        if target < sum {
+            return (i, w / total);
+        }
+    }
+    let last = weights.iter().rposition(|w| *w > 0.0).unwrap_or(weights.len() - 1);
+    (last, weights[last] / total)
+}
+
 /// What a light's probability at a shading point takes besides its own estimate (the light choice's
-/// `weights` there): its weight is imp · `scale` + `share` / n, its probability that over `total`.
+/// `weights` there): its weight is imp · `scale` + `share` / n, its probability that over `total`; in
+/// lanes, one set per lane.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SelectionSums {
-    share: f32,
-    scale: f32,
-    total: f32,
+pub struct SelectionSums<R = f32> {
+    share: R,
+    scale: R,
+    total: R,
 }
 
 impl SelectionSums {
     /// The sums of a uniform choice (unused by it).
     pub const UNIFORM: SelectionSums = SelectionSums { share: 1.0, scale: 0.0, total: 1.0 };
+}
 
+impl<R: Real> SelectionSums<R> {
     /// The weight of a light of estimated importance `importance` among `n`.
     #[inline]
-    fn weight(self, importance: f32, n: usize) -> f32 {
+    fn weight(self, importance: R, n: usize) -> R {
         importance * self.scale + self.share * (1.0 / n as f32)
+    }
+
+    /// Lane `i`'s sums.
+    #[inline]
+    fn lane(self, i: usize) -> SelectionSums {
+        SelectionSums { share: self.share.lane(i), scale: self.scale.lane(i), total: self.total.lane(i) }
     }
 }
 
@@ -286,7 +333,7 @@ mod tests {
             [Vec3::ZERO, Vec3::new(0.1, -0.2, 0.3), Vec3::new(-1.0, 0.5, 4.0), Vec3::new(2.0, -1.0, -3.0), Vec3::new(9.0, 9.0, -9.0)];
         for x in points {
             for (i, light) in lights.iter().enumerate() {
-                let (got, want) = (selection.importance(&lights, i, x), by_the_table(light, &shapes, x));
+                let (got, want) = (selection.importance(&lights, i, V3::from(x)), by_the_table(light, &shapes, x));
                 assert!((f64::from(got) - want).abs() <= 1e-5 * want, "light {i} at {x}: {got} vs {want}");
             }
             let total: f32 = (0..lights.len()).map(|i| selection.pmf(&lights, x, i)).sum();
@@ -302,10 +349,24 @@ mod tests {
             }
         }
         // The spot's cone holds the origin and not (9, 9, −9); the flat emitters face +z and −z.
-        assert_eq!(selection.importance(&lights, 3, Vec3::new(9.0, 9.0, -9.0)), 0.0);
-        let on_light = selection.importance(&lights, 0, Vec3::new(0.0, 2.0, 0.0));
+        assert_eq!(selection.importance(&lights, 3, V3::from(Vec3::new(9.0, 9.0, -9.0))), 0.0);
+        let on_light = selection.importance(&lights, 0, V3::from(Vec3::new(0.0, 2.0, 0.0)));
         assert!(on_light.is_finite() && on_light > 1e30, "on the point light: {on_light}");
         let p = selection.pmf(&lights, Vec3::new(0.0, 2.0, 0.0), 0);
         assert!(p.is_finite() && p > 0.79, "{p}");
+        // In lanes, each lane's choice is the single call's, bit for bit (the point light's own position,
+        // inside and outside the spot's cone, behind the disks), and lanes left out keep the default.
+        let mut x = points.to_vec();
+        x.extend([Vec3::new(0.0, 2.0, 0.0), Vec3::new(-1.0, 0.0, 2.0), Vec3::new(0.3, 0.1, 1.0)]);
+        let xl = V3::new(Float8::from_fn(|i| x[i].x), Float8::from_fn(|i| x[i].y), Float8::from_fn(|i| x[i].z));
+        for (k, lanes) in [0xffu32, 0b1011_0110].into_iter().enumerate() {
+            let u = Float8::from_fn(|i| ((i * 37 + k * 11) % 100) as f32 / 100.0);
+            let got = selection.sample_lanes(&lights, xl, u, lanes);
+            for i in 0..8 {
+                let want =
+                    if lanes & (1 << i) != 0 { selection.sample(&lights, x[i], u.lane(i)) } else { (0, 1.0, SelectionSums::UNIFORM) };
+                assert_eq!((got[i].0, got[i].1.to_bits(), got[i].2), (want.0, want.1.to_bits(), want.2), "lane {i} at {}", x[i]);
+            }
+        }
     }
 }
