@@ -360,8 +360,9 @@ impl Shading<'_> {
 /// their model.
 #[inline(always)]
 fn shading<'a>(scene: &'a Scene, p: &Packet, hit: &Surfaces8) -> Shading<'a> {
-    // The lanes on one shape, or on shapes of one constant reflectance (`Scene::material_class`), share their material:
-    // a constant or checkerboard reflectance is found for them together, other materials lane by lane.
+    // The lanes on one shape, or on shapes of one constant reflectance (`Scene::material_class`), share
+    // their material: a constant or checkerboard reflectance is found for them together, other materials
+    // lane by lane.
     let (mut rho, mut rho_rows, mut diffuse, mut diffuse_rows) = ([Float8::splat(0.0); 3], Rows3::default(), 0u32, 0u32);
     let mut models: [Option<Cow<'_, Bsdf>>; W] = Default::default();
     let (u, v) = (Float8::load(&hit.uv[0]), Float8::load(&hit.uv[1]));
@@ -508,7 +509,7 @@ fn light_sample(scene: &Scene, p: &mut Packet, hit: &Surfaces8, sh: &Shading<'_>
     let (mut pt_position, mut on_point) = (Rows3::default(), 0u32);
     let u_light = p.rng.next_f32(smooth);
     let (u_c, u_x, u_y) = (p.rng.next_f32(smooth), p.rng.next_f32(smooth), p.rng.next_f32(smooth));
-    // The light of each lane and the probability of its choice (`LightSelection::sample`).
+    // The light of each lane and the probability of its choice (`LightSelection::sample_lanes`).
     let (mut chosen, mut pmf) = ([0.0f32; W], [1.0f32; W]);
     let choices = scene.light_selection.sample_lanes(&scene.lights, hit.p.lanes(), u_light, smooth);
     for lane in bits(smooth) {
