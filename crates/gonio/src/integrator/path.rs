@@ -185,6 +185,14 @@ impl Packet {
         self.depth = Float8::select(m, Float8::splat(0.0), depth).to_array().map(|d| d.to_bits() as i32);
     }
 
+    /// The live paths' rays leave their vertices: one more segment each.
+    #[inline(always)]
+    fn deepen(&mut self) {
+        for (i, depth) in self.depth.iter_mut().enumerate() {
+            *depth += (self.live >> i & 1) as i32;
+        }
+    }
+
     /// Lane `lane`'s path ends: its radiance goes to `out`.
     #[inline(always)]
     fn finish(&mut self, lane: usize, out: &mut [Rgb]) {
@@ -353,6 +361,10 @@ impl Shading<'_> {
 
     fn to_local(&self, v: V3<Float8>) -> V3<Float8> {
         to_local(self.frame.0, self.frame.1, self.frame.2, v)
+    }
+
+    fn to_world(&self, v: V3<Float8>) -> V3<Float8> {
+        to_world(self.frame.0, self.frame.1, self.frame.2, v)
     }
 }
 
@@ -713,7 +725,7 @@ fn sample_bsdf(p: &mut Packet, hit: &Surfaces8, sh: &Shading<'_>) -> (u32, [Floa
         s_delta |= (s.is_delta() & m).bitmask();
     }
     let eta = Float8::load(&p.eta) * s_eta;
-    let wi = to_world(sh.frame.0, sh.frame.1, sh.frame.2, s_wi);
+    let wi = sh.to_world(s_wi);
     let sp = hit.p.lanes();
     p.o.store(offset_origin_lanes(sp, hit.n.lanes(), wi));
     p.d.store(wi);
@@ -778,9 +790,7 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
             // The `direct` integrator's BSDF samples, other than one: each is traced here for the emission
             // it finds, and the paths end (max_depth 2).
             debug_assert_eq!(max_depth, 2, "several BSDF samples at a vertex end the path there");
-            for (i, depth) in p.depth.iter_mut().enumerate() {
-                *depth += (p.live >> i & 1) as i32;
-            }
+            p.deepen();
             let beta = load_rgb(&p.beta);
             for _ in 0..bsdf_samples {
                 let (valid, weight, _) = sample_bsdf(&mut p, &hit, &sh);
@@ -805,9 +815,7 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
         let beta_max = beta[0].max(beta[1]).max(beta[2]);
         let q = (beta_max * eta * eta).min(Float8::splat(0.95));
         let dead = p.live & (!beta_max.gt(Float8::splat(0.0))).bitmask();
-        for (i, depth) in p.depth.iter_mut().enumerate() {
-            *depth += (p.live >> i & 1) as i32;
-        }
+        p.deepen();
         for lane in bits(dead) {
             p.finish(lane, out);
         }

@@ -64,8 +64,8 @@ const ATANH_SERIES: [f32; 4] = [1.0 / 3.0, 1.0 / 5.0, 1.0 / 7.0, 1.0 / 9.0];
 
 /// ln x for x ∈ (0, 1], arguments below f32's smallest normal taken as that (ln = −87.34); NaN gives NaN.
 /// x = m·2ᵉ with m ∈ [√½, √2) (from its exponent bits, [`Real::split_exponent`]), then ln m from the atanh
-/// series and e ln 2 in two parts. Relative error ≤ 2·10⁻⁷ (test `exp_and_ln_match_f64`; near x = 1, where ln x → 0,
-/// too).
+/// series and e ln 2 in two parts. Relative error ≤ 2·10⁻⁷ (test `exp_and_ln_match_f64`; near x = 1, where
+/// ln x → 0, too).
 #[inline(always)]
 #[must_use]
 pub fn ln_unit<R: Real>(x: R) -> R {
