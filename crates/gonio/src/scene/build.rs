@@ -14,48 +14,38 @@ use crate::geometry::disk::Disk;
 use crate::geometry::sphere::Sphere;
 use crate::geometry::{Mesh, Shape};
 use crate::light::{AreaLight, ConstantLight, DirectionalLight, EnvMap, Light, PointLight, SpotLight};
+use crate::math::Transform;
 use crate::props::Props;
 use crate::spectrum::Rgb;
 use glam::Vec3;
 
-const SHAPES: &str = "sphere, rectangle, cube, disk, cylinder, obj, ply, serialized";
+const SHAPES: &str = "sphere, rectangle, cube, disk, cylinder, obj, ply, serialized, shapegroup, instance";
 
 impl Scene {
     /// Build every plugin of a parsed scene.
     pub fn build(desc: SceneDescription) -> Result<Scene> {
         let mut warnings = desc.warnings.clone();
-        let mut shapes = Vec::new();
-        let mut materials = Vec::new();
-        let mut shape_lights = Vec::new();
-        let mut lights = Vec::new();
+        let mut built = Built::default();
         for p in &desc.shapes {
-            shapes.push(shape_from_props(p)?);
-            let (nested, emitters) = (p.nested_of("bsdf"), p.nested_of("emitter"));
-            // Without a <bsdf>, Mitsuba 3 gives a shape a `diffuse` of reflectance 0.5, and an emitting shape
-            // one of reflectance 0 (its `Shape` constructor): a light that reflects nothing. (Until
-            // 2026-12-03 gonio gave lights 0.5 too: the material spheres' light reflected the floor's light
-            // back onto it: 0.4 % of the image's mean, 1 % of the near floor's brightness, against Mitsuba's.)
-            let default_reflectance = if emitters.is_empty() { 0.5 } else { 0.0 };
-            materials.push(match nested.as_slice() {
-                [] => Material::Fixed(Bsdf::Diffuse(Diffuse::new(Rgb::splat(default_reflectance)))),
-                [one] => Material::from_props(one)?,
-                [_, second, ..] => return Err(Error::spec(second.at(), "a shape takes one <bsdf>")),
-            });
-            shape_lights.push(match emitters.as_slice() {
-                [] => None,
-                [e] => {
-                    if e.plugin_type() != "area" {
-                        return Err(Error::spec(e.at(), format!("a shape can only carry an `area` emitter, not `{}`", e.plugin_type())));
+            match p.plugin_type() {
+                // A declaration for the instances that `<ref>` it; its shapes are built by each instance.
+                "shapegroup" => check_shape_group(p)?,
+                "instance" => {
+                    let to_world = p.transform("to_world")?;
+                    let groups = p.nested_of("shape");
+                    let group = match groups.as_slice() {
+                        [g] if g.plugin_type() == "shapegroup" => g,
+                        _ => return Err(Error::spec(p.at(), "an `instance` takes one <ref id=\"…\"> to a `shapegroup`")),
+                    };
+                    for s in group.nested_of("shape") {
+                        built.add(s, &to_world)?;
                     }
-                    let radiance = e.rgb_in("radiance", Rgb::ONE, 0.0, f32::MAX)?;
-                    e.finish()?;
-                    lights.push(Light::Area(AreaLight { shape: (shapes.len() - 1) as u32, radiance }));
-                    Some((lights.len() - 1) as u32)
+                    p.finish()?;
                 }
-                [_, second, ..] => return Err(Error::spec(second.at(), "a shape takes one <emitter>")),
-            });
-            p.finish()?;
+                _ => built.add(p, &Transform::IDENTITY)?,
+            }
         }
+        let Built { shapes, materials, shape_lights, mut lights } = built;
         for e in &desc.emitters {
             let light = light_from_props(e)?;
             if light.is_environment() && lights.iter().any(Light::is_environment) {
@@ -98,8 +88,71 @@ impl Scene {
     }
 }
 
-fn shape_from_props(p: &Props) -> Result<Shape> {
-    let to_world = p.transform("to_world")?;
+/// The shapes of a scene as they are built, with their materials, their area lights' indices and the
+/// lights so far.
+#[derive(Default)]
+struct Built {
+    shapes: Vec<Shape>,
+    materials: Vec<Material>,
+    shape_lights: Vec<Option<u32>>,
+    lights: Vec<Light>,
+}
+
+impl Built {
+    /// Add shape `p`, placed by `outer` after its own `to_world` (an instance's transform, or the identity).
+    fn add(&mut self, p: &Props, outer: &Transform) -> Result<()> {
+        self.shapes.push(shape_from_props(p, outer)?);
+        let (nested, emitters) = (p.nested_of("bsdf"), p.nested_of("emitter"));
+        // Without a <bsdf>, Mitsuba 3 gives a shape a `diffuse` of reflectance 0.5, and an emitting shape
+        // one of reflectance 0 (its `Shape` constructor): a light that reflects nothing. (Until
+        // 2026-12-03 gonio gave lights 0.5 too: the material spheres' light reflected the floor's light
+        // back onto it: 0.4 % of the image's mean, 1 % of the near floor's brightness, against Mitsuba's.)
+        let default_reflectance = if emitters.is_empty() { 0.5 } else { 0.0 };
+        self.materials.push(match nested.as_slice() {
+            [] => Material::Fixed(Bsdf::Diffuse(Diffuse::new(Rgb::splat(default_reflectance)))),
+            [one] => Material::from_props(one)?,
+            [_, second, ..] => return Err(Error::spec(second.at(), "a shape takes one <bsdf>")),
+        });
+        self.shape_lights.push(match emitters.as_slice() {
+            [] => None,
+            [e] => {
+                if e.plugin_type() != "area" {
+                    return Err(Error::spec(e.at(), format!("a shape can only carry an `area` emitter, not `{}`", e.plugin_type())));
+                }
+                let radiance = e.rgb_in("radiance", Rgb::ONE, 0.0, f32::MAX)?;
+                e.finish()?;
+                self.lights.push(Light::Area(AreaLight { shape: (self.shapes.len() - 1) as u32, radiance }));
+                Some((self.lights.len() - 1) as u32)
+            }
+            [_, second, ..] => return Err(Error::spec(second.at(), "a shape takes one <emitter>")),
+        });
+        p.finish()?;
+        Ok(())
+    }
+}
+
+/// Check a `shapegroup`: shapes only, none of them a group or carrying an emitter (Mitsuba 3 refuses
+/// both: instances share their shapes, and an instanced light would need its own area and sampling).
+fn check_shape_group(g: &Props) -> Result<()> {
+    for s in g.nested() {
+        if s.class() != "shape" {
+            return Err(Error::spec(s.at(), format!("a `shapegroup` holds shapes only, not a <{}>", s.class())));
+        }
+        if matches!(s.plugin_type(), "shapegroup" | "instance") {
+            return Err(Error::spec(s.at(), format!("a `shapegroup` cannot hold a `{}` (no nested instancing)", s.plugin_type())));
+        }
+        if let Some(e) = s.nested_of("emitter").first() {
+            return Err(Error::spec(
+                e.at(),
+                "a shape in a `shapegroup` cannot carry an emitter (instanced lights are not supported, as in Mitsuba 3)",
+            ));
+        }
+    }
+    g.finish()
+}
+
+fn shape_from_props(p: &Props, outer: &Transform) -> Result<Shape> {
+    let to_world = outer.then_after(p.transform("to_world")?);
     let flip = p.bool("flip_normals", false)?;
     let at = p.at();
     Ok(match p.plugin_type() {
@@ -318,5 +371,71 @@ mod tests {
         let scene = Scene::build(mitsuba_xml::load_str(SCENE, "t.xml", Path::new("."), &[]).unwrap()).unwrap();
         let reflectance: Vec<Option<Rgb>> = scene.materials.iter().map(|m| m.diffuse_reflectance(glam::Vec2::ZERO)).collect();
         assert_eq!(reflectance, [Some(Rgb::splat(0.5)), Some(Rgb::splat(0.0)), Some(Rgb::splat(0.3))]);
+    }
+
+    fn scene(shapes: &str) -> Result<Scene> {
+        let text = format!(
+            r#"<scene version="3.0.0"><sensor type="perspective"><film type="hdrfilm"><integer name="width" value="4"/>
+               <integer name="height" value="4"/></film></sensor>{shapes}</scene>"#
+        );
+        Scene::build(mitsuba_xml::load_str(&text, "t.xml", Path::new("."), &[])?)
+    }
+
+    /// An `instance` of a `shapegroup` is its shapes placed by the instance's `to_world` after their own
+    /// (the group itself renders nothing): the same hits, normals and materials as the shapes given so.
+    #[test]
+    fn instances_place_their_group() {
+        let group = r#"<shape type="shapegroup" id="g">
+                <shape type="sphere"><point name="center" x="1" y="0" z="0"/><float name="radius" value="0.5"/>
+                    <bsdf type="diffuse"><rgb name="reflectance" value="0.3"/></bsdf></shape>
+                <shape type="rectangle"><transform name="to_world"><rotate y="1" angle="-80"/></transform></shape>
+            </shape>"#;
+        let place = r#"<transform name="to_world"><rotate z="1" angle="30"/><scale value="1.5"/><translate z="2"/></transform>"#;
+        let instanced =
+            scene(&format!(r#"{group}<shape type="instance"><ref id="g"/></shape><shape type="instance"><ref id="g"/>{place}</shape>"#))
+                .unwrap();
+        let direct = scene(&format!(
+            r#"<shape type="sphere"><point name="center" x="1" y="0" z="0"/><float name="radius" value="0.5"/>
+                   <bsdf type="diffuse"><rgb name="reflectance" value="0.3"/></bsdf></shape>
+               <shape type="rectangle"><transform name="to_world"><rotate y="1" angle="-80"/></transform></shape>
+               <shape type="sphere"><point name="center" x="1" y="0" z="0"/><float name="radius" value="0.5"/>
+                   <bsdf type="diffuse"><rgb name="reflectance" value="0.3"/></bsdf>
+                   <transform name="to_world"><rotate z="1" angle="30"/><scale value="1.5"/><translate z="2"/></transform></shape>
+               <shape type="rectangle"><transform name="to_world"><rotate y="1" angle="-80"/><rotate z="1" angle="30"/>
+                   <scale value="1.5"/><translate z="2"/></transform></shape>"#
+        ))
+        .unwrap();
+        assert_eq!(instanced.shapes.len(), 4);
+        let reflectance = |s: &Scene| s.materials.iter().map(|m| m.diffuse_reflectance(glam::Vec2::ZERO)).collect::<Vec<_>>();
+        assert_eq!(reflectance(&instanced), reflectance(&direct));
+        let mut hits = 0;
+        for i in 0..400 {
+            let (y, z) = ((i % 20) as f32 * 0.2 - 2.0, (i / 20) as f32 * 0.25 - 1.0);
+            let ray = crate::geometry::Ray::new(Vec3::new(-6.0, y, z), Vec3::new(1.0, 0.05, 0.02).normalize(), f32::INFINITY);
+            let (a, b) = (instanced.intersect(&ray), direct.intersect(&ray));
+            assert_eq!(a.is_some(), b.is_some(), "ray {i}");
+            if let (Some(a), Some(b)) = (a, b) {
+                hits += 1;
+                assert_eq!(a.shape, b.shape, "ray {i}");
+                assert!((a.p - b.p).length() < 1e-5 && (a.n - b.n).length() < 1e-5, "ray {i}: {a:?} against {b:?}");
+            }
+        }
+        assert!(hits > 100, "{hits} of 400 rays hit");
+    }
+
+    /// What Mitsuba 3 refuses in instancing gonio refuses too, at the place.
+    #[test]
+    fn shape_groups_refuse_emitters_nesting_and_other_plugins() {
+        let error = |shapes: &str| scene(shapes).err().expect("refused").to_string();
+        let e = error(r#"<shape type="shapegroup" id="g"><shape type="sphere"><emitter type="area"/></shape></shape>"#);
+        assert!(e.contains("t.xml:2:119:") && e.contains("cannot carry an emitter"), "{e}");
+        let e = error(r#"<shape type="shapegroup" id="g"><shape type="shapegroup" id="h"><shape type="sphere"/></shape></shape>"#);
+        assert!(e.contains("no nested instancing"), "{e}");
+        let e = error(r#"<shape type="shapegroup" id="g"><bsdf type="diffuse"/></shape>"#);
+        assert!(e.contains("holds shapes only, not a <bsdf>"), "{e}");
+        let e = error(r#"<shape type="shapegroup" id="g"><float name="radius" value="1"/></shape>"#);
+        assert!(e.contains("unknown parameter `radius` for `shapegroup`"), "{e}");
+        let e = error(r#"<shape type="instance"><shape type="sphere"/></shape>"#);
+        assert!(e.contains("an `instance` takes one <ref id=\"…\"> to a `shapegroup`"), "{e}");
     }
 }

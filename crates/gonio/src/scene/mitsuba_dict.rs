@@ -288,6 +288,29 @@ mod tests {
         assert_eq!((from_dict.film, from_dict.sampler, from_dict.integrator), (from_xml.film, from_xml.sampler, from_xml.integrator));
     }
 
+    /// Instancing as Mitsuba 3's dictionaries write it: a top-level `shapegroup`, and instances that refer
+    /// to it by id; the same shapes as the XML form.
+    #[test]
+    fn instances_refer_to_their_group() {
+        let xml = r#"<scene version="3.0.0"><sensor type="perspective"/>
+            <shape type="shapegroup" id="g"><shape type="sphere"><float name="radius" value="0.5"/></shape></shape>
+            <shape type="instance"><ref id="g"/><transform name="to_world"><translate x="2"/></transform></shape>
+            <shape type="instance"><ref id="g"/></shape>
+        </scene>"#;
+        let from_xml = Scene::build(mitsuba_xml::load_str(xml, "x.xml", std::path::Path::new("."), &[]).unwrap()).unwrap();
+        let dict = json!({
+            "type": "scene",
+            "sensor": {"type": "perspective"},
+            "g": {"type": "shapegroup", "ball": {"type": "sphere", "radius": 0.5}},
+            "a": {"type": "instance", "group": {"type": "ref", "id": "g"},
+                  "to_world": [[1, 0, 0, 2], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]},
+            "b": {"type": "instance", "group": {"type": "ref", "id": "g"}},
+        });
+        let from_dict = Scene::build(load_value(&dict, "d").unwrap()).unwrap();
+        assert_eq!(from_dict.shapes.len(), 2);
+        assert_eq!(format!("{:?}", from_dict.shapes), format!("{:?}", from_xml.shapes));
+    }
+
     #[test]
     fn errors_name_the_json_path() {
         let cam = json!({"type": "perspective"});
