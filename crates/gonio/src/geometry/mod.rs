@@ -1,5 +1,5 @@
 //! Geometry: rays, bounding boxes, the shapes of Mitsuba's scene format (sphere, rectangle, cube, disk,
-//! cylinder, triangle meshes, and the mesh file loaders in [`mesh_io`]), surface interactions and the bounding volume hierarchy over all primitives.
+//! cylinder, triangle meshes, signed-distance grids, and the mesh file loaders in [`mesh_io`]), surface interactions and the bounding volume hierarchy over all primitives.
 
 pub mod bounds;
 pub mod builtin_meshes;
@@ -10,6 +10,7 @@ pub mod interaction;
 pub mod mesh;
 pub mod mesh_io;
 pub mod ray;
+pub mod sdf_grid;
 pub mod shape;
 pub mod sphere;
 

@@ -5,6 +5,7 @@ use super::cylinder::Cylinder;
 use super::disk::Disk;
 use super::interaction::{PositionSample, SurfaceInteraction};
 use super::mesh::Mesh;
+use super::sdf_grid::SdfGrid;
 use super::sphere::Sphere;
 use super::{Bounds3, Ray};
 use crate::math::lanes::{Real, V3};
@@ -37,6 +38,8 @@ pub enum Shape {
     Disk(Disk),
     Cylinder(Cylinder),
     Mesh(Mesh),
+    /// Never an area light (refused at load, as by Mitsuba): no area or position sampling.
+    SdfGrid(SdfGrid),
 }
 
 impl Shape {
@@ -44,6 +47,7 @@ impl Shape {
     pub fn primitive_count(&self) -> usize {
         match self {
             Shape::Mesh(m) => m.triangle_count(),
+            Shape::SdfGrid(g) => g.primitive_count(),
             Shape::Sphere(_) | Shape::Disk(_) | Shape::Cylinder(_) => 1,
         }
     }
@@ -55,6 +59,7 @@ impl Shape {
             Shape::Disk(d) => d.bounds(),
             Shape::Cylinder(c) => c.bounds(),
             Shape::Mesh(m) => m.triangle_bounds(prim),
+            Shape::SdfGrid(g) => g.voxel_bounds(prim),
         }
     }
 
@@ -66,6 +71,7 @@ impl Shape {
             Shape::Sphere(s) => s.intersect(ray),
             Shape::Disk(d) => d.intersect(ray),
             Shape::Cylinder(c) => c.intersect(ray),
+            Shape::SdfGrid(g) => g.intersect(prim, ray),
         }
     }
 
@@ -78,6 +84,7 @@ impl Shape {
             Shape::Sphere(s) => s.interaction(ray, hit.t, uv),
             Shape::Disk(d) => d.interaction(ray, hit, uv),
             Shape::Cylinder(c) => c.interaction(ray, hit.t, uv),
+            Shape::SdfGrid(g) => g.interaction(prim, ray, hit),
         };
         si.shape = shape;
         si.prim = prim;
@@ -91,6 +98,8 @@ impl Shape {
             Shape::Disk(d) => d.area(),
             Shape::Cylinder(c) => c.area(),
             Shape::Mesh(m) => m.area(),
+            // Mitsuba's too: it is never sampled.
+            Shape::SdfGrid(_) => 0.0,
         }
     }
 
@@ -132,6 +141,7 @@ impl Shape {
             Shape::Disk(d) => d.sample_position(u),
             Shape::Cylinder(c) => c.sample_position(u),
             Shape::Mesh(m) => m.sample_position(uc, u),
+            Shape::SdfGrid(_) => unreachable!("an sdfgrid is never an area light (refused at load)"),
         }
     }
 }

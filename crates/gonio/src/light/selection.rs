@@ -263,6 +263,8 @@ fn vector_area(shape: &Shape) -> Vec3 {
     match shape {
         // An open cylinder's normals cancel round its circumference.
         Shape::Sphere(_) | Shape::Cylinder(_) => Vec3::ZERO,
+        // Never an emitter (refused at load); no area.
+        Shape::SdfGrid(_) => Vec3::ZERO,
         Shape::Disk(d) => d.normal() * d.area(),
         Shape::Mesh(m) => (0..m.triangle_count() as u32).fold(Vec3::ZERO, |a, t| {
             let [_, e1, e2] = m.triangle_edges(t);

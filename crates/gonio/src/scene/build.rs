@@ -11,6 +11,7 @@ use crate::film::FilmSpec;
 use crate::geometry::builtin_meshes::{cube, rectangle};
 use crate::geometry::cylinder::{Cylinder, CylinderError};
 use crate::geometry::disk::Disk;
+use crate::geometry::sdf_grid::{read_vol, SdfGrid};
 use crate::geometry::sphere::Sphere;
 use crate::geometry::{Mesh, Shape};
 use crate::light::{AreaLight, ConstantLight, DirectionalLight, EnvMap, Light, PointLight, SpotLight};
@@ -19,7 +20,7 @@ use crate::props::Props;
 use crate::spectrum::Rgb;
 use glam::Vec3;
 
-const SHAPES: &str = "sphere, rectangle, cube, disk, cylinder, obj, ply, serialized, shapegroup, instance";
+const SHAPES: &str = "sphere, rectangle, cube, disk, cylinder, obj, ply, serialized, sdfgrid, shapegroup, instance";
 
 impl Scene {
     /// Build every plugin of a parsed scene.
@@ -116,6 +117,9 @@ impl Built {
         self.shape_lights.push(match emitters.as_slice() {
             [] => None,
             [e] => {
+                if matches!(self.shapes.last(), Some(Shape::SdfGrid(_))) {
+                    return Err(Error::spec(e.at(), "an `sdfgrid` cannot be an area light (as in Mitsuba 3: it has no area to sample)"));
+                }
                 if e.plugin_type() != "area" {
                     return Err(Error::spec(e.at(), format!("a shape can only carry an `area` emitter, not `{}`", e.plugin_type())));
                 }
@@ -183,6 +187,21 @@ fn shape_from_props(p: &Props, outer: &Transform) -> Result<Shape> {
                     "a cylinder's `to_world` must keep its cross-section a circle (rotate, translate, scale x and y by one factor; no shear)",
                 ),
             })?)
+        }
+        "sdfgrid" => {
+            let filename = p.string("filename")?.ok_or_else(|| Error::spec(at, "`sdfgrid` needs a `filename` (a grid volume file)"))?;
+            let smooth = match p.string("normals")?.as_deref() {
+                None | Some("smooth") => true,
+                Some("analytic") => false,
+                Some(other) => {
+                    return Err(Error::spec(p.at_param("normals"), format!("`normals` is `smooth` or `analytic`, got `{other}`")))
+                }
+            };
+            let place = format!("{}: {filename}", p.at_param("filename"));
+            let bytes =
+                std::fs::read(&filename).map_err(|e| Error::spec(p.at_param("filename"), format!("cannot read {filename}: {e}")))?;
+            let (res, values) = read_vol(&bytes).map_err(|e| Error::spec(p.at_param("filename"), format!("{filename}: {e}")))?;
+            Shape::SdfGrid(SdfGrid::new(res, values, to_world, smooth, flip).map_err(|e| Error::spec(place.as_str(), e.to_string()))?)
         }
         kind @ ("obj" | "ply" | "serialized") => {
             let filename = p.string("filename")?.ok_or_else(|| Error::spec(at, format!("`{kind}` needs a `filename`")))?;

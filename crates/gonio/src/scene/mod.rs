@@ -168,7 +168,7 @@ impl Primitives {
                     }
                     p.spheres[p.sphere_packet[packet] as usize].set(lane, s);
                 }
-                Shape::Disk(_) | Shape::Cylinder(_) => p.others[packet] |= 1 << lane,
+                Shape::Disk(_) | Shape::Cylinder(_) | Shape::SdfGrid(_) => p.others[packet] |= 1 << lane,
             }
             p.slots.push(r);
         }
