@@ -52,7 +52,6 @@ const REFUSED: &[(&str, &str)] = &[
     ("t_normalmap", "test_normalmap_path.xml:7:9: unknown BSDF type `normalmap`"),
     ("t_principled1", "test_texturedprincipled1_path.xml:5:9: unknown BSDF type `principled`"),
     ("t_media_area", "test_homo_area_light_volpath.xml:8:5: unsupported element <medium> in <scene>"),
-    ("d_projector", "emitter_projector_textured.xml:4:5: unsupported emitter `projector`"),
     ("d_aov", "integrator_aov.xml:4:2: unsupported integrator `aov`"),
     ("d_sss", "medium_homogeneous_sss.xml:14:5: unsupported element <medium> in <scene>"),
     ("d_mesh_attribute", "texture_mesh_attribute_vertex.xml:6:13: unsupported texture `mesh_attribute`"),

@@ -15,6 +15,7 @@ fn decode_dynamic(path: &Path, bytes: &[u8], format: Format) -> Result<DynamicIm
         Format::Hdr => ImageFormat::Hdr,
         Format::Png => ImageFormat::Png,
         Format::Jpeg => ImageFormat::Jpeg,
+        Format::Bmp => ImageFormat::Bmp,
         Format::Exr => unreachable!("EXR is decoded by the exr module"),
     };
     ::image::load_from_memory_with_format(bytes, image_format)

@@ -6,6 +6,7 @@
 //! | Radiance (`.hdr`, `.rgbe`, `.pic`) | RGBE, run-length encoded or flat | RGBE, run-length encoded; negative and NaN samples as 0 |
 //! | PNG (`.png`) | 8- or 16-bit, grey or colour, alpha ignored; sRGB-decoded to linear | 8-bit RGB, sRGB-encoded, clamped to [0, 1], rounded |
 //! | JPEG (`.jpg`, `.jpeg`) | 8-bit, grey or colour; sRGB-decoded to linear | — |
+//! | BMP (`.bmp`) | 8-bit grey, colour or palette, alpha ignored; sRGB-decoded to linear | — |
 //!
 //! The format is taken from the file's magic bytes when they are recognised, else from the extension
 //! (case-insensitive). Integer images are taken to be sRGB-encoded, as Mitsuba 3 does for PNG and JPEG
@@ -106,9 +107,10 @@ enum Format {
     Hdr,
     Png,
     Jpeg,
+    Bmp,
 }
 
-const READ_EXTENSIONS: &str = ".exr, .hdr (also .rgbe, .pic), .png, .jpg, .jpeg";
+const READ_EXTENSIONS: &str = ".exr, .hdr (also .rgbe, .pic), .png, .jpg, .jpeg, .bmp";
 const WRITE_EXTENSIONS: &str = ".exr, .png, .hdr";
 
 fn format_from_extension(path: &Path) -> Option<Format> {
@@ -118,6 +120,7 @@ fn format_from_extension(path: &Path) -> Option<Format> {
         "hdr" | "rgbe" | "pic" => Some(Format::Hdr),
         "png" => Some(Format::Png),
         "jpg" | "jpeg" => Some(Format::Jpeg),
+        "bmp" => Some(Format::Bmp),
         _ => None,
     }
 }
@@ -131,6 +134,8 @@ fn format_from_magic(bytes: &[u8]) -> Option<Format> {
         Some(Format::Png)
     } else if bytes.starts_with(&[0xff, 0xd8, 0xff]) {
         Some(Format::Jpeg)
+    } else if bytes.starts_with(b"BM") {
+        Some(Format::Bmp)
     } else {
         None
     }
@@ -204,7 +209,7 @@ fn decode_stored_image(path: &Path, bytes: &[u8]) -> Result<Stored> {
     let format = format_of(path, bytes)?;
     let stored = guard(path, || match format {
         Format::Exr => exr::decode(path, bytes).map(Stored::Linear),
-        Format::Hdr | Format::Png | Format::Jpeg => ldr::decode_stored(path, bytes, format),
+        Format::Hdr | Format::Png | Format::Jpeg | Format::Bmp => ldr::decode_stored(path, bytes, format),
     })?;
     let (width, height) = stored.size();
     if width == 0 || height == 0 {
@@ -252,7 +257,9 @@ pub fn write_image_with_notes(path: &Path, img: &Image, notes: &[(&str, String)]
         Format::Exr => exr::encode(path, img, notes),
         Format::Png => ldr::encode_png(path, img),
         Format::Hdr => ldr::encode_hdr(path, img),
-        Format::Jpeg => Err(Error::format(path, "file name", format!("cannot write this extension; accepted: {WRITE_EXTENSIONS}"))),
+        Format::Jpeg | Format::Bmp => {
+            Err(Error::format(path, "file name", format!("cannot write this extension; accepted: {WRITE_EXTENSIONS}")))
+        }
     })?;
     write_atomically(path, &bytes)
 }
@@ -277,7 +284,7 @@ pub fn read_notes(path: &Path) -> Result<Vec<(String, String)>> {
 /// The format `path`'s extension asks for, or an error listing the extensions gonio writes.
 fn writable_format(path: &Path) -> Result<Format> {
     format_from_extension(path)
-        .filter(|f| *f != Format::Jpeg)
+        .filter(|f| !matches!(f, Format::Jpeg | Format::Bmp))
         .ok_or_else(|| Error::format(path, "file name", format!("cannot write this extension; accepted: {WRITE_EXTENSIONS}")))
 }
 
@@ -438,6 +445,25 @@ mod tests {
         assert!(img.data.iter().all(|v| (v - want).abs() < 0.01), "{:?}", img.get(0, 0));
         let white = read_image(&gpath).unwrap();
         assert!(white.data.iter().all(|v| (v - 1.0).abs() < 0.01));
+    }
+
+    /// BMP (8-bit, as Mitsuba's `flower.bmp`): samples sRGB-decoded, top row first, whatever the file's
+    /// row order; never written.
+    #[test]
+    fn reads_bmp() {
+        let dir = scratch_dir("bmp");
+        let mut img = ::image::RgbImage::new(3, 2);
+        img.put_pixel(0, 0, ::image::Rgb([255, 0, 0]));
+        img.put_pixel(2, 1, ::image::Rgb([0, 128, 255]));
+        let path = dir.join("two_rows.bmp");
+        img.save_with_format(&path, ::image::ImageFormat::Bmp).unwrap();
+        let read = read_image(&path).unwrap();
+        assert_eq!((read.width, read.height), (3, 2));
+        assert_eq!(read.get(0, 0), Rgb::new(1.0, 0.0, 0.0));
+        assert_eq!(read.get(2, 1), Rgb::new(0.0, srgb_to_linear(128.0 / 255.0), 1.0));
+        assert_eq!(read.get(1, 0), Rgb::ZERO);
+        let e = write_image(&dir.join("out.bmp"), &Image::new(1, 1)).unwrap_err().to_string();
+        assert!(e.contains("cannot write this extension"), "{e}");
     }
 
     #[test]

@@ -1,6 +1,6 @@
-//! Light sources: `area` (emission from a shape), `point`, `spot`, `directional`, and the environments
+//! Light sources: `area` (emission from a shape), `point`, `spot`, `projector`, `directional`, and the environments
 //! `constant` (uniform) and `envmap` (a lat-long image, importance sampled) — one file each, one variant
-//! each below. `point`, `spot` and `directional` are delta lights: only light sampling finds them.
+//! each below. `point`, `spot`, `projector` and `directional` are delta lights: only light sampling finds them.
 //!
 //! Every light answers three questions for next-event estimation and multiple importance sampling:
 //! sample a direction from a reference point ([`Light::sample_li`]), the solid-angle density of a
@@ -11,6 +11,7 @@ pub mod constant;
 pub mod directional;
 pub mod envmap;
 pub mod point;
+pub mod projector;
 pub mod selection;
 pub mod spot;
 
@@ -19,6 +20,7 @@ pub use constant::ConstantLight;
 pub use directional::DirectionalLight;
 pub use envmap::EnvMap;
 pub use point::PointLight;
+pub use projector::ProjectorLight;
 pub use selection::LightSelection;
 pub use spot::SpotLight;
 
@@ -46,6 +48,7 @@ pub enum Light {
     Area(AreaLight),
     Point(PointLight),
     Spot(SpotLight),
+    Projector(ProjectorLight),
     Directional(DirectionalLight),
     Constant(ConstantLight),
     EnvMap(EnvMap),
@@ -59,6 +62,7 @@ impl Light {
             Light::Area(l) => l.sample_li(&shapes[l.shape as usize], p, n, uc, u),
             Light::Point(l) => l.sample_li(p, n),
             Light::Spot(l) => l.sample_li(p, n),
+            Light::Projector(l) => l.sample_li(p, n),
             Light::Directional(l) => l.sample_li(p, n),
             Light::Constant(l) => l.sample_li(p, n, u),
             Light::EnvMap(l) => l.sample_li(p, n, uc, u),
@@ -68,7 +72,7 @@ impl Light {
     /// Whether the light is a delta distribution (no chance of hitting it by BSDF sampling).
     #[must_use]
     pub fn is_delta(&self) -> bool {
-        matches!(self, Light::Point(_) | Light::Spot(_) | Light::Directional(_))
+        matches!(self, Light::Point(_) | Light::Spot(_) | Light::Projector(_) | Light::Directional(_))
     }
 
     /// Whether the light is an environment (seen by rays that escape the scene).

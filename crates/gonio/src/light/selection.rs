@@ -12,6 +12,7 @@
 //! |---------------|--------------------------------------------------------------------------------------|
 //! | `point`       | I / d²                                                                               |
 //! | `spot`        | I · falloff(x) / d² (0 outside the cone, where the light brings nothing)              |
+//! | `projector`   | π · scale · Ē / d², Ē the projected image's mean (as if it shone in every direction) |
 //! | `directional` | E                                                                                    |
 //! | `constant`    | π L                                                                                  |
 //! | `envmap`      | π L̄, L̄ the map's mean radiance over the sphere                                       |
@@ -68,6 +69,8 @@ impl LightSelection {
             .map(|(index, light)| match light {
                 Light::Point(p) => Estimate::Point { position: p.position, intensity: p.intensity.luminance(), spot: None },
                 Light::Spot(s) => Estimate::Point { position: s.position, intensity: s.intensity.luminance(), spot: Some(index) },
+                // Its mean intensity in the frame, as if it shone everywhere.
+                Light::Projector(p) => Estimate::Point { position: p.position, intensity: p.mean_intensity(), spot: None },
                 Light::Directional(d) => Estimate::Distant(d.irradiance.luminance()),
                 Light::Constant(c) => Estimate::Distant(PI * c.radiance.luminance()),
                 Light::EnvMap(e) => Estimate::Distant(PI * e.mean_luminance()),
@@ -287,6 +290,7 @@ mod tests {
         match light {
             Light::Point(p) => f64::from(p.intensity.luminance()) / dist2(p.position),
             Light::Spot(s) => f64::from(s.intensity.luminance()) * f64::from(s.falloff_at(x)) / dist2(s.position),
+            Light::Projector(p) => f64::from(p.mean_intensity()) / dist2(p.position),
             Light::Directional(d) => f64::from(d.irradiance.luminance()),
             Light::Constant(c) => std::f64::consts::PI * f64::from(c.radiance.luminance()),
             Light::EnvMap(e) => std::f64::consts::PI * f64::from(e.mean_luminance()),

@@ -14,7 +14,7 @@ use crate::geometry::disk::Disk;
 use crate::geometry::sdf_grid::{read_vol, SdfGrid};
 use crate::geometry::sphere::Sphere;
 use crate::geometry::{Mesh, Shape};
-use crate::light::{AreaLight, ConstantLight, DirectionalLight, EnvMap, Light, PointLight, SpotLight};
+use crate::light::{AreaLight, ConstantLight, DirectionalLight, EnvMap, Light, PointLight, ProjectorLight, SpotLight};
 use crate::math::Transform;
 use crate::props::Props;
 use crate::spectrum::Rgb;
@@ -241,6 +241,7 @@ fn light_from_props(e: &Props) -> Result<Light> {
             Light::Point(PointLight { position, intensity: e.rgb_in("intensity", Rgb::ONE, 0.0, f32::MAX)? })
         }
         "spot" => Light::Spot(SpotLight::from_props(e)?),
+        "projector" => Light::Projector(ProjectorLight::from_props(e)?),
         "directional" => Light::Directional(DirectionalLight::from_props(e)?),
         "constant" => Light::Constant(ConstantLight { radiance: e.rgb_in("radiance", Rgb::ONE, 0.0, f32::MAX)? }),
         "envmap" => Light::EnvMap(EnvMap::from_props(e)?),
@@ -248,7 +249,7 @@ fn light_from_props(e: &Props) -> Result<Light> {
         other => {
             return Err(Error::spec(
                 e.at(),
-                format!("unsupported emitter `{other}` (gonio has: area, point, spot, directional, constant, envmap)"),
+                format!("unsupported emitter `{other}` (gonio has: area, point, spot, projector, directional, constant, envmap)"),
             ))
         }
     };

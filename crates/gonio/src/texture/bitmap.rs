@@ -109,6 +109,15 @@ impl Bitmap {
         Ok(Bitmap { texels, bilinear, wrap, to_uv: p.transform("to_uv")? })
     }
 
+    /// Width and height in pixels.
+    #[must_use]
+    pub fn resolution(&self) -> (usize, usize) {
+        match &self.texels {
+            Texels::Linear(image) => (image.width, image.height),
+            Texels::Bytes { image, .. } => (image.width, image.height),
+        }
+    }
+
     #[must_use]
     pub fn eval(&self, uv: Vec2) -> Rgb {
         match &self.texels {

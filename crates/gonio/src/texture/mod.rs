@@ -33,6 +33,15 @@ impl Texture {
         Ok(t)
     }
 
+    /// Width and height in texels: a bitmap's image, (1, 1) for others (as Mitsuba's `Texture::resolution`).
+    #[must_use]
+    pub fn resolution(&self) -> (usize, usize) {
+        match self {
+            Texture::Checkerboard(_) => (1, 1),
+            Texture::Bitmap(b) => b.resolution(),
+        }
+    }
+
     /// The colour at texture coordinates `uv`.
     #[inline]
     #[must_use]
