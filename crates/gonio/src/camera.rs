@@ -121,19 +121,7 @@ impl Camera {
                 format!("unsupported sensor `{}` (gonio has: perspective, thinlens, orthographic)", p.plugin_type()),
             ));
         }
-        let (fov, axis) = if p.has("fov") {
-            if p.has("focal_length") {
-                return Err(Error::spec(p.at_param("focal_length"), "give `fov` or `focal_length`, not both"));
-            }
-            (p.float_in("fov", 45.0, 1e-3, 179.999)?, p.string("fov_axis")?.unwrap_or_else(|| "x".into()))
-        } else {
-            let raw = p.string("focal_length")?.unwrap_or_else(|| "50mm".into());
-            let f: f32 = raw.trim().trim_end_matches("mm").trim().parse().ok().filter(|f: &f32| *f > 0.0).ok_or_else(|| {
-                Error::spec(p.at_param("focal_length"), format!("`focal_length` must be a length like \"50mm\", got \"{raw}\""))
-            })?;
-            let _ = p.string("fov_axis")?;
-            ((36.0f32.hypot(24.0) / (2.0 * f)).atan().to_degrees() * 2.0, "diagonal".to_string())
-        };
+        let (fov, axis) = p.field_of_view()?;
         let near = p.float_positive("near_clip", 1e-2)?;
         let far = p.float_positive("far_clip", 1e4)?;
         if far <= near {

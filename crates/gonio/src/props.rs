@@ -285,6 +285,24 @@ impl Props {
         }
     }
 
+    /// A pinhole's field of view as Mitsuba's `perspective` sensor and `projector` emitter read it: `fov`
+    /// degrees along `fov_axis` (default `x`), or else `focal_length` (default "50mm", a 35 mm film
+    /// equivalent) as a field of view along the diagonal; both given is an error.
+    pub fn field_of_view(&self) -> Result<(f32, String)> {
+        if self.has("fov") {
+            if self.has("focal_length") {
+                return Err(Error::spec(self.at_param("focal_length"), "give `fov` or `focal_length`, not both"));
+            }
+            return Ok((self.float_in("fov", 45.0, 1e-3, 179.999)?, self.string("fov_axis")?.unwrap_or_else(|| "x".into())));
+        }
+        let raw = self.string("focal_length")?.unwrap_or_else(|| "50mm".into());
+        let f: f32 = raw.trim().trim_end_matches("mm").trim().parse().ok().filter(|f: &f32| *f > 0.0).ok_or_else(|| {
+            Error::spec(self.at_param("focal_length"), format!("`focal_length` must be a length like \"50mm\", got \"{raw}\""))
+        })?;
+        let _ = self.string("fov_axis")?;
+        Ok(((36.0f32.hypot(24.0) / (2.0 * f)).atan().to_degrees() * 2.0, "diagonal".to_string()))
+    }
+
     /// Where parameter `name` was given, or where the plugin was when it was not.
     #[must_use]
     pub fn at_param(&self, name: &str) -> &str {

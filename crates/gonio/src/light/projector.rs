@@ -58,18 +58,7 @@ impl ProjectorLight {
             Irradiance::Uniform(_) => (1, 1),
         };
         let aspect = width as f32 / height as f32;
-        let (fov, axis) = if p.has("fov") {
-            if p.has("focal_length") {
-                return Err(Error::spec(p.at_param("focal_length"), "give `fov` or `focal_length`, not both"));
-            }
-            (p.float_in("fov", 45.0, 1e-3, 179.999)?, p.string("fov_axis")?.unwrap_or_else(|| "x".into()))
-        } else {
-            let raw = p.string("focal_length")?.unwrap_or_else(|| "50mm".into());
-            let f: f32 = raw.trim().trim_end_matches("mm").trim().parse().ok().filter(|f: &f32| *f > 0.0).ok_or_else(|| {
-                Error::spec(p.at_param("focal_length"), format!("`focal_length` must be a length like \"50mm\", got \"{raw}\""))
-            })?;
-            ((36.0f32.hypot(24.0) / (2.0 * f)).atan().to_degrees() * 2.0, "diagonal".to_string())
-        };
+        let (fov, axis) = p.field_of_view()?;
         let (tan_x, tan_y) = tan_half_angles(fov, &axis, aspect).ok_or_else(|| {
             Error::spec(p.at_param("fov_axis"), format!("`fov_axis` must be x, y, smaller, larger or diagonal, got `{axis}`"))
         })?;
