@@ -50,7 +50,6 @@ const MAX_ROUNDS: u32 = 4;
 const REFUSED: &[(&str, &str)] = &[
     ("t_bumpmap", "test_bumpmap_path.xml:7:9: unknown BSDF type `bumpmap`"),
     ("t_normalmap", "test_normalmap_path.xml:7:9: unknown BSDF type `normalmap`"),
-    ("t_principled1", "test_texturedprincipled1_path.xml:5:9: unknown BSDF type `principled`"),
     ("t_instancing", "test_instancing_path.xml:41:5: unsupported shape `shapegroup`"),
     ("t_media_area", "test_homo_area_light_volpath.xml:8:5: unsupported element <medium> in <scene>"),
     ("t_various_shapes", "test_various_shapes_path.xml:140:5: unsupported shape `shapegroup`"),
@@ -61,7 +60,6 @@ const REFUSED: &[(&str, &str)] = &[
     ("d_mesh_attribute", "texture_mesh_attribute_vertex.xml:6:13: unsupported texture `mesh_attribute`"),
     ("tu_shadow_art", "shadow_art.xml:60:2: unsupported shape `bsplinecurve`"),
     ("tu_polarizers", "polarizers.xml:27:9: unknown BSDF type `polarizer`"),
-    ("bl_test1", "test1.xml:41:3: unknown BSDF type `principled`"),
 ];
 
 /// Scenes that render but differ from Mitsuba by design: the ratio gonio/Mitsuba expected (checked like a
