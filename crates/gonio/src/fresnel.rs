@@ -60,6 +60,18 @@ pub fn refract_about(wi: Vec3, n: Vec3, eta: f32) -> Option<Refraction> {
     Some(Refraction { wt, eta })
 }
 
+/// [`refract_about`] in lanes for a direction on the side `n` points to: `cos` = w·n > 0 and `eta` = ηₜ/ηᵢ,
+/// the relative index along the path. Returns the transmitted direction (normalised; pbrt-v4 eq. 9.4 with
+/// the normal `n`) and cos²θₜ ([`cos2_transmitted`]), which is ≤ 0 where there is total internal
+/// reflection (the direction is then meaningless).
+#[inline(always)]
+#[must_use]
+pub fn refract_lanes<R: Real>(w: V3<R>, n: V3<R>, cos: R, eta: R) -> (V3<R>, R) {
+    let cos2_t = cos2_transmitted(cos, eta);
+    let wt = w.div(eta).neg().add(n.scale(cos / eta - cos2_t.sqrt())).normalize();
+    (wt, cos2_t)
+}
+
 /// cos²θₜ = 1 − (1 − cos²θᵢ)/η² written as (cos²θᵢ + η² − 1)/η², which keeps its precision when η ≈ 1
 /// and θᵢ is grazing (2026-11: the first form rounded to total internal reflection at η = 1 for
 /// |cos θᵢ| < 1.7e-4, found by the Mitsuba cross-check). ≤ 0 means total internal reflection.

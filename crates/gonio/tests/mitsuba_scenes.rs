@@ -50,14 +50,12 @@ const MAX_ROUNDS: u32 = 4;
 const REFUSED: &[(&str, &str)] = &[
     ("t_bumpmap", "test_bumpmap_path.xml:7:9: unknown BSDF type `bumpmap`"),
     ("t_normalmap", "test_normalmap_path.xml:7:9: unknown BSDF type `normalmap`"),
-    ("t_principled1", "test_texturedprincipled1_path.xml:5:9: unknown BSDF type `principled`"),
     ("t_media_area", "test_homo_area_light_volpath.xml:8:5: unsupported element <medium> in <scene>"),
     ("d_aov", "integrator_aov.xml:4:2: unsupported integrator `aov`"),
     ("d_sss", "medium_homogeneous_sss.xml:14:5: unsupported element <medium> in <scene>"),
     ("d_mesh_attribute", "texture_mesh_attribute_vertex.xml:6:13: unsupported texture `mesh_attribute`"),
     ("tu_shadow_art", "shadow_art.xml:60:2: unsupported shape `bsplinecurve`"),
     ("tu_polarizers", "polarizers.xml:27:9: unknown BSDF type `polarizer`"),
-    ("bl_test1", "test1.xml:41:3: unknown BSDF type `principled`"),
 ];
 
 /// Scenes that render but differ from Mitsuba by design: the ratio gonio/Mitsuba expected (checked like a

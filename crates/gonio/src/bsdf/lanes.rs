@@ -21,6 +21,7 @@
 use super::conductor::Conductor;
 use super::dielectric::Dielectric;
 use super::plastic::Plastic;
+use super::principled::PrincipledLobes;
 use super::rough_conductor::ConductorKernel;
 use super::rough_dielectric::DielectricKernel;
 use super::rough_plastic::PlasticKernel;
@@ -156,6 +157,7 @@ pub enum LaneKernel<'a> {
     Dielectric(&'a Dielectric),
     ThinDielectric(&'a ThinDielectric),
     Plastic(&'a Plastic),
+    Principled(PrincipledLobes),
 }
 
 impl Bsdf {
@@ -173,6 +175,7 @@ impl Bsdf {
             Bsdf::Dielectric(m) => Some(LaneKernel::Dielectric(m)),
             Bsdf::ThinDielectric(m) => Some(LaneKernel::ThinDielectric(m)),
             Bsdf::Plastic(m) => Some(LaneKernel::Plastic(m)),
+            Bsdf::Principled(m) => m.lanes().map(LaneKernel::Principled),
             _ => None,
         }
     }
@@ -194,6 +197,7 @@ impl LaneModel for LaneKernel<'_> {
             LaneKernel::Dielectric(k) => k.f_lanes(wo, wi),
             LaneKernel::ThinDielectric(k) => k.f_lanes(wo, wi),
             LaneKernel::Plastic(k) => k.f_lanes(wo, wi),
+            LaneKernel::Principled(k) => k.f_lanes(wo, wi),
         }
     }
 
@@ -207,6 +211,7 @@ impl LaneModel for LaneKernel<'_> {
             LaneKernel::Dielectric(k) => k.pdf_lanes(wo, wi),
             LaneKernel::ThinDielectric(k) => k.pdf_lanes(wo, wi),
             LaneKernel::Plastic(k) => k.pdf_lanes(wo, wi),
+            LaneKernel::Principled(k) => k.pdf_lanes(wo, wi),
         }
     }
 
@@ -220,6 +225,7 @@ impl LaneModel for LaneKernel<'_> {
             LaneKernel::Dielectric(k) => k.sample_lanes(wo, uc, ux, uy),
             LaneKernel::ThinDielectric(k) => k.sample_lanes(wo, uc, ux, uy),
             LaneKernel::Plastic(k) => k.sample_lanes(wo, uc, ux, uy),
+            LaneKernel::Principled(k) => k.sample_lanes(wo, uc, ux, uy),
         }
     }
 }

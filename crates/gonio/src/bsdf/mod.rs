@@ -295,6 +295,7 @@ pub mod merl;
 pub mod oren_nayar;
 pub mod phong;
 pub mod plastic;
+pub mod principled;
 pub mod rough_conductor;
 pub mod rough_dielectric;
 pub mod rough_plastic;
@@ -322,6 +323,7 @@ pub use merl::Merl;
 pub use oren_nayar::OrenNayar;
 pub use phong::Phong;
 pub use plastic::Plastic;
+pub use principled::Principled;
 pub use rough_conductor::{MicrofacetConductor, RoughConductor};
 pub use rough_dielectric::RoughDielectric;
 pub use rough_plastic::RoughPlastic;
@@ -779,6 +781,7 @@ bsdf_models! {
     Layered(Layered) = "layered",
     AshikhminShirley(AshikhminShirley) = "ashikhmin_shirley",
     Merl(Merl) = "merl",
+    Principled(Principled) = "principled",
 }
 
 impl Bsdf {
@@ -795,14 +798,15 @@ impl Bsdf {
     }
 
     /// Set this model's float parameter `name` in [0, 1] (a texture's value at a hit) without building it
-    /// again, where the model has such a parameter: the blend `weight`. `false` (the model unchanged)
-    /// otherwise. The float counterpart of [`Self::reflectance_slot`].
+    /// again, where the model has such a parameter: the blend `weight`, `principled`'s floats. `false` (the
+    /// model unchanged) otherwise. The float counterpart of [`Self::reflectance_slot`].
     pub fn set_unit_float(&mut self, name: &str, value: f32) -> bool {
         match (self, name) {
             (Bsdf::Blend(b), "weight") => {
                 b.set_weight(value);
                 true
             }
+            (Bsdf::Principled(p), name) => p.set_unit_float(name, value),
             _ => false,
         }
     }
@@ -836,6 +840,7 @@ impl Bsdf {
             (Bsdf::Plastic(p), "specular_reflectance") => Some(&mut p.specular_reflectance),
             (Bsdf::RoughPlastic(p), "diffuse_reflectance") => Some(&mut p.diffuse_reflectance),
             (Bsdf::RoughPlastic(p), "specular_reflectance") => Some(&mut p.coating.specular_reflectance),
+            (Bsdf::Principled(p), "base_color") => Some(&mut p.base_color),
             _ => None,
         }
     }

@@ -67,7 +67,7 @@ use super::lanes::{f_one, flag_lanes, pdf_one, sample_one, LaneModel, LaneSample
 use super::rough_conductor::{read_distribution, MicrofacetParams};
 use super::{BsdfFlags, BsdfModel, BsdfSample};
 use crate::error::{Error, Result};
-use crate::fresnel::{cos2_transmitted, fresnel_dielectric, fresnel_dielectric_lanes, reflect, reflect_lanes, refract_about};
+use crate::fresnel::{fresnel_dielectric, fresnel_dielectric_lanes, reflect, reflect_lanes, refract_about, refract_lanes};
 use crate::math::lanes::{channels, Real, V3};
 use crate::math::{Vec2, Vec3};
 use crate::microfacet::reflection::ReflectionLobe;
@@ -76,7 +76,7 @@ use crate::props::Props;
 use crate::spectrum::Rgb;
 
 /// The glossy transmission lobe.
-const GLOSSY_TRANSMISSION: BsdfFlags = BsdfFlags(2 | 8);
+pub(crate) const GLOSSY_TRANSMISSION: BsdfFlags = BsdfFlags(2 | 8);
 /// The transmitted lobe of `energy_compensation`.
 const DIFFUSE_TRANSMISSION: BsdfFlags = BsdfFlags(2 | 4);
 
@@ -788,6 +788,15 @@ impl<D: Distribution> DielectricLobe<D> {
         fresnel_dielectric_lanes(R::select(inside, -cos, cos), self.eta)
     }
 
+    /// The transmission lobe f(ωo, ωi) of Walter 2007 eq. 21 for ωo, ωi on opposite sides, ωo below the
+    /// surface in the lanes of `inside` (other lanes: unspecified): [`transmission_over_eta2`]
+    /// (Self::transmission_over_eta2) times ηo² (1 outside, η inside). Also `principled`'s transmission.
+    #[inline(always)]
+    pub(crate) fn transmission<R: Real>(&self, wo: V3<R>, wi: V3<R>, inside: R::Mask) -> R {
+        let over_eta2 = self.transmission_over_eta2(V3::select(inside, wi, wo), V3::select(inside, wo, wi));
+        R::select(inside, over_eta2 * (self.eta * self.eta), over_eta2)
+    }
+
     /// The transmission lobe divided by ηo², Walter 2007 eq. 21, for `w_out` above and `w_in` below the
     /// surface (other lanes: unspecified): symmetric in the two, never computed from which one is ωo.
     #[inline(always)]
@@ -817,7 +826,7 @@ impl<D: Distribution> DielectricLobe<D> {
 /// transmitted pdf of 8·10⁻⁶ by 2.6 % (f64 of the same f32 directions: 8.006·10⁻⁶; gonio 8.07·10⁻⁶ with
 /// the reciprocal, 7.86·10⁻⁶ with the division; Mitsuba 7.76·10⁻⁶; 2026-12-05).
 #[inline(always)]
-fn unit_upper<R: Real>(h: V3<R>) -> V3<R> {
+pub(crate) fn unit_upper<R: Real>(h: V3<R>) -> V3<R> {
     let wm = h.div(h.length());
     V3::select(wm.z.lt(R::splat(0.0)), wm.neg(), wm)
 }
@@ -838,9 +847,7 @@ impl<D: Distribution> LaneModel for DielectricLobe<D> {
             out = channels!(|c| R::select(ok, value * r[c], zero));
         }
         if R::any(crossing) {
-            // ηo = 1 outside, η inside.
-            let over_eta2 = self.transmission_over_eta2(V3::select(inside, wi, wo), V3::select(inside, wo, wi));
-            let value = R::select(inside, over_eta2 * (self.eta * self.eta), over_eta2);
+            let value = self.transmission(wo, wi, inside);
             out = channels!(|c| R::select(crossing, value * t[c], out[c]));
         }
         out
@@ -883,9 +890,7 @@ impl<D: Distribution> LaneModel for DielectricLobe<D> {
         let o_m = wo_up.dot(wm);
         let reflected = uc.lt(self.fresnel(o_m, inside));
         let wr = reflect_lanes(wo_up, wm).normalize();
-        // Refraction about ωm (pbrt-v4 eq. 9.4 with the normal ωm).
-        let cos2_t = cos2_transmitted(o_m, eta);
-        let wt = wo_up.div(eta).neg().add(wm.scale(o_m / eta - cos2_t.sqrt())).normalize();
+        let (wt, cos2_t) = refract_lanes(wo_up, wm, o_m, eta);
         let wi_up = V3::select(reflected, wr, wt);
         let sides = (reflected & wr.z.gt(zero)) | (!reflected & cos2_t.gt(zero) & wt.z.lt(zero));
         let valid = !wo.z.eq(zero) & o_m.gt(zero) & sides;

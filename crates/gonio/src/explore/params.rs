@@ -79,6 +79,7 @@ const SOURCES: &[(&str, &str)] = &[
     ("layered", include_str!("../bsdf/layered.rs")),
     ("ashikhmin_shirley", include_str!("../bsdf/ashikhmin_shirley.rs")),
     ("merl", include_str!("../bsdf/merl.rs")),
+    ("principled", include_str!("../bsdf/principled.rs")),
 ];
 
 fn source(plugin: &str) -> Option<&'static str> {

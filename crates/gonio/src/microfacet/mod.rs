@@ -66,6 +66,7 @@ pub mod beckmann;
 pub mod blinn;
 pub mod distribution;
 pub mod ggx;
+pub mod gtr1;
 pub mod reflection;
 #[cfg(test)]
 mod tests;
@@ -75,6 +76,7 @@ pub use beckmann::{beckmann_lambda, Beckmann};
 pub use blinn::{alpha_from_blinn_exponent, blinn_exponent_from_alpha, Blinn};
 pub use distribution::Distribution;
 pub use ggx::Ggx;
+pub use gtr1::Gtr1;
 
 use crate::math::lanes::V3;
 use crate::math::{Vec2, Vec3};

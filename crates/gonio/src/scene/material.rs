@@ -17,7 +17,25 @@ const CACHE_CAPACITY: usize = 256;
 
 /// BSDF parameters that take a float, not a colour: a texture there is read with Mitsuba's scalar lookup
 /// ([`Texture::eval_1`]), which differs from the colour lookup for checkerboards.
-const SCALAR_PARAMETERS: &[&str] = &["alpha", "alpha_u", "alpha_v", "opacity", "weight", "exponent"];
+const SCALAR_PARAMETERS: &[&str] = &[
+    "alpha",
+    "alpha_u",
+    "alpha_v",
+    "opacity",
+    "weight",
+    "exponent",
+    // principled
+    "roughness",
+    "anisotropic",
+    "metallic",
+    "spec_trans",
+    "spec_tint",
+    "sheen",
+    "sheen_tint",
+    "flatness",
+    "clearcoat",
+    "clearcoat_gloss",
+];
 
 /// One shape's reflection model.
 #[derive(Debug)]
@@ -262,6 +280,13 @@ mod tests {
             ("roughplastic", r#"<string name="distribution" value="ggx"/>"#, vec![("specular_reflectance", a, b)]),
             ("roughplastic", "", vec![("diffuse_reflectance", a, "0.5, 1.5, 0.5")]),
             ("blendbsdf", blend, vec![("weight", "0.2", "0.7")]),
+            ("principled", "", vec![("base_color", a, b)]),
+            (
+                "principled",
+                r#"<float name="roughness" value="0.3"/>"#,
+                vec![("metallic", "0.7", "0.1"), ("clearcoat", "0.9", "0.1"), ("spec_trans", "0.2", "0.8"), ("sheen", "0.2", "0.9")],
+            ),
+            ("principled", "", vec![("roughness", "0.05", "0.8"), ("anisotropic", "0.05", "0.8"), ("flatness", "1", "0")]),
             ("blendbsdf", blend, vec![("weight", "1.5", "0.3")]),
         ];
         for (plugin, extra, textured) in &cases {

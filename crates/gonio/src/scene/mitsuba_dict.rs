@@ -90,7 +90,6 @@ const CLASSES: &[(&str, &[&str])] = &[
             "pplastic",
             "bumpmap",
             "normalmap",
-            "principled",
             "principledthindielectric",
             "polarizer",
             "retarder",
