@@ -73,7 +73,7 @@
 //! `tests::matches_mitsuba` checks f·|cos θi| and pdf against `eval` and `pdf` of Mitsuba at 1120 pairs of
 //! directions over 14 parameter sets (80 each, from above and below, reflected and transmitted, half of
 //! them drawn by Mitsuba's `sample`; the numbers in `tests/data/principled_mitsuba.json`, made by
-//! `tests/principled_mitsuba.py`): 4480 values agree within 4.4e-5 relative (2026-12-05; floor 1e-6 of a
+//! `tools/principled_reference.py`): 4480 values agree within 4.4e-5 relative (2026-12-05; floor 1e-6 of a
 //! set's largest value), the differences of f32 rounding (GTR1's D is written as sin²θ + α² cos²θ where
 //! Mitsuba's 1 + (α² − 1) cos²θ cancels at the pole, Schlick's blend and cos θd taken as |ωo + ωi|/2).
 //!
@@ -603,7 +603,7 @@ mod tests {
 
     /// Reflection above and below, transmission both ways: f·|cos θi| and pdf against Mitsuba 3.9.1
     /// `scalar_rgb` (`eval`, `pdf`) at the pairs of `tests/data/principled_mitsuba.json`, written by
-    /// `tests/principled_mitsuba.py`. Both compute in f32.
+    /// `tools/principled_reference.py`. Both compute in f32.
     #[test]
     fn matches_mitsuba() {
         let text = include_str!("../../tests/data/principled_mitsuba.json");

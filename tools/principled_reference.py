@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Reference values of Mitsuba 3's `principled` for gonio's `bsdf::principled::tests::matches_mitsuba`.
 
-    .venv/bin/python crates/gonio/tests/principled_mitsuba.py > crates/gonio/tests/data/principled_mitsuba.json
+    .venv/bin/python tools/principled_reference.py > crates/gonio/tests/data/principled_mitsuba.json
 
 For each parameter set, 80 pairs (wo, wi) in gonio's naming (Mitsuba's si.wi = wo, its bs.wo = wi): half
 with wi drawn by Mitsuba's own `sample` (so that most land in the lobes, transmitted ones included), half
