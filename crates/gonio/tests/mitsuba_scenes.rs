@@ -55,7 +55,6 @@ const REFUSED: &[(&str, &str)] = &[
     ("d_sss", "medium_homogeneous_sss.xml:14:5: unsupported element <medium> in <scene>"),
     ("d_mesh_attribute", "texture_mesh_attribute_vertex.xml:6:13: unsupported texture `mesh_attribute`"),
     ("tu_shadow_art", "shadow_art.xml:60:2: unsupported shape `bsplinecurve`"),
-    ("tu_polarizers", "polarizers.xml:27:9: unknown BSDF type `polarizer`"),
 ];
 
 /// Scenes that render but differ from Mitsuba by design: the ratio gonio/Mitsuba expected (checked like a

@@ -21,6 +21,7 @@
 use super::conductor::Conductor;
 use super::dielectric::Dielectric;
 use super::plastic::Plastic;
+use super::polarizer::Polarizer;
 use super::principled::PrincipledLobes;
 use super::rough_conductor::ConductorKernel;
 use super::rough_dielectric::DielectricKernel;
@@ -157,6 +158,7 @@ pub enum LaneKernel<'a> {
     Dielectric(&'a Dielectric),
     ThinDielectric(&'a ThinDielectric),
     Plastic(&'a Plastic),
+    Polarizer(&'a Polarizer),
     Principled(PrincipledLobes),
 }
 
@@ -175,6 +177,7 @@ impl Bsdf {
             Bsdf::Dielectric(m) => Some(LaneKernel::Dielectric(m)),
             Bsdf::ThinDielectric(m) => Some(LaneKernel::ThinDielectric(m)),
             Bsdf::Plastic(m) => Some(LaneKernel::Plastic(m)),
+            Bsdf::Polarizer(m) => Some(LaneKernel::Polarizer(m)),
             Bsdf::Principled(m) => m.lanes().map(LaneKernel::Principled),
             _ => None,
         }
@@ -197,6 +200,7 @@ impl LaneModel for LaneKernel<'_> {
             LaneKernel::Dielectric(k) => k.f_lanes(wo, wi),
             LaneKernel::ThinDielectric(k) => k.f_lanes(wo, wi),
             LaneKernel::Plastic(k) => k.f_lanes(wo, wi),
+            LaneKernel::Polarizer(k) => k.f_lanes(wo, wi),
             LaneKernel::Principled(k) => k.f_lanes(wo, wi),
         }
     }
@@ -211,6 +215,7 @@ impl LaneModel for LaneKernel<'_> {
             LaneKernel::Dielectric(k) => k.pdf_lanes(wo, wi),
             LaneKernel::ThinDielectric(k) => k.pdf_lanes(wo, wi),
             LaneKernel::Plastic(k) => k.pdf_lanes(wo, wi),
+            LaneKernel::Polarizer(k) => k.pdf_lanes(wo, wi),
             LaneKernel::Principled(k) => k.pdf_lanes(wo, wi),
         }
     }
@@ -225,6 +230,7 @@ impl LaneModel for LaneKernel<'_> {
             LaneKernel::Dielectric(k) => k.sample_lanes(wo, uc, ux, uy),
             LaneKernel::ThinDielectric(k) => k.sample_lanes(wo, uc, ux, uy),
             LaneKernel::Plastic(k) => k.sample_lanes(wo, uc, ux, uy),
+            LaneKernel::Polarizer(k) => k.sample_lanes(wo, uc, ux, uy),
             LaneKernel::Principled(k) => k.sample_lanes(wo, uc, ux, uy),
         }
     }

@@ -295,6 +295,7 @@ pub mod merl;
 pub mod oren_nayar;
 pub mod phong;
 pub mod plastic;
+pub mod polarizer;
 pub mod principled;
 pub mod rough_conductor;
 pub mod rough_dielectric;
@@ -323,6 +324,7 @@ pub use merl::Merl;
 pub use oren_nayar::OrenNayar;
 pub use phong::Phong;
 pub use plastic::Plastic;
+pub use polarizer::Polarizer;
 pub use principled::Principled;
 pub use rough_conductor::{MicrofacetConductor, RoughConductor};
 pub use rough_dielectric::RoughDielectric;
@@ -782,6 +784,7 @@ bsdf_models! {
     AshikhminShirley(AshikhminShirley) = "ashikhmin_shirley",
     Merl(Merl) = "merl",
     Principled(Principled) = "principled",
+    Polarizer(Polarizer) = "polarizer",
 }
 
 impl Bsdf {
@@ -841,6 +844,7 @@ impl Bsdf {
             (Bsdf::RoughPlastic(p), "diffuse_reflectance") => Some(&mut p.diffuse_reflectance),
             (Bsdf::RoughPlastic(p), "specular_reflectance") => Some(&mut p.coating.specular_reflectance),
             (Bsdf::Principled(p), "base_color") => Some(&mut p.base_color),
+            (Bsdf::Polarizer(p), "transmittance") => Some(&mut p.transmittance),
             _ => None,
         }
     }

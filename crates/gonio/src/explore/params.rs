@@ -80,6 +80,7 @@ const SOURCES: &[(&str, &str)] = &[
     ("ashikhmin_shirley", include_str!("../bsdf/ashikhmin_shirley.rs")),
     ("merl", include_str!("../bsdf/merl.rs")),
     ("principled", include_str!("../bsdf/principled.rs")),
+    ("polarizer", include_str!("../bsdf/polarizer.rs")),
 ];
 
 fn source(plugin: &str) -> Option<&'static str> {
