@@ -88,7 +88,7 @@ fn unknown_plugin() {
         "blob.xml",
         SPHERE,
         r#"<shape type="blob"/>"#,
-        "DIR/blob.xml:9:5: unsupported shape `blob` (gonio has: sphere, rectangle, cube, disk, cylinder, obj, ply, serialized)",
+        "DIR/blob.xml:9:5: unsupported shape `blob` (gonio has: sphere, rectangle, cube, disk, cylinder, obj, ply, serialized, sdfgrid, shapegroup, instance)",
     );
 }
 

@@ -239,7 +239,7 @@ impl LaneModel for LaneKernel<'_> {
 /// Any model in lanes, for the lanes of a mask (the others' results are unspecified): the path tracer
 /// calls it once for the lanes of a packet that share a model, and the batch drivers (through
 /// `impl LaneModel for Bsdf`) for every model. Models with a kernel run it in lanes; the composites
-/// (`twosided`, `mask`, `sum`, `blendbsdf`) combine their components' lanes; a model that cannot vectorise
+/// (`twosided`, `mask`, `normalmap`, `sum`, `blendbsdf`) combine their components' lanes; a model that cannot vectorise
 /// (a random walk, a table lookup per lane, a composite inside a composite) runs its single calls lane by
 /// lane, inside this dispatch ([`each_lane`]) rather than in its callers.
 impl Bsdf {
@@ -252,6 +252,7 @@ impl Bsdf {
         match self {
             Bsdf::TwoSided(m) => m.f_lanes_where(wo, wi, active),
             Bsdf::Mask(m) => m.f_lanes_where(wo, wi, active),
+            Bsdf::NormalMap(m) => m.f_lanes_where(wo, wi, active),
             _ => self.leaf_f(wo, wi, active),
         }
     }
@@ -265,6 +266,7 @@ impl Bsdf {
         match self {
             Bsdf::TwoSided(m) => m.pdf_lanes_where(wo, wi, active),
             Bsdf::Mask(m) => m.pdf_lanes_where(wo, wi, active),
+            Bsdf::NormalMap(m) => m.pdf_lanes_where(wo, wi, active),
             _ => self.leaf_pdf(wo, wi, active),
         }
     }
@@ -278,6 +280,7 @@ impl Bsdf {
         match self {
             Bsdf::TwoSided(m) => m.sample_lanes_where(wo, uc, ux, uy, active),
             Bsdf::Mask(m) => m.sample_lanes_where(wo, uc, ux, uy, active),
+            Bsdf::NormalMap(m) => m.sample_lanes_where(wo, uc, ux, uy, active),
             _ => self.leaf_sample(wo, uc, ux, uy, active),
         }
     }

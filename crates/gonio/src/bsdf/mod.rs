@@ -292,6 +292,7 @@ pub mod layered;
 pub mod mask;
 pub mod measured;
 pub mod merl;
+pub mod normal_map;
 pub mod oren_nayar;
 pub mod phong;
 pub mod plastic;
@@ -321,6 +322,7 @@ pub use layered::Layered;
 pub use mask::Mask;
 pub use measured::Measured;
 pub use merl::Merl;
+pub use normal_map::NormalMap;
 pub use oren_nayar::OrenNayar;
 pub use phong::Phong;
 pub use plastic::Plastic;
@@ -785,6 +787,7 @@ bsdf_models! {
     Merl(Merl) = "merl",
     Principled(Principled) = "principled",
     Polarizer(Polarizer) = "polarizer",
+    NormalMap(NormalMap) = "normalmap",
 }
 
 impl Bsdf {
@@ -845,6 +848,7 @@ impl Bsdf {
             (Bsdf::RoughPlastic(p), "specular_reflectance") => Some(&mut p.coating.specular_reflectance),
             (Bsdf::Principled(p), "base_color") => Some(&mut p.base_color),
             (Bsdf::Polarizer(p), "transmittance") => Some(&mut p.transmittance),
+            (Bsdf::NormalMap(m), "normalmap") => Some(&mut m.normalmap),
             _ => None,
         }
     }

@@ -81,6 +81,7 @@ const SOURCES: &[(&str, &str)] = &[
     ("merl", include_str!("../bsdf/merl.rs")),
     ("principled", include_str!("../bsdf/principled.rs")),
     ("polarizer", include_str!("../bsdf/polarizer.rs")),
+    ("normalmap", include_str!("../bsdf/normal_map.rs")),
 ];
 
 fn source(plugin: &str) -> Option<&'static str> {

@@ -83,10 +83,7 @@ const CLASSES: &[(&str, &[&str])] = &[
         ],
     ),
     ("texture", &["bitmap", "checkerboard", "mesh_attribute", "volume"]),
-    (
-        "bsdf",
-        &["hair", "pplastic", "bumpmap", "normalmap", "principledthindielectric", "retarder", "circular", "measured_polarized", "null"],
-    ),
+    ("bsdf", &["hair", "pplastic", "bumpmap", "principledthindielectric", "retarder", "circular", "measured_polarized", "null"]),
     ("medium", &["homogeneous", "heterogeneous"]),
     ("phase", &["isotropic", "hg", "rayleigh", "blendphase", "tabphase", "sggx"]),
 ];
