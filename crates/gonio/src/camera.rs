@@ -66,8 +66,8 @@ impl Camera {
     /// A camera for a film of `width × height` pixels with field of view `fov_deg` along `axis`.
     #[allow(clippy::too_many_arguments)] // one argument per plugin parameter, as in the table above
     pub fn new(to_world: Transform, fov_deg: f32, axis: &str, width: u32, height: u32, near: f32, far: f32, at: &str) -> Result<Self> {
-        let (tan_half_x, tan_half_y) = crate::math::perspective::tan_half_angles(fov_deg, axis, width as f32 / height as f32)
-            .ok_or_else(|| Error::spec(at, format!("`fov_axis` must be x, y, smaller, larger or diagonal, got `{axis}`")))?;
+        let (tan_half_x, tan_half_y) =
+            crate::math::perspective::tan_half_angles(fov_deg, axis, width as f32 / height as f32).map_err(|e| Error::spec(at, e))?;
         Ok(Camera { to_world, tan_half_x, tan_half_y, near, far, orthographic: None, aperture_radius: 0.0, focus_distance: far })
     }
 

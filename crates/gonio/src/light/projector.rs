@@ -59,9 +59,7 @@ impl ProjectorLight {
         };
         let aspect = width as f32 / height as f32;
         let (fov, axis) = p.field_of_view()?;
-        let (tan_x, tan_y) = tan_half_angles(fov, &axis, aspect).ok_or_else(|| {
-            Error::spec(p.at_param("fov_axis"), format!("`fov_axis` must be x, y, smaller, larger or diagonal, got `{axis}`"))
-        })?;
+        let (tan_x, tan_y) = tan_half_angles(fov, &axis, aspect).map_err(|e| Error::spec(p.at_param("fov_axis"), e))?;
         let to_world = p.transform("to_world")?;
         Ok(ProjectorLight {
             position: to_world.point(Vec3::ZERO),

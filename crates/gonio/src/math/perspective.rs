@@ -6,10 +6,9 @@
 use glam::Vec3;
 
 /// The tangents of the half field of view along x and y for a field of view of `fov_deg` degrees along
-/// `axis` (`x`, `y`, `diagonal`, `smaller` or `larger`) of an image of `aspect` = width / height; `None`
-/// for another axis name.
-#[must_use]
-pub fn tan_half_angles(fov_deg: f32, axis: &str, aspect: f32) -> Option<(f32, f32)> {
+/// `axis` (`x`, `y`, `diagonal`, `smaller` or `larger`) of an image of `aspect` = width / height; for
+/// another axis name, the message that says so (the caller gives its place).
+pub fn tan_half_angles(fov_deg: f32, axis: &str, aspect: f32) -> Result<(f32, f32), String> {
     let t = (fov_deg.to_radians() * 0.5).tan();
     let axis = match axis {
         "smaller" if aspect > 1.0 => "y",
@@ -19,13 +18,13 @@ pub fn tan_half_angles(fov_deg: f32, axis: &str, aspect: f32) -> Option<(f32, f3
         other => other,
     };
     match axis {
-        "x" => Some((t, t / aspect)),
-        "y" => Some((t * aspect, t)),
+        "x" => Ok((t, t / aspect)),
+        "y" => Ok((t * aspect, t)),
         "diagonal" => {
             let diag = (1.0 + 1.0 / (aspect * aspect)).sqrt();
-            Some((t / diag, t / (diag * aspect)))
+            Ok((t / diag, t / (diag * aspect)))
         }
-        _ => None,
+        other => Err(format!("`fov_axis` must be x, y, smaller, larger or diagonal, got `{other}`")),
     }
 }
 
@@ -51,6 +50,6 @@ mod tests {
         }
         assert_eq!(tan_half_angles(40.0, "smaller", 2.0), tan_half_angles(40.0, "y", 2.0));
         assert_eq!(tan_half_angles(40.0, "larger", 0.5), tan_half_angles(40.0, "y", 0.5));
-        assert_eq!(tan_half_angles(40.0, "z", 1.0), None);
+        assert_eq!(tan_half_angles(40.0, "z", 1.0), Err("`fov_axis` must be x, y, smaller, larger or diagonal, got `z`".into()));
     }
 }
