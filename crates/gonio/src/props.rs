@@ -403,6 +403,19 @@ impl Props {
         found
     }
 
+    /// The nested plugin at `path` (names of nested plugins from this one, as [`Props::take_textures`]
+    /// gives them; the empty path is this one), without marking anything as read.
+    #[must_use]
+    pub fn nested_at(&self, path: &[String]) -> Option<&Props> {
+        match path {
+            [] => Some(self),
+            [first, rest @ ..] => match &self.entries.iter().find(|e| &e.name == first)?.value {
+                Value::Nested(p) => p.nested_at(rest),
+                _ => None,
+            },
+        }
+    }
+
     /// Set a parameter at a path returned by [`Props::take_textures`]; `at` locates it in messages.
     pub fn set_path(&mut self, path: &[String], value: Value, at: &str) {
         match path {

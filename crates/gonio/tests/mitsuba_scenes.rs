@@ -48,7 +48,6 @@ const MAX_ROUNDS: u32 = 4;
 
 /// Scenes gonio refuses, with the end of the place in the error ("file:line:col") and what it says.
 const REFUSED: &[(&str, &str)] = &[
-    ("t_bumpmap", "test_bumpmap_path.xml:7:9: unknown BSDF type `bumpmap`"),
     ("t_media_area", "test_homo_area_light_volpath.xml:8:5: unsupported element <medium> in <scene>"),
     ("d_aov", "integrator_aov.xml:4:2: unsupported integrator `aov`"),
     ("d_sss", "medium_homogeneous_sss.xml:14:5: unsupported element <medium> in <scene>"),

@@ -731,8 +731,10 @@ macro_rules! bsdf_models {
             pub fn from_props(props: &Props) -> Result<Bsdf> {
                 let bsdf = match props.plugin_type() {
                     $( $plugin => <$ty>::from_props(props)?.into(), )*
+                    // A normal map whose normal a scene's material sets from a height field at each hit.
+                    "bumpmap" => NormalMap::from_props(props)?.into(),
                     other => return Err(Error::spec(props.at(), format!(
-                        "unknown BSDF type `{other}`; expected one of: {}", PLUGINS.join(", ")))),
+                        "unknown BSDF type `{other}`; expected one of: {}, bumpmap", PLUGINS.join(", ")))),
                 };
                 props.finish()?;
                 Ok(bsdf)

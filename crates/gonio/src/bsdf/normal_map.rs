@@ -1,6 +1,8 @@
 //! `normalmap` — a nested model seen in a shading frame turned to a normal read from a texture (Mitsuba 3's
-//! `normalmap`): normal mapping, detail without geometry. Also the core of `bumpmap` ([`super::bump_map`]),
-//! whose normal comes from a height texture's gradient.
+//! `normalmap`): normal mapping, detail without geometry. Also Mitsuba's `bumpmap` (parameters `scale`,
+//! default 1, and one height texture): the same model, whose normal a scene's material computes at each
+//! hit from the height field's gradient and the surface's ∂p/∂u, ∂p/∂v (`scene::material::bump_normal`);
+//! without a surface (e.g. `gonio check`) a bump map leaves the shading normal as it is.
 //!
 //! | parameter                | type          | default   | meaning                                        |
 //! |--------------------------|---------------|-----------|------------------------------------------------|
@@ -63,7 +65,13 @@ impl NormalMap {
         NormalMap { normalmap, flip_invalid_normals: true, use_shadowing_function: true, nested: Box::new(nested) }
     }
 
+    /// A `normalmap`, or a `bumpmap`: the same model, whose `normalmap` colour the scene's material sets
+    /// from the height texture at each hit (`scene::material::bump_normal`; the texture and its `scale`
+    /// are the material's).
     pub fn from_props(p: &Props) -> Result<Self> {
+        if p.plugin_type() == "bumpmap" {
+            p.float_in("scale", 1.0, f32::MIN, f32::MAX)?;
+        }
         let normalmap = p.rgb_in("normalmap", Rgb::new(0.5, 0.5, 1.0), f32::MIN, f32::MAX)?;
         let flip_invalid_normals = p.bool("flip_invalid_normals", true)?;
         let use_shadowing_function = p.bool("use_shadowing_function", true)?;

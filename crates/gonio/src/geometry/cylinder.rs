@@ -137,6 +137,13 @@ impl Cylinder {
         (self.to_world.point(on), self.to_world.vector(radial), on)
     }
 
+    /// ∂p/∂u = 2π (−y, x, 0) and ∂p/∂v = (0, 0, L) (module doc) at the surface point `p`, in world space.
+    #[must_use]
+    pub fn uv_partials(&self, p: Vec3) -> (Vec3, Vec3) {
+        let (_, _, local) = self.surface(p);
+        (self.to_world.vector(Vec3::new(-local.y, local.x, 0.0) * (2.0 * PI)), self.to_world.vector(Vec3::new(0.0, 0.0, self.length)))
+    }
+
     /// The interaction at parameter `t` of `ray`; the point is re-projected onto the surface.
     #[must_use]
     pub fn interaction(&self, ray: &Ray, t: f32, uv: bool) -> SurfaceInteraction {

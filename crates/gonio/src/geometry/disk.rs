@@ -72,6 +72,16 @@ impl Disk {
         Frame::from_normal_and_dp_du(self.normal, self.to_world.vector(Vec3::new(x, y, 0.0)))
     }
 
+    /// ∂p/∂u and ∂p/∂v at the surface point `p` for u = r, v = φ/2π: (cos φ, sin φ, 0) and 2π (−y, x, 0)
+    /// in object space (φ = 0 at the centre), mapped to world space.
+    #[must_use]
+    pub fn uv_partials(&self, p: Vec3) -> (Vec3, Vec3) {
+        let q = self.to_world.inverse().point(p);
+        let r = q.x.hypot(q.y);
+        let radial = if r > 0.0 { Vec3::new(q.x / r, q.y / r, 0.0) } else { Vec3::X };
+        (self.to_world.vector(radial), self.to_world.vector(Vec3::new(-q.y, q.x, 0.0) * (2.0 * PI)))
+    }
+
     /// The interaction for a hit whose `uv` holds the object-space (x, y).
     #[must_use]
     pub fn interaction(&self, ray: &Ray, hit: &PrimHit, uv: bool) -> SurfaceInteraction {

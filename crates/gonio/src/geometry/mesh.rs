@@ -374,6 +374,25 @@ impl Mesh {
         }
     }
 
+    /// ∂p/∂u and ∂p/∂v of triangle `tri`: the solution of [Δp₁ Δp₂] = [∂p/∂u ∂p/∂v] [Δuv₁ Δuv₂] over its
+    /// edges (pbrt-v4 §6.5.3, as Mitsuba's `compute_surface_interaction`); the edges p₁ − p₀ and p₂ − p₀
+    /// themselves without texture coordinates (uv are then the barycentrics) or where the texture
+    /// coordinates are degenerate.
+    #[must_use]
+    pub fn uv_partials(&self, tri: u32) -> (Vec3, Vec3) {
+        let [p0, p1, p2] = self.vertices(tri);
+        let (e1, e2) = (p1 - p0, p2 - p0);
+        let Some(uvs) = &self.uvs else { return (e1, e2) };
+        let idx = self.indices[tri as usize];
+        let (uv0, uv1, uv2) = (uvs[idx[0] as usize], uvs[idx[1] as usize], uvs[idx[2] as usize]);
+        let (duv1, duv2) = (uv1 - uv0, uv2 - uv0);
+        let det = duv1.x * duv2.y - duv1.y * duv2.x;
+        if det == 0.0 {
+            return (e1, e2);
+        }
+        ((e1 * duv2.y - e2 * duv1.y) / det, (e2 * duv1.x - e1 * duv2.x) / det)
+    }
+
     /// The shading frame of triangle `tri` where it is flat-shaded ([`Mesh::flat_frames`]; without vertex
     /// normals its `n` is the geometric normal), `None` where it is smooth-shaded.
     #[inline]

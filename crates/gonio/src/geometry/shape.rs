@@ -91,6 +91,20 @@ impl Shape {
         si
     }
 
+    /// ∂p/∂u and ∂p/∂v (world space) at the point `p` of primitive `prim`, of the parameterisation that
+    /// gives the shape its texture coordinates (Mitsuba's, shape by shape): what `bumpmap` perturbs. An
+    /// `sdfgrid` has no parameterisation (its uv are 0): its shading frame's tangents `s`, `t` stand in.
+    #[must_use]
+    pub fn uv_partials(&self, prim: u32, p: glam::Vec3, shading: &crate::math::Frame) -> (glam::Vec3, glam::Vec3) {
+        match self {
+            Shape::Mesh(m) => m.uv_partials(prim),
+            Shape::Sphere(s) => s.uv_partials(p),
+            Shape::Disk(d) => d.uv_partials(p),
+            Shape::Cylinder(c) => c.uv_partials(p),
+            Shape::SdfGrid(_) => (shading.s, shading.t),
+        }
+    }
+
     #[must_use]
     pub fn area(&self) -> f32 {
         match self {

@@ -94,6 +94,17 @@ impl Sphere {
         Vec2::new(phi / (2.0 * PI), local.z.clamp(-1.0, 1.0).acos() / PI)
     }
 
+    /// ∂p/∂u and ∂p/∂v at the surface point `p` for u = φ/2π, v = θ/π in object space: 2π (−y, x, 0) and
+    /// π (z cos φ, z sin φ, −sin θ) there (φ = 0 at the poles), mapped to world space.
+    #[must_use]
+    pub fn uv_partials(&self, p: Vec3) -> (Vec3, Vec3) {
+        let q = self.to_object.point(p);
+        let rd = q.x.hypot(q.y);
+        let (cos_phi, sin_phi) = if rd > 0.0 { (q.x / rd, q.y / rd) } else { (1.0, 0.0) };
+        let to_world = self.to_object.inverse();
+        (to_world.vector(Vec3::new(-q.y, q.x, 0.0) * (2.0 * PI)), to_world.vector(Vec3::new(q.z * cos_phi, q.z * sin_phi, -rd) * PI))
+    }
+
     /// The interaction at parameter `t` of `ray`; the point is re-projected onto the surface.
     #[must_use]
     pub fn interaction(&self, ray: &Ray, t: f32, uv: bool) -> SurfaceInteraction {

@@ -27,7 +27,7 @@ pub fn radiance(scene: &Scene, ray: &Ray, rng: &mut Pcg32, emitter_samples: u32,
     let hit = scene.intersect(ray);
     let mut l = if hide_emitters { Rgb::ZERO } else { emitter_hit(scene, ray, hit.as_ref(), None) };
     let Some(si) = hit else { return l };
-    let material = scene.materials[si.shape as usize].at(si.uv);
+    let material = scene.bsdf_at(&si);
     let bsdf = &*material;
     let wo = si.shading.to_local(-ray.d);
     let (ne, nb) = (emitter_samples as f32, bsdf_samples as f32);

@@ -2,11 +2,13 @@
 //! untextured material is that `Bsdf` already.
 
 use crate::bsdf::{Bsdf, Diffuse};
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::math::simd::Float8;
+use crate::math::Frame;
 use crate::props::{Props, Value};
+use crate::spectrum::Rgb;
 use crate::texture::Texture;
-use glam::Vec2;
+use glam::{Vec2, Vec3};
 use std::borrow::Cow;
 use std::collections::HashMap;
 use std::sync::{Mutex, RwLock};
@@ -46,11 +48,10 @@ pub enum Material {
     /// A model whose every texture sets a reflectance it reads as it is ([`Bsdf::reflectance_slot`]) or a
     /// float in [0, 1] it can take at once ([`Bsdf::set_unit_float`]: a blend's weight): built once, and
     /// at a hit copied with the textures' values written into it — the model [`Material::Textured`] would
-    /// build from the same values, without `Props`. Each texture with its parameter and whether that is a
-    /// float (in `SCALAR_PARAMETERS`, read with [`Texture::eval_1`]).
+    /// build from the same values, without `Props`. Each texture with its parameter and how it is read.
     Slotted {
         model: Bsdf,
-        textures: Vec<(String, Texture, bool)>,
+        textures: Vec<(String, Texture, Lookup)>,
     },
     /// Any other BSDF with texture parameters: the description without them, and the textures with their
     /// parameter paths. Rebuilt at every hit from a copy of the template (`Props` tracks which parameters
@@ -61,9 +62,53 @@ pub enum Material {
     /// entries, so textures with few distinct values (checkerboards, masks) build each model once.
     Textured {
         template: Mutex<Props>,
-        textures: Vec<(Vec<String>, Texture)>,
+        textures: Vec<(Vec<String>, Texture, Lookup)>,
         cache: RwLock<HashMap<Vec<u32>, Bsdf>>,
     },
+}
+
+/// How a material reads one of its textures at a hit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Lookup {
+    /// A colour parameter: [`Texture::eval`].
+    Colour,
+    /// A float parameter (in `SCALAR_PARAMETERS`): [`Texture::eval_1`].
+    Float,
+    /// A `bumpmap`'s height field, times `scale`: its gradient turns the shading normal, which the
+    /// `bumpmap` (a [`crate::bsdf::NormalMap`]) reads as its `normalmap` colour ([`bump_normal`]).
+    Bump { scale: f32 },
+}
+
+/// The surface at a hit where a bump map is read: the geometric normal, the shading frame, and ∂p/∂u,
+/// ∂p/∂v of the shape's parameterisation (world space; [`crate::geometry::Shape::uv_partials`]).
+#[derive(Clone, Copy, Debug)]
+pub struct Differentials {
+    pub n: Vec3,
+    pub shading: Frame,
+    pub dp_du: Vec3,
+    pub dp_dv: Vec3,
+}
+
+/// The normal a height field with gradient `grad` (∂h/∂u, ∂h/∂v, already scaled) gives the surface `d`,
+/// in its shading frame and encoded as `normalmap` colours are ((n + 1)/2): Mitsuba 3's `bumpmap`
+/// (Blinn 1978, ignoring the normal's own derivatives): ∂p/∂u′ = ∂p/∂u + n (∂h/∂u − n·∂p/∂u) with n the
+/// shading normal, likewise for v, n′ = ∂p/∂u′ × ∂p/∂v′ turned to the side of the geometric normal.
+/// Without a surface (`None`), or where n′ is degenerate, the shading normal itself.
+#[must_use]
+pub fn bump_normal(grad: Vec2, d: Option<&Differentials>) -> Rgb {
+    let flat = Rgb::new(0.5, 0.5, 1.0);
+    let Some(d) = d else { return flat };
+    let ns = d.shading.n;
+    let dp_du = d.dp_du + ns * (grad.x - ns.dot(d.dp_du));
+    let dp_dv = d.dp_dv + ns * (grad.y - ns.dot(d.dp_dv));
+    let mut n = dp_du.cross(dp_dv);
+    if d.n.dot(n) < 0.0 {
+        n = -n;
+    }
+    match d.shading.to_local(n).try_normalize() {
+        Some(l) => Rgb::new(0.5 * l.x + 0.5, 0.5 * l.y + 0.5, 0.5 * l.z + 0.5),
+        None => flat,
+    }
 }
 
 impl Material {
@@ -73,15 +118,14 @@ impl Material {
         let Material::Textured { textures, .. } = &material else { return Ok(material) };
         // Built once now, so that parameter errors surface at load time; that model is the slotted form's
         // where every texture has a slot in it.
-        let model = material.try_at(Vec2::splat(0.5))?.into_owned();
-        let slotted = textures.iter().all(|(path, _)| match path.as_slice() {
-            [name] if SCALAR_PARAMETERS.contains(&name.as_str()) => model.clone().set_unit_float(name, 0.5),
-            [name] => model.clone().reflectance_slot(name).is_some(),
+        let model = material.try_at(Vec2::splat(0.5), None)?.into_owned();
+        let slotted = textures.iter().all(|(path, _, lookup)| match (path.as_slice(), lookup) {
+            ([name], Lookup::Float) => model.clone().set_unit_float(name, 0.5),
+            ([name], _) => model.clone().reflectance_slot(name).is_some(),
             _ => false,
         });
         if slotted {
-            let textures =
-                textures.iter().map(|(path, t)| (path[0].clone(), t.clone(), SCALAR_PARAMETERS.contains(&path[0].as_str()))).collect();
+            let textures = textures.iter().map(|(path, t, lookup)| (path[0].clone(), t.clone(), *lookup)).collect();
             return Ok(Material::Slotted { model, textures });
         }
         Ok(material)
@@ -94,49 +138,68 @@ impl Material {
         if taken.is_empty() {
             return Ok(Material::Fixed(Bsdf::from_props(p)?));
         }
-        let textures = taken.iter().map(|(path, t)| Ok((path.clone(), Texture::from_props(t)?))).collect::<Result<Vec<_>>>()?;
+        let mut bumped: Vec<&[String]> = Vec::new();
+        let mut textures = Vec::with_capacity(taken.len());
+        for (path, t) in &taken {
+            let texture = Texture::from_props(t)?;
+            let parent = &path[..path.len() - 1];
+            let bump = template.nested_at(parent).filter(|b| b.plugin_type() == "bumpmap");
+            if let Some(b) = bump {
+                // The height field sets the bumpmap's normal (a parameter `normalmap` of that model).
+                if bumped.contains(&parent) {
+                    return Err(Error::spec(t.at(), "a `bumpmap` takes one texture (its height field)"));
+                }
+                bumped.push(parent);
+                let scale = b.float_in("scale", 1.0, f32::MIN, f32::MAX)?;
+                textures.push(([parent, &["normalmap".to_string()]].concat(), texture, Lookup::Bump { scale }));
+            } else {
+                let float = path.last().is_some_and(|name| SCALAR_PARAMETERS.contains(&name.as_str()));
+                textures.push((path.clone(), texture, if float { Lookup::Float } else { Lookup::Colour }));
+            }
+        }
         Ok(match (template.plugin_type(), textures.as_slice()) {
-            ("diffuse", [(path, t)]) if path == &["reflectance"] => Material::TexturedDiffuse(t.clone()),
+            ("diffuse", [(path, t, Lookup::Colour)]) if path == &["reflectance"] => Material::TexturedDiffuse(t.clone()),
             _ => Material::Textured { template: Mutex::new(template), textures, cache: RwLock::new(HashMap::new()) },
         })
     }
 
-    fn try_at(&self, uv: Vec2) -> Result<Cow<'_, Bsdf>> {
+    fn try_at(&self, uv: Vec2, surface: Option<&Differentials>) -> Result<Cow<'_, Bsdf>> {
         Ok(match self {
             Material::Fixed(b) => Cow::Borrowed(b),
             Material::TexturedDiffuse(t) => Cow::Owned(Bsdf::Diffuse(Diffuse::new(Self::texel(t, uv)))),
             Material::Slotted { model, textures } => {
                 let mut model = model.clone();
-                for (name, t, float) in textures {
+                for (name, t, lookup) in textures {
                     // The range of `Props::reflectance` and of the floats' `float_in`, so that a value out of
                     // it fails as the rebuilt model would.
                     let outside =
                         |v: &dyn std::fmt::Debug| crate::error::Error::spec("", format!("texture value {v:?} of `{name}` outside [0, 1]"));
-                    if *float {
-                        let value = t.eval_1(uv);
-                        if !(0.0..=1.0).contains(&value) {
-                            return Err(outside(&value));
+                    match TextureValue::of(t, *lookup, uv, surface) {
+                        TextureValue::Scalar(value) => {
+                            if !(0.0..=1.0).contains(&value) {
+                                return Err(outside(&value));
+                            }
+                            model.set_unit_float(name, value);
                         }
-                        model.set_unit_float(name, value);
-                    } else {
-                        let value = t.eval(uv);
-                        if !value.0.iter().all(|c| (0.0..=1.0).contains(c)) {
-                            return Err(outside(&value));
+                        TextureValue::Colour(value) => {
+                            if !value.0.iter().all(|c| (0.0..=1.0).contains(c)) {
+                                return Err(outside(&value));
+                            }
+                            *model.reflectance_slot(name).expect("slots checked when the material was built") = value;
                         }
-                        *model.reflectance_slot(name).expect("slots checked when the material was built") = value;
                     }
                 }
                 Cow::Owned(model)
             }
             Material::Textured { template, textures, cache } => {
-                let values: Vec<TextureValue> = textures.iter().map(|(path, t)| TextureValue::of(path, t, uv)).collect();
+                let values: Vec<TextureValue> = textures.iter().map(|(_, t, lookup)| TextureValue::of(t, *lookup, uv, surface)).collect();
                 let key: Vec<u32> = values.iter().flat_map(TextureValue::bits).collect();
                 if let Some(b) = cache.read().ok().and_then(|c| c.get(&key).cloned()) {
                     return Ok(Cow::Owned(b));
                 }
                 let mut p = template.lock().map_or_else(|poisoned| poisoned.into_inner().clone(), |t| t.clone());
                 let at = p.at().to_string();
-                for ((path, _), value) in textures.iter().zip(&values) {
+                for ((path, ..), value) in textures.iter().zip(&values) {
                     p.set_path(path, value.to_value(), &at);
                 }
                 let bsdf = Bsdf::from_props(&p)?;
@@ -205,7 +268,28 @@ impl Material {
         if let Material::Fixed(b) = self {
             return Cow::Borrowed(b);
         }
-        self.try_at(uv).unwrap_or_else(|_| Cow::Owned(Bsdf::Diffuse(Diffuse::new(crate::spectrum::Rgb::ZERO))))
+        self.at_surface(uv, None)
+    }
+
+    /// Whether the material reads the surface's differential geometry (it has a bump map): evaluate it
+    /// with [`Self::at_surface`] then.
+    #[must_use]
+    pub fn reads_differentials(&self) -> bool {
+        match self {
+            Material::Slotted { textures, .. } => textures.iter().any(|(_, _, l)| matches!(l, Lookup::Bump { .. })),
+            Material::Textured { textures, .. } => textures.iter().any(|(_, _, l)| matches!(l, Lookup::Bump { .. })),
+            Material::Fixed(_) | Material::TexturedDiffuse(_) => false,
+        }
+    }
+
+    /// [`Self::at`] on the surface `surface` (where bump maps read it; without it, they leave the shading
+    /// normal as it is).
+    #[must_use]
+    pub fn at_surface(&self, uv: Vec2, surface: Option<&Differentials>) -> Cow<'_, Bsdf> {
+        if let Material::Fixed(b) = self {
+            return Cow::Borrowed(b);
+        }
+        self.try_at(uv, surface).unwrap_or_else(|_| Cow::Owned(Bsdf::Diffuse(Diffuse::new(crate::spectrum::Rgb::ZERO))))
     }
 }
 
@@ -216,11 +300,11 @@ enum TextureValue {
 }
 
 impl TextureValue {
-    fn of(path: &[String], t: &Texture, uv: Vec2) -> Self {
-        if path.last().is_some_and(|name| SCALAR_PARAMETERS.contains(&name.as_str())) {
-            TextureValue::Scalar(t.eval_1(uv))
-        } else {
-            TextureValue::Colour(t.eval(uv))
+    fn of(t: &Texture, lookup: Lookup, uv: Vec2, surface: Option<&Differentials>) -> Self {
+        match lookup {
+            Lookup::Float => TextureValue::Scalar(t.eval_1(uv)),
+            Lookup::Colour => TextureValue::Colour(t.eval(uv)),
+            Lookup::Bump { scale } => TextureValue::Colour(bump_normal(t.eval_1_grad(uv) * scale, surface)),
         }
     }
 
@@ -315,5 +399,28 @@ mod tests {
             let m = Material::from_props(&props(plugin, extra, &textured)).unwrap();
             assert!(matches!(m, Material::Textured { .. }), "{plugin} {textured:?}");
         }
+    }
+
+    /// On a plane with ∂p/∂u = (2, 0, 0), ∂p/∂v = (0, 3, 0), a height gradient (a, b) gives the normal
+    /// (2, 0, a) × (0, 3, b) ∝ (−3a, −2b, 6), in the shading frame and encoded as (n + 1)/2; turned to the
+    /// geometric normal's side; the shading normal where there is no surface or no gradient.
+    #[test]
+    fn bump_normals_are_the_cross_product_of_the_bumped_partials() {
+        let d = Differentials {
+            n: Vec3::Z,
+            shading: Frame::from_normal(Vec3::Z),
+            dp_du: Vec3::new(2.0, 0.0, 0.0),
+            dp_dv: Vec3::new(0.0, 3.0, 0.0),
+        };
+        let decode = |c: Rgb| Vec3::new(2.0 * c.r() - 1.0, 2.0 * c.g() - 1.0, 2.0 * c.b() - 1.0);
+        for (a, b) in [(0.5f32, -1.0f32), (3.0, 2.0), (0.0, 0.0)] {
+            let local = decode(bump_normal(Vec2::new(a, b), Some(&d)));
+            let want = d.shading.to_local(Vec3::new(-3.0 * a, -2.0 * b, 6.0).normalize());
+            assert!((local - want).length() < 1e-6, "({a}, {b}): {local} against {want}");
+        }
+        // ∂p/∂u × ∂p/∂v against the geometric normal: turned round.
+        let flipped = Differentials { dp_dv: Vec3::new(0.0, -3.0, 0.0), ..d };
+        assert!(decode(bump_normal(Vec2::new(0.5, -1.0), Some(&flipped))).z > 0.0);
+        assert_eq!(bump_normal(Vec2::new(0.5, -1.0), None), Rgb::new(0.5, 0.5, 1.0));
     }
 }

@@ -12,6 +12,7 @@ pub mod surfaces;
 
 pub use material::Material;
 
+use crate::bsdf::Bsdf;
 use crate::camera::Camera;
 use crate::error::Result;
 use crate::film::FilmSpec;
@@ -24,6 +25,7 @@ use crate::geometry::{Bvh, PrimHit, Ray, Shape, SurfaceInteraction};
 use crate::light::{Light, LightSelection};
 use crate::math::simd::{Float8, Mask8};
 use crate::math::Vec2;
+use std::borrow::Cow;
 use std::path::Path;
 
 /// Which integrator renders the scene.
@@ -493,6 +495,18 @@ impl Scene {
     #[must_use]
     pub fn primitive_count(&self) -> usize {
         self.prims.slots.iter().filter(|r| r.shape != EMPTY_SLOT).count()
+    }
+
+    /// The reflection model of the surface `si`: its shape's material at its texture coordinates, and, for
+    /// a material with a bump map, on its differential geometry ([`Shape::uv_partials`]).
+    #[must_use]
+    pub fn bsdf_at(&self, si: &SurfaceInteraction) -> Cow<'_, Bsdf> {
+        let material = &self.materials[si.shape as usize];
+        if !material.reads_differentials() {
+            return material.at(si.uv);
+        }
+        let (dp_du, dp_dv) = self.shapes[si.shape as usize].uv_partials(si.prim, si.p, &si.shading);
+        material.at_surface(si.uv, Some(&material::Differentials { n: si.n, shading: si.shading, dp_du, dp_dv }))
     }
 
     /// The closest surface along `ray`.

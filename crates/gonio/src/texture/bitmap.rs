@@ -133,6 +133,41 @@ impl Bitmap {
         }
     }
 
+    /// The gradient ∂/∂(u, v) of the scalar lookup (the luminance of [`Self::eval`]), as Mitsuba 3's
+    /// `eval_1_grad`: the derivative of the bilinear interpolant over the texel grid, taken through `to_uv`'s
+    /// linear part (its transpose applied to the texel-space gradient; Mitsuba scales by the resolution
+    /// after that transpose, the same unless `to_uv` rotates); 0 for `nearest` lookups, which are
+    /// piecewise constant.
+    #[must_use]
+    pub fn eval_1_grad(&self, uv: Vec2) -> Vec2 {
+        if !self.bilinear {
+            return Vec2::ZERO;
+        }
+        let (iw, ih) = self.resolution();
+        let q = self.to_uv.point(Vec3::new(uv.x, uv.y, 0.0));
+        let (w, h) = (iw as f32, ih as f32);
+        let (x, y) = (q.x * w - 0.5, q.y * h - 0.5);
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let (c0, c1) = (self.wrap.apply(x0 as i64, iw), self.wrap.apply(x0 as i64 + 1, iw));
+        let (r0, r1) = (self.wrap.apply(y0 as i64, ih), self.wrap.apply(y0 as i64 + 1, ih));
+        let texel = |x: usize, y: usize| {
+            let i = 3 * (y * iw + x);
+            match &self.texels {
+                Texels::Linear(image) => Rgb::new(image.data[i], image.data[i + 1], image.data[i + 2]).luminance(),
+                Texels::Bytes { image, table } => {
+                    let v = |k: usize| table[usize::from(image.data[k])];
+                    Rgb::new(v(i), v(i + 1), v(i + 2)).luminance()
+                }
+            }
+        };
+        let (f00, f10, f01, f11) = (texel(c0, r0), texel(c1, r0), texel(c0, r1), texel(c1, r1));
+        // ∂f/∂x and ∂f/∂y in texels, then per unit of the transformed coordinates (× resolution).
+        let (dx, dy) = (((f10 - f00) * (1.0 - fy) + (f11 - f01) * fy) * w, ((f01 - f00) * (1.0 - fx) + (f11 - f10) * fx) * h);
+        let (du, dv) = (self.to_uv.vector(Vec3::X), self.to_uv.vector(Vec3::Y));
+        Vec2::new(du.x * dx + du.y * dy, dv.x * dx + dv.y * dy)
+    }
+
     /// The lookup at `uv` of a `iw` × `ih` image whose texel starting at sample `i` (3 (y · iw + x), both
     /// coordinates already wrapped into it) is `texel(i)`.
     #[inline(always)]
@@ -230,5 +265,36 @@ mod tests {
         assert_eq!(b.eval(Vec2::new(0.75, 0.25)).r(), 1.0);
         assert!((b.eval(Vec2::new(0.5, 0.25)).r() - 0.5).abs() < 1e-6);
         assert_eq!(b.eval(Vec2::new(0.75, 0.75)).r(), 0.0);
+    }
+
+    /// The gradient is the bilinear interpolant's: it matches central differences of `eval`'s luminance
+    /// inside a texel cell, through a scaling and rotating `to_uv`, and is 0 for `nearest`.
+    #[test]
+    fn gradients_are_the_interpolants() {
+        use crate::sampling::Pcg32;
+        let mut rng = Pcg32::new(9, 2);
+        let data: Vec<f32> = (0..3 * 5 * 4).map(|_| rng.next_f32()).collect();
+        let to_uv = Transform::rotate(Vec3::Z, 30.0).unwrap().then_after(Transform::scale(Vec3::new(2.0, 3.0, 1.0)).unwrap());
+        let b = Bitmap { texels: Texels::Linear(Arc::new(Image { width: 5, height: 4, data })), bilinear: true, wrap: Wrap::Repeat, to_uv };
+        for _ in 0..200 {
+            let uv = Vec2::new(rng.next_f32(), rng.next_f32());
+            let h = 1e-3;
+            let f = |d: Vec2| f64::from(b.eval(uv + d).luminance());
+            let numeric = Vec2::new(
+                ((f(Vec2::new(h, 0.0)) - f(Vec2::new(-h, 0.0))) / (2.0 * f64::from(h))) as f32,
+                ((f(Vec2::new(0.0, h)) - f(Vec2::new(0.0, -h))) / (2.0 * f64::from(h))) as f32,
+            );
+            let g = b.eval_1_grad(uv);
+            // Central differences straddle a texel edge at some points: compare where both sides agree.
+            let one_sided = Vec2::new(
+                ((f(Vec2::new(h, 0.0)) - f(Vec2::ZERO)) / f64::from(h)) as f32,
+                ((f(Vec2::new(0.0, h)) - f(Vec2::ZERO)) / f64::from(h)) as f32,
+            );
+            if (numeric - one_sided).length() < 1e-2 * numeric.length().max(1.0) {
+                assert!((g - numeric).length() < 2e-2 * numeric.length().max(1.0), "at {uv}: {g} against {numeric}");
+            }
+        }
+        let nearest = Bitmap { bilinear: false, ..b };
+        assert_eq!(nearest.eval_1_grad(Vec2::new(0.3, 0.6)), Vec2::ZERO);
     }
 }

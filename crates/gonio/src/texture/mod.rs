@@ -62,4 +62,15 @@ impl Texture {
             Texture::Bitmap(b) => b.eval(uv).luminance(),
         }
     }
+
+    /// The gradient ∂/∂(u, v) of [`Self::eval_1`] (Mitsuba's `eval_1_grad`, what `bumpmap` reads): a
+    /// bitmap's ([`Bitmap::eval_1_grad`]); 0 for a checkerboard, constant between its edges.
+    #[inline]
+    #[must_use]
+    pub fn eval_1_grad(&self, uv: Vec2) -> Vec2 {
+        match self {
+            Texture::Checkerboard(_) => Vec2::ZERO,
+            Texture::Bitmap(b) => b.eval_1_grad(uv),
+        }
+    }
 }
