@@ -151,8 +151,8 @@ pub fn render_samples(scene: &Scene, seed: u64, samples: Range<u32>, cancel: &At
                 let mut buffer = vec![0.0; channels];
                 // Pixel by pixel, its `n` samples in order (the tile's pixels are row-major, as `samples`).
                 if filter.is_box() {
-                    for i in 0..samples.len() {
-                        if !tile.add(i / n as usize, sample_values(&mut buffer, radiance[i], &aovs, i)) {
+                    for (i, &l) in radiance.iter().enumerate() {
+                        if !tile.add(i / n as usize, sample_values(&mut buffer, l, &aovs, i)) {
                             bad += 1;
                         }
                     }
@@ -160,13 +160,13 @@ pub fn render_samples(scene: &Scene, seed: u64, samples: Range<u32>, cancel: &At
                     // Each sample into the (2b + 1)² pixels around its own, b = the border.
                     let taps = 2 * border as usize + 1;
                     let (mut wx, mut wy) = (vec![0.0; taps], vec![0.0; taps]);
-                    for (i, s) in samples.iter().enumerate() {
+                    for (i, (s, &l)) in samples.iter().zip(&radiance).enumerate() {
                         let u = integrator::pixel_offset(scene, seed, *s);
                         filter.weights(u.x, &mut wx);
                         filter.weights(u.y, &mut wy);
                         // The tile's pixel (x − x0, y − y0) sits at (x − x0 + b, y − y0 + b) of its buffer;
                         // the taps start b before it.
-                        if !tile.splat(s.x - x0, s.y - y0, &wx, &wy, sample_values(&mut buffer, radiance[i], &aovs, i)) {
+                        if !tile.splat(s.x - x0, s.y - y0, &wx, &wy, sample_values(&mut buffer, l, &aovs, i)) {
                             bad += 1;
                         }
                     }

@@ -7,8 +7,11 @@
 //! | nested integrators | plugin | none       | any number of `path` or `direct`, each under its parameter name (`_arg_0`, … when unnamed) |
 //!
 //! The film's channels, in Mitsuba 3.9.1's order ([`IntegratorKind::channels`]): `R`, `G`, `B` (the first
-//! nested integrator's image, bit for bit what it renders alone; black without one), then for each nested
-//! integrator `name.R`, `name.G`, `name.B`, `name.A`, then for each entry of `aovs` its channels:
+//! nested integrator's image, what it renders alone; black without one), then for each nested integrator
+//! `name.R`, `name.G`, `name.B`, `name.A`, then for each entry of `aovs` its channels. (The image is that
+//! one bit for bit, except where a `prim_index` or `uv` output changes which pairs of triangles the BVH
+//! tests as one parallelogram — none for `prim_index`, only those whose texture coordinates agree for
+//! `uv` —: the same hits, to rounding.)
 //!
 //! | type          | channels        | value at the camera ray's first hit                                     |
 //! |---------------|-----------------|-------------------------------------------------------------------------|
