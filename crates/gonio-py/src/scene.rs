@@ -210,7 +210,9 @@ impl PyScene {
 
 #[pymethods]
 impl PyScene {
-    /// Render the scene; returns linear RGB as a float32 array of shape (height, width, 3), top row first.
+    /// Render the scene; returns linear RGB as a float32 array of shape (height, width, 3), top row first,
+    /// or (height, width, C) with the further channels of an `aov` integrator after the RGB, named by
+    /// `channels` (as `mitsuba.render` returns its AOVs, in the order of Mitsuba's film).
     ///
     /// - `spp`: samples per pixel (default: the scene's sampler `sample_count`)
     /// - `seed`: random seed (default: the sampler's `seed`); the image depends on the seed only, not on
@@ -240,8 +242,15 @@ impl PyScene {
         let out =
             self.run(py, spp, threads, progress, move |scene, cancel, progress| gonio::render::render(scene, spp, seed, cancel, progress))?;
         warn_nonfinite(py, out.nonfinite)?;
-        let (w, h) = (self.scene.film.width, self.scene.film.height);
-        let image = PyArray1::from_vec(py, out.data).reshape([h as usize, w as usize, 3])?;
+        let (w, h) = (self.scene.film.width as usize, self.scene.film.height as usize);
+        let k = 3 + out.aovs.names.len();
+        let data = if k == 3 {
+            out.data
+        } else {
+            let further = out.aovs.data.chunks_exact(k - 3);
+            out.data.chunks_exact(3).zip(further).flat_map(|(rgb, more)| rgb.iter().chain(more).copied()).collect()
+        };
+        let image = PyArray1::from_vec(py, data).reshape([h, w, k])?;
         Ok(image.into_any())
     }
 
@@ -249,7 +258,8 @@ impl PyScene {
     /// not divided: a part of a render that adds up with the parts of other ranges (what
     /// `gonio.distributed.render` runs on each machine). Returns a dict:
     ///
-    /// - `sum`: float64 array (height, width, 3), the per-pixel sums of the (filter-weighted) samples
+    /// - `sum`: float64 array (height, width, C), the per-pixel sums of the (filter-weighted) samples, C
+    ///   as in `render` (3, or more with an `aov` integrator: `channels`)
     /// - `weight`: float64 array (height, width) of summed filter weights, or `None` for the box filter
     /// - `first`, `spp`: the range summed (`spp` < `count` only when interrupted: then Ctrl-C raises
     ///   `KeyboardInterrupt` as `render` does, so a returned part is always whole)
@@ -277,10 +287,9 @@ impl PyScene {
         let part = self.run(py, spp, threads, progress, move |scene, cancel, progress| {
             gonio::render::render_samples(scene, seed, range, cancel, progress)
         })?;
-        let (w, h) = (part.film.width as usize, part.film.height as usize);
-        let sum: Vec<f64> = part.film.sums().iter().flatten().copied().collect();
+        let (w, h, k) = (part.film.width as usize, part.film.height as usize, part.film.channels());
         let out = PyDict::new(py);
-        out.set_item("sum", PyArray1::from_vec(py, sum).reshape([h, w, 3])?)?;
+        out.set_item("sum", PyArray1::from_slice(py, part.film.sums()).reshape([h, w, k])?)?;
         match part.film.weights() {
             Some(wt) => out.set_item("weight", PyArray1::from_slice(py, wt).reshape([h, w])?)?,
             None => out.set_item("weight", py.None())?,
@@ -290,6 +299,13 @@ impl PyScene {
         out.set_item("nonfinite", part.nonfinite)?;
         out.set_item("seconds", part.seconds)?;
         Ok(out)
+    }
+
+    /// The names of the channels `render` returns: `["R", "G", "B"]`, then an `aov` integrator's further
+    /// channels as Mitsuba 3 names them (`image.R`, …, `image.A`, `nn.X`, …, `dd.y.T`).
+    #[getter]
+    fn channels(&self) -> Vec<String> {
+        self.scene.integrator.channels()
     }
 
     /// Image width in pixels (the film's `width`).
@@ -348,9 +364,10 @@ impl PyScene {
 
     fn __repr__(&self) -> String {
         let s = &self.scene;
-        let integrator = match s.integrator {
+        let integrator = match &s.integrator {
             IntegratorKind::Path { max_depth, .. } => format!("path, max_depth {max_depth}"),
             IntegratorKind::Direct { .. } => "direct".to_string(),
+            IntegratorKind::Aov { .. } => format!("aov, {} channels", s.integrator.channels().len()),
         };
         format!(
             "<gonio.Scene {}: {}×{}, {} spp, {} shapes ({} primitives), {} lights, {integrator}>",
@@ -376,7 +393,7 @@ fn warn_nonfinite(py: Python<'_>, nonfinite: u64) -> PyResult<()> {
 
 /// The image of summed samples (`Scene.render_samples`' `sum` and `weight`, several parts added) holding
 /// `spp` samples per pixel: the box filter's means, or weighted sums over summed weights, as float32
-/// (height, width, 3) — the same development as `Scene.render`'s. `weight` is `None` for the box filter.
+/// (height, width, C) — the same development as `Scene.render`'s. `weight` is `None` for the box filter.
 #[pyfunction]
 #[pyo3(signature = (sum, weight, spp))]
 fn develop<'py>(
@@ -386,9 +403,9 @@ fn develop<'py>(
     spp: u32,
 ) -> PyResult<Bound<'py, PyAny>> {
     let shape = sum.shape();
-    let (h, w) = (shape[0], shape[1]);
-    if shape[2] != 3 {
-        return Err(PyValueError::new_err(format!("develop: `sum` must have shape (height, width, 3), got {shape:?}")));
+    let (h, w, k) = (shape[0], shape[1], shape[2]);
+    if k < 3 {
+        return Err(PyValueError::new_err(format!("develop: `sum` must have shape (height, width, C ≥ 3), got {shape:?}")));
     }
     if let Some(wt) = &weight {
         if wt.shape() != [h, w] {
@@ -399,8 +416,8 @@ fn develop<'py>(
     let (w32, h32) = (u32::try_from(w).map_err(|_| too_big())?, u32::try_from(h).map_err(|_| too_big())?);
     let sum = sum.as_array().iter().copied().collect::<Vec<f64>>();
     let weight = weight.map(|wt| wt.as_array().iter().copied().collect::<Vec<f64>>());
-    let film = gonio::film::Film::from_sums(w32, h32, &sum, weight.as_deref()).map_err(|e| PyValueError::new_err(e.to_string()))?;
-    Ok(PyArray1::from_vec(py, film.mean(spp)).reshape([h, w, 3])?.into_any())
+    let film = gonio::film::Film::from_sums(w32, h32, k, &sum, weight.as_deref()).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    Ok(PyArray1::from_vec(py, film.mean(spp)).reshape([h, w, k])?.into_any())
 }
 
 /// The files a Mitsuba 3 XML scene is read from: the scene file, its `<include>`s, then every asset it

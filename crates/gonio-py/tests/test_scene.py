@@ -161,6 +161,31 @@ def test_render_equals_cli_exr_bit_for_bit(scene_file, tmp_path):
     assert np.array_equal(cli, py)
 
 
+def test_aov_channels_follow_the_rgb(scene_file, tmp_path):
+    # Mitsuba's `aov` integrator: its channels after the RGB, named as Mitsuba names them; the RGB (and the
+    # nested image's channels) are the nested path integrator's image; parts of a render carry every channel.
+    aov = (
+        '<integrator type="aov"><string name="aovs" value="dd.y:depth, nn:sh_normal"/>'
+        '<integrator type="path" name="image"><integer name="max_depth" value="4"/></integrator></integrator>'
+    )
+    path = tmp_path / "aov.xml"
+    path.write_text(scene_file.read_text().replace('<integrator type="path"><integer name="max_depth" value="4"/></integrator>', aov))
+    s = gonio.load_scene(path)
+    assert s.channels == ["R", "G", "B", "image.R", "image.G", "image.B", "image.A", "dd.y.T", "nn.X", "nn.Y", "nn.Z"]
+    assert gonio.load_scene(scene_file).channels == ["R", "G", "B"]
+    img = s.render(seed=3, progress=False)
+    assert img.shape == (24, 32, 11) and img.dtype == np.float32
+    plain = gonio.load_scene(scene_file).render(seed=3, progress=False)
+    assert np.array_equal(img[..., :3], plain) and np.array_equal(img[..., 3:6], plain)
+    # The environment is seen where nothing is hit: the nested path's samples are all valid (A = 1).
+    assert np.all(img[..., 6] == 1.0)
+    depth = img[..., 7]
+    assert depth.min() == 0.0 and 3.0 < depth.max() < 7.7  # the far corner of the 6 × 6 floor: 7.7 away
+    part = s.render_samples(0, 4, seed=3)
+    assert part["sum"].shape == (24, 32, 11)
+    assert np.array_equal(gonio.develop(part["sum"], part["weight"], 4), img)
+
+
 def test_load_dict_agrees_with_load_scene(tmp_path):
     # Transforms given as matrices in both forms, so that both hold the same numbers.
     def xml_matrix(m):

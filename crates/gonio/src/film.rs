@@ -7,7 +7,7 @@
 //! |--------------------|---------|---------|---------------------------------------------------|
 //! | `width`, `height`  | integer | 768, 576| resolution: each in [1, 65536], at most 2²⁶ pixels |
 //! | `file_format`      | string  | openexr | `openexr`, `exr`, `rgbe` or `pfm`: accepted (the output format follows the file name) |
-//! | `pixel_format`     | string  | rgb     | one of Mitsuba's (`rgb`, `rgba`, `luminance`, `xyz`, …): accepted (gonio writes RGB) |
+//! | `pixel_format`     | string  | rgb     | one of Mitsuba's (`rgb`, `rgba`, `luminance`, `xyz`, …): accepted (gonio writes RGB, and an `aov` integrator's channels) |
 //! | `component_format` | string  | float16 | `float16`, `float32` or `uint32`: accepted (the output format follows the file name) |
 //! | `crop_offset_x`, `crop_offset_y`, `crop_width`, `crop_height` | integer | 0, 0, width, height | a crop window: only the whole film (gonio renders no partial films yet; anything else is an error) |
 //! | `sample_border`    | boolean | false   | only `false` (samples in the film's pixels; `true` is an error) |
@@ -19,7 +19,6 @@
 
 use crate::error::{Error, Result};
 use crate::props::Props;
-use crate::spectrum::Rgb;
 
 /// A separable reconstruction filter, Mitsuba 3's `rfilter` plugins:
 ///
@@ -211,60 +210,64 @@ fn one_of(p: &Props, name: &'static str, allowed: &[&str]) -> Result<()> {
     }
 }
 
-/// Per-pixel sums of samples: with the box filter plain sums (divided by the sample count), otherwise
-/// weighted sums and the sums of their weights.
+/// Per-pixel sums of samples, `channels` values each (RGB, then an `aov` integrator's further channels):
+/// with the box filter plain sums (divided by the sample count), otherwise weighted sums and the sums of
+/// their weights. Every channel is filtered alike, as Mitsuba 3's film splats its AOVs with the colour.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Film {
     pub width: u32,
     pub height: u32,
-    sum: Vec<[f64; 3]>,
+    channels: usize,
+    /// `channels` sums per pixel, row-major.
+    sum: Vec<f64>,
     /// Summed filter weights per pixel; empty for the box filter.
     weight: Vec<f64>,
 }
 
 impl Film {
-    /// A film for the box filter.
+    /// A film of `channels` values per pixel for the box filter.
     #[must_use]
-    pub fn new(width: u32, height: u32) -> Self {
-        Film { width, height, sum: vec![[0.0; 3]; width as usize * height as usize], weight: Vec::new() }
+    pub fn new(width: u32, height: u32, channels: usize) -> Self {
+        Film { width, height, channels, sum: vec![0.0; channels * width as usize * height as usize], weight: Vec::new() }
     }
 
-    /// A film for a filter with weights (see [`Film::splat`]).
+    /// A film of `channels` values per pixel for a filter with weights (see [`Film::splat`]).
     #[must_use]
-    pub fn weighted(width: u32, height: u32) -> Self {
+    pub fn weighted(width: u32, height: u32, channels: usize) -> Self {
         let n = width as usize * height as usize;
-        Film { width, height, sum: vec![[0.0; 3]; n], weight: vec![0.0; n] }
+        Film { width, height, channels, sum: vec![0.0; channels * n], weight: vec![0.0; n] }
     }
 
-    /// A film from sums read back (e.g. a part of a render sent between processes): `sum` has 3 values
-    /// per pixel, row-major; `weight` one per pixel for a weighted film, `None` for the box filter.
+    /// A film from sums read back (e.g. a part of a render sent between processes): `sum` has `channels`
+    /// values per pixel, row-major; `weight` one per pixel for a weighted film, `None` for the box filter.
     ///
     /// # Errors
     /// When a length does not match the size.
-    pub fn from_sums(width: u32, height: u32, sum: &[f64], weight: Option<&[f64]>) -> Result<Film> {
+    pub fn from_sums(width: u32, height: u32, channels: usize, sum: &[f64], weight: Option<&[f64]>) -> Result<Film> {
         let n = width as usize * height as usize;
-        if sum.len() != 3 * n || weight.is_some_and(|w| w.len() != n) {
+        if channels == 0 || sum.len() != channels * n || weight.is_some_and(|w| w.len() != n) {
             return Err(Error::spec(
                 "film",
                 format!(
-                    "a {width}×{height} film needs {} sums and {n} weights (or none), got {} and {}",
-                    3 * n,
+                    "a {width}×{height} film of {channels} channels needs {} sums and {n} weights (or none), got {} and {}",
+                    channels * n,
                     sum.len(),
                     weight.map_or_else(|| "none".to_string(), |w| w.len().to_string())
                 ),
             ));
         }
-        Ok(Film {
-            width,
-            height,
-            sum: sum.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
-            weight: weight.map(<[f64]>::to_vec).unwrap_or_default(),
-        })
+        Ok(Film { width, height, channels, sum: sum.to_vec(), weight: weight.map(<[f64]>::to_vec).unwrap_or_default() })
     }
 
-    /// The per-pixel sums, row-major (see [`Film::from_sums`]).
+    /// Values per pixel.
     #[must_use]
-    pub fn sums(&self) -> &[[f64; 3]] {
+    pub fn channels(&self) -> usize {
+        self.channels
+    }
+
+    /// The per-pixel sums, row-major, [`Film::channels`] per pixel (see [`Film::from_sums`]).
+    #[must_use]
+    pub fn sums(&self) -> &[f64] {
         &self.sum
     }
 
@@ -274,35 +277,39 @@ impl Film {
         (!self.weight.is_empty()).then_some(self.weight.as_slice())
     }
 
-    /// Add one sample to pixel `index` (box filter); returns false (and adds nothing) when it is not finite.
+    /// Add one sample (its [`Film::channels`] values) to pixel `index` (box filter); returns false (and adds
+    /// nothing) when a value is not finite.
     #[inline]
-    pub fn add(&mut self, index: usize, v: Rgb) -> bool {
-        if !v.is_finite() {
+    pub fn add(&mut self, index: usize, v: &[f32]) -> bool {
+        debug_assert_eq!(v.len(), self.channels);
+        if !v.iter().all(|c| c.is_finite()) {
             return false;
         }
-        for (s, c) in self.sum[index].iter_mut().zip(v.0) {
+        for (s, &c) in self.sum[index * self.channels..].iter_mut().zip(v) {
             *s += f64::from(c);
         }
         true
     }
 
-    /// Splat a sample into the pixels (x0 + i, y0 + j) with weight `wx[i] · wy[j]` (a filter's weights
-    /// around the sample, [`Filter::weights`]; the pixels must lie in the film). A non-finite sample adds
-    /// its weights but no value (it counts as black) and returns false.
+    /// Splat a sample (its [`Film::channels`] values) into the pixels (x0 + i, y0 + j) with weight
+    /// `wx[i] · wy[j]` (a filter's weights around the sample, [`Filter::weights`]; the pixels must lie in
+    /// the film). A sample with a non-finite value adds its weights but no value (it counts as black) and
+    /// returns false.
     #[inline]
-    pub fn splat(&mut self, x0: u32, y0: u32, wx: &[f32], wy: &[f32], v: Rgb) -> bool {
-        let finite = v.is_finite();
-        let v = if finite { v.0.map(f64::from) } else { [0.0; 3] };
+    pub fn splat(&mut self, x0: u32, y0: u32, wx: &[f32], wy: &[f32], v: &[f32]) -> bool {
+        debug_assert_eq!(v.len(), self.channels);
+        let finite = v.iter().all(|c| c.is_finite());
+        let k = self.channels;
         // A tap of weight 0 (beyond the radius: one per axis for the Gaussian) adds nothing: skipped.
         for (j, &wy) in wy.iter().enumerate().filter(|(_, w)| **w != 0.0) {
             let row = (y0 as usize + j) * self.width as usize + x0 as usize;
             let wy = f64::from(wy);
-            let vy = v.map(|c| c * wy);
             for (i, &wx) in wx.iter().enumerate().filter(|(_, w)| **w != 0.0) {
                 let wx = f64::from(wx);
-                let s = &mut self.sum[row + i];
-                for c in 0..3 {
-                    s[c] += wx * vy[c];
+                if finite {
+                    for (s, &c) in self.sum[(row + i) * k..(row + i + 1) * k].iter_mut().zip(v) {
+                        *s += wx * (f64::from(c) * wy);
+                    }
                 }
                 self.weight[row + i] += wx * wy;
             }
@@ -310,11 +317,12 @@ impl Film {
         finite
     }
 
-    /// Add a tile's sums, its top-left pixel at (x0, y0) of this film (negative, or reaching past the
-    /// right or bottom edge, for a tile with a filter's border: what falls outside is dropped, as Mitsuba
-    /// drops the border of its image blocks).
+    /// Add a tile's sums (of as many channels), its top-left pixel at (x0, y0) of this film (negative, or
+    /// reaching past the right or bottom edge, for a tile with a filter's border: what falls outside is
+    /// dropped, as Mitsuba drops the border of its image blocks).
     pub fn add_tile(&mut self, x0: i64, y0: i64, tile: &Film) {
-        let weighted = !self.weight.is_empty();
+        debug_assert_eq!(tile.channels, self.channels);
+        let (weighted, k) = (!self.weight.is_empty(), self.channels);
         for ty in 0..i64::from(tile.height) {
             let y = y0 + ty;
             if y < 0 || y >= i64::from(self.height) {
@@ -326,8 +334,8 @@ impl Film {
                     continue;
                 }
                 let (dst, src) = ((y * i64::from(self.width) + x) as usize, (ty * i64::from(tile.width) + tx) as usize);
-                for c in 0..3 {
-                    self.sum[dst][c] += tile.sum[src][c];
+                for (d, s) in self.sum[dst * k..(dst + 1) * k].iter_mut().zip(&tile.sum[src * k..(src + 1) * k]) {
+                    *d += s;
                 }
                 if weighted {
                     self.weight[dst] += tile.weight[src];
@@ -336,15 +344,19 @@ impl Film {
         }
     }
 
-    /// The pixel values for `spp` samples per pixel: RGB, row-major, top row first (the box filter's
-    /// means, or weighted sums over summed weights; a pixel no sample reached is 0).
+    /// The pixel values for `spp` samples per pixel: [`Film::channels`] per pixel, row-major, top row
+    /// first (the box filter's means, or weighted sums over summed weights; a pixel no sample reached is 0).
     #[must_use]
     pub fn mean(&self, spp: u32) -> Vec<f32> {
         if self.weight.is_empty() {
             let inv = if spp > 0 { 1.0 / f64::from(spp) } else { 0.0 };
-            return self.sum.iter().flat_map(|s| s.map(|v| (v * inv) as f32)).collect();
+            return self.sum.iter().map(|v| (v * inv) as f32).collect();
         }
-        self.sum.iter().zip(&self.weight).flat_map(|(s, &w)| s.map(|v| if w != 0.0 { (v / w) as f32 } else { 0.0 })).collect()
+        self.sum
+            .chunks_exact(self.channels)
+            .zip(&self.weight)
+            .flat_map(|(s, &w)| s.iter().map(move |v| if w != 0.0 { (v / w) as f32 } else { 0.0 }))
+            .collect()
     }
 }
 
@@ -430,10 +442,10 @@ mod tests {
         f.weights(0.5, &mut wx); // the pixel centre: (0, 1, 0)
         f.weights(0.25, &mut wy); // (0.25, 0.75, 0)
         assert_eq!((wx, wy), ([0.0, 1.0, 0.0], [0.25, 0.75, 0.0]));
-        let mut tile = Film::weighted(3, 3);
-        assert!(tile.splat(0, 0, &wx, &wy, Rgb::splat(2.0)));
-        assert!(!tile.splat(0, 0, &wx, &wy, Rgb::splat(f32::NAN)));
-        let mut film = Film::weighted(2, 2);
+        let mut tile = Film::weighted(3, 3, 3);
+        assert!(tile.splat(0, 0, &wx, &wy, &[2.0; 3]));
+        assert!(!tile.splat(0, 0, &wx, &wy, &[f32::NAN, 1.0, 1.0]));
+        let mut film = Film::weighted(2, 2, 3);
         film.add_tile(-1, -1, &tile); // the tile's centre pixel is the film's (0, 0)
         let img = film.mean(2);
         // Pixel (0, 0) has weight 0.75 from each sample, one of them black: a mean of 1.

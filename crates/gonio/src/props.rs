@@ -364,12 +364,19 @@ impl Props {
     /// Nested plugins, in the order they were given, whatever their parameter names.
     #[must_use]
     pub fn nested(&self) -> Vec<&Props> {
+        self.nested_named().into_iter().map(|(_, p)| p).collect()
+    }
+
+    /// Nested plugins with their parameter names (`_arg_0`, `_arg_1`, … for unnamed XML elements, as
+    /// Mitsuba 3 names them), in the order they were given.
+    #[must_use]
+    pub fn nested_named(&self) -> Vec<(&str, &Props)> {
         self.entries
             .iter()
             .filter_map(|e| match &e.value {
                 Value::Nested(p) => {
                     e.used.set(true);
-                    Some(p)
+                    Some((e.name.as_str(), p))
                 }
                 _ => None,
             })
@@ -377,7 +384,7 @@ impl Props {
     }
 
     /// Remove every nested `<texture>` parameter, here and in nested plugins, and return them with their
-    /// paths (`["reflectance"]`, `["_arg_1", "reflectance"]` for a texture inside a nested BSDF).
+    /// paths (`["reflectance"]`, `["_arg_0", "reflectance"]` for a texture inside a nested BSDF).
     /// [`Props::set_path`] puts a value back at such a path.
     pub fn take_textures(&mut self) -> Vec<(Vec<String>, Props)> {
         let mut found = Vec::new();
@@ -568,9 +575,11 @@ impl Props {
             let cat = xml_at(source, child);
             let ctag = child.tag_name().name();
             let name = env.attr(child, "name", source)?;
+            // Mitsuba 3's names for unnamed nested plugins: `_arg_0`, `_arg_1`, … in order (an `aov`
+            // integrator's channels carry them, e.g. `_arg_0.R`).
             let mut auto_name = || {
                 unnamed += 1;
-                format!("_arg_{unnamed}")
+                format!("_arg_{}", unnamed - 1)
             };
             if PLUGIN_TAGS.contains(&ctag) {
                 let nested = Props::from_xml_nested(child, source, env, depth + 1)?;

@@ -11,6 +11,7 @@
 //! holds exactly `spp_done` samples in every pixel.
 
 use crate::film::Film;
+use crate::image::Channels;
 use crate::integrator::{self, CameraSample};
 use crate::scene::Scene;
 use crate::spectrum::Rgb;
@@ -28,6 +29,11 @@ pub struct RenderOutput {
     pub height: u32,
     /// Linear RGB, row-major, top row first (the layout of `image::Image`).
     pub data: Vec<f32>,
+    /// The integrator's channels after the RGB (an `aov` integrator's, [`IntegratorKind::channels`]
+    /// after `R`, `G`, `B`; none for the others), filtered as the RGB is.
+    ///
+    /// [`IntegratorKind::channels`]: crate::scene::IntegratorKind::channels
+    pub aovs: Channels,
     /// Samples per pixel in `data` (less than requested when cancelled).
     pub spp_done: u32,
     pub spp_requested: u32,
@@ -35,6 +41,27 @@ pub struct RenderOutput {
     pub nonfinite: u64,
     pub cancelled: bool,
     pub seconds: f64,
+}
+
+/// Sample `i`'s values for the film, in `buffer` (R, G, B and the further channels): its radiance `rgb`,
+/// then its values in `aovs` (`buffer.len() − 3` per sample).
+#[inline(always)]
+fn sample_values<'a>(buffer: &'a mut [f32], rgb: Rgb, aovs: &[f32], i: usize) -> &'a [f32] {
+    let extra = buffer.len() - 3;
+    buffer[..3].copy_from_slice(&rgb.0);
+    buffer[3..].copy_from_slice(&aovs[extra * i..extra * (i + 1)]);
+    buffer
+}
+
+/// Pixel values of all channels (`names`, `R`, `G`, `B` first) as the RGB and the further channels.
+fn split_rgb(values: Vec<f32>, names: Vec<String>) -> (Vec<f32>, Channels) {
+    let k = names.len();
+    if k == 3 {
+        return (values, Channels::none());
+    }
+    let rgb = values.chunks_exact(k).flat_map(|p| p[..3].iter().copied()).collect();
+    let data = values.chunks_exact(k).flat_map(|p| p[3..].iter().copied()).collect();
+    (rgb, Channels { names: names[3..].to_vec(), data })
 }
 
 /// The unnormalised sums of the samples with indices in a range: one part of a render. Parts of disjoint
@@ -59,10 +86,12 @@ pub struct SampleSums {
 /// The image is [`render_samples`] of `0..spp`, developed.
 pub fn render(scene: &Scene, spp: u32, seed: u64, cancel: &AtomicBool, progress: &(dyn Fn(u64) + Sync)) -> RenderOutput {
     let part = render_samples(scene, seed, 0..spp, cancel, progress);
+    let (data, aovs) = split_rgb(part.film.mean(part.spp_done), scene.integrator.channels());
     RenderOutput {
         width: part.film.width,
         height: part.film.height,
-        data: part.film.mean(part.spp_done),
+        data,
+        aovs,
         spp_done: part.spp_done,
         spp_requested: spp,
         nonfinite: part.nonfinite,
@@ -81,7 +110,10 @@ pub fn render_samples(scene: &Scene, seed: u64, samples: Range<u32>, cancel: &At
     let (w, h) = (scene.film.width, scene.film.height);
     let filter = &scene.film.filter;
     let border = filter.border();
-    let mut film = if filter.is_box() { Film::new(w, h) } else { Film::weighted(w, h) };
+    // R, G, B and the integrator's further channels (an `aov` integrator's), `extra` of them.
+    let channels = scene.integrator.channels().len();
+    let extra = channels - 3;
+    let mut film = if filter.is_box() { Film::new(w, h, channels) } else { Film::weighted(w, h, channels) };
     let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE)).flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE))).collect();
     let nonfinite = AtomicU64::new(0);
     let done = AtomicU64::new(0);
@@ -99,7 +131,8 @@ pub fn render_samples(scene: &Scene, seed: u64, samples: Range<u32>, cancel: &At
                     return None;
                 }
                 let (tw, th) = (TILE.min(w - x0), TILE.min(h - y0));
-                let mut tile = if filter.is_box() { Film::new(tw, th) } else { Film::weighted(tw + 2 * border, th + 2 * border) };
+                let mut tile =
+                    if filter.is_box() { Film::new(tw, th, channels) } else { Film::weighted(tw + 2 * border, th + 2 * border, channels) };
                 let mut bad = 0;
                 // The tile's camera samples, pixel by pixel and sample by sample within a pixel; the integrator
                 // may trace them in any order (several at once), and the film sums them in this one.
@@ -113,26 +146,27 @@ pub fn render_samples(scene: &Scene, seed: u64, samples: Range<u32>, cancel: &At
                 }
                 let mut radiance = vec![Rgb::ZERO; samples.len()];
                 integrator::radiance(scene, seed, &samples, &mut radiance);
+                let mut aovs = vec![0.0; extra * samples.len()];
+                integrator::aov::channels(scene, seed, &samples, &radiance, &mut aovs);
+                let mut buffer = vec![0.0; channels];
                 // Pixel by pixel, its `n` samples in order (the tile's pixels are row-major, as `samples`).
                 if filter.is_box() {
-                    for (pixel, ls) in radiance.chunks_exact(n as usize).enumerate() {
-                        for &l in ls {
-                            if !tile.add(pixel, l) {
-                                bad += 1;
-                            }
+                    for (i, &l) in radiance.iter().enumerate() {
+                        if !tile.add(i / n as usize, sample_values(&mut buffer, l, &aovs, i)) {
+                            bad += 1;
                         }
                     }
                 } else {
                     // Each sample into the (2b + 1)² pixels around its own, b = the border.
                     let taps = 2 * border as usize + 1;
                     let (mut wx, mut wy) = (vec![0.0; taps], vec![0.0; taps]);
-                    for (s, &l) in samples.iter().zip(&radiance) {
+                    for (i, (s, &l)) in samples.iter().zip(&radiance).enumerate() {
                         let u = integrator::pixel_offset(scene, seed, *s);
                         filter.weights(u.x, &mut wx);
                         filter.weights(u.y, &mut wy);
                         // The tile's pixel (x − x0, y − y0) sits at (x − x0 + b, y − y0 + b) of its buffer;
                         // the taps start b before it.
-                        if !tile.splat(s.x - x0, s.y - y0, &wx, &wy, l) {
+                        if !tile.splat(s.x - x0, s.y - y0, &wx, &wy, sample_values(&mut buffer, l, &aovs, i)) {
                             bad += 1;
                         }
                     }

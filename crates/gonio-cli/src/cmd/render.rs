@@ -1,6 +1,7 @@
 //! `gonio render SCENE.xml`: render a Mitsuba 3 XML scene with gonio's path tracer.
 //!
-//! The image goes to `-o FILE` (`.exr`: float32 linear RGB; `.png`: 8-bit sRGB), by default next to the
+//! The image goes to `-o FILE` (`.exr`: float32 linear RGB, and an `aov` integrator's further channels
+//! under Mitsuba 3's names, e.g. `image.R`, `dd.y.T`; `.png`: 8-bit sRGB, the RGB only), by default next to the
 //! scene with the extension replaced by `.exr` (as Mitsuba's `mitsuba scene.xml` does), atomically: a
 //! failure never leaves a partial file, and a file already there survives any error. The output path is
 //! checked before the scene is loaded, so an unwritable one fails at once.
@@ -14,7 +15,7 @@
 //! Non-finite samples (NaN or Inf radiance, e.g. from overflow) are dropped and counted as black; when
 //! there are any, stderr says "N non-finite samples dropped".
 
-use gonio::image::{check_writable, write_image_with_notes, Image};
+use gonio::image::{check_writable, write_image_with_channels, Image};
 use gonio::render::render;
 use gonio::scene::Scene;
 use gonio::Error;
@@ -157,7 +158,15 @@ pub fn run(args: Args) -> Result<ExitCode, Error> {
         ("gonio.seed", seed.to_string()),
     ];
     let image = Image { width: out.width as usize, height: out.height as usize, data: out.data };
-    write_image_with_notes(&output, &image, &notes)?;
+    write_image_with_channels(&output, &image, &out.aovs, &notes)?;
+    let exr = output.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+    if !out.aovs.names.is_empty() && !exr {
+        eprintln!(
+            "gonio: note: {} holds the RGB only; the aov channels ({}) are written to .exr files",
+            output.display(),
+            out.aovs.names.join(", ")
+        );
+    }
     if !args.quiet {
         let rate = f64::from(out.spp_done) * f64::from(w) * f64::from(h) / out.seconds.max(1e-9);
         eprintln!(

@@ -83,6 +83,9 @@ class Scene:
     """A renderable scene; build one with `load_scene` or `load_dict`."""
 
     @property
+    def channels(self) -> List[str]:
+        """Names of the channels `render` returns: R, G, B, then an `aov` integrator's (`image.R`, …, `nn.X`, …)."""
+    @property
     def width(self) -> int:
         """Image width in pixels (the film's `width`)."""
     @property
@@ -109,7 +112,8 @@ class Scene:
     def render(
         self, spp: Optional[int] = None, seed: Optional[int] = None, threads: Optional[int] = None, progress: bool = True
     ) -> npt.NDArray[np.float32]:
-        """Render to linear RGB of shape (height, width, 3), float32, top row first.
+        """Render to linear RGB of shape (height, width, 3), float32, top row first; with an `aov` integrator
+        (height, width, C), its further channels after the RGB, named by `channels` (Mitsuba's film order).
 
         `spp`/`seed` default to the scene's sampler; the image depends on the seed only (not on `threads`)
         and equals `gonio render --seed` bit for bit. `threads` defaults to all cores. A progress bar goes to
@@ -119,8 +123,8 @@ class Scene:
     def render_samples(
         self, first: int, count: int, seed: Optional[int] = None, threads: Optional[int] = None, progress: bool = False
     ) -> Dict[str, Any]:
-        """The unnormalised sums of the samples first … first + count − 1 of every pixel: `sum` (H, W, 3)
-        float64, `weight` (H, W) float64 or None (box filter), `first`, `spp`, `nonfinite`, `seconds`.
+        """The unnormalised sums of the samples first … first + count − 1 of every pixel: `sum` (H, W, C)
+        float64 (C as in `render`), `weight` (H, W) float64 or None (box filter), `first`, `spp`, `nonfinite`, `seconds`.
         Parts of disjoint ranges add up; `develop(sum, weight, spp)` makes the image (docs/distributed.md)."""
 
 def develop(sum: npt.NDArray[np.float64], weight: Optional[npt.NDArray[np.float64]], spp: int) -> npt.NDArray[np.float32]:

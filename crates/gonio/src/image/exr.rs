@@ -8,7 +8,7 @@ use std::path::Path;
 use ::exr::prelude as x;
 use ::exr::prelude::{ReadChannels as _, ReadLayers as _, WritableImage as _};
 
-use super::Image;
+use super::{Channels, Image};
 use crate::error::{Error, Result};
 
 /// More pixels than this in one layer is taken as a hostile or corrupt header: refused before the
@@ -95,14 +95,22 @@ pub(super) fn decode(path: &Path, bytes: &[u8]) -> Result<Image> {
     Ok(img)
 }
 
-/// Encodes `img`, with each note as a string attribute of the layer header (names and values must be
-/// representable as EXR text: Latin-1, no longer than the format allows).
-pub(super) fn encode(path: &Path, img: &Image, notes: &[(&str, String)]) -> Result<Vec<u8>> {
-    let width = img.width;
-    let channels = x::SpecificChannels::rgb(|p: x::Vec2<usize>| {
-        let i = 3 * (p.y() * width + p.x());
-        (img.data[i], img.data[i + 1], img.data[i + 2])
-    });
+/// Encodes `img` as float32 channels R, G, B and `extra`'s under their names (the file lists them sorted
+/// by name, as OpenEXR requires), with each note as a string attribute of the layer header (names and
+/// values must be representable as EXR text: Latin-1, no longer than the format allows).
+pub(super) fn encode(path: &Path, img: &Image, extra: &Channels, notes: &[(&str, String)]) -> Result<Vec<u8>> {
+    let text = |name: &str, what: &str| {
+        x::Text::new_or_none(name).ok_or_else(|| Error::format(path, "OpenEXR encoding", format!("the {what} `{name}` is not EXR text")))
+    };
+    let mut list = x::SmallVec::new();
+    for (c, name) in ["R", "G", "B"].iter().enumerate() {
+        let plane = img.data.iter().skip(c).step_by(3).copied().collect();
+        list.push(x::AnyChannel::new(*name, x::FlatSamples::F32(plane)));
+    }
+    for (c, name) in extra.names.iter().enumerate() {
+        list.push(x::AnyChannel::new(text(name, "channel name")?, x::FlatSamples::F32(extra.plane(c).collect())));
+    }
+    let channels = x::AnyChannels::sort(list);
     let mut image = x::Image::from_channels((img.width, img.height), channels);
     for (name, value) in notes {
         let (Some(n), Some(v)) = (x::Text::new_or_none(name), x::Text::new_or_none(value)) else {

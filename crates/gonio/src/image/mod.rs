@@ -2,9 +2,9 @@
 //!
 //! | format | read | write |
 //! |---|---|---|
-//! | OpenEXR (`.exr`) | first layer; R, G, B (A ignored) or a single Y channel; half, float or uint → `f32` | float32 RGB, linear, lossless RLE compression (the `exr` crate's default) |
-//! | Radiance (`.hdr`, `.rgbe`, `.pic`) | RGBE, run-length encoded or flat | RGBE, run-length encoded; negative and NaN samples as 0 |
-//! | PNG (`.png`) | 8- or 16-bit, grey or colour, alpha ignored; sRGB-decoded to linear | 8-bit RGB, sRGB-encoded, clamped to [0, 1], rounded |
+//! | OpenEXR (`.exr`) | first layer; R, G, B (A ignored) or a single Y channel; half, float or uint → `f32` | float32 RGB and any further named [`Channels`] (an `aov` integrator's), linear, lossless RLE compression (the `exr` crate's default) |
+//! | Radiance (`.hdr`, `.rgbe`, `.pic`) | RGBE, run-length encoded or flat | RGBE, run-length encoded; negative and NaN samples as 0; RGB only |
+//! | PNG (`.png`) | 8- or 16-bit, grey or colour, alpha ignored; sRGB-decoded to linear | 8-bit RGB, sRGB-encoded, clamped to [0, 1], rounded; RGB only |
 //! | JPEG (`.jpg`, `.jpeg`) | 8-bit, grey or colour; sRGB-decoded to linear | — |
 //! | BMP (`.bmp`) | 8-bit grey, colour or palette, alpha ignored; sRGB-decoded to linear | — |
 //!
@@ -97,6 +97,28 @@ impl Image {
             ));
         }
         Ok(())
+    }
+}
+
+/// Named channels beside an image's RGB (an `aov` integrator's outputs, named as Mitsuba 3 names them,
+/// e.g. `depth.T`): `names.len()` values per pixel, row-major, top row first. Written to EXR files only.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Channels {
+    pub names: Vec<String>,
+    /// `names.len() · width · height` floats: pixel i's values start at `names.len() · i`.
+    pub data: Vec<f32>,
+}
+
+impl Channels {
+    /// No channels.
+    #[must_use]
+    pub fn none() -> Self {
+        Channels::default()
+    }
+
+    /// The values of channel `c` (an index into `names`), pixel by pixel.
+    pub fn plane(&self, c: usize) -> impl Iterator<Item = f32> + '_ {
+        self.data.iter().skip(c).step_by(self.names.len().max(1)).copied()
     }
 }
 
@@ -248,13 +270,26 @@ pub fn write_image(path: &Path, img: &Image) -> Result<()> {
 /// attributes in an EXR header (read back with [`read_notes`]); other formats drop them. `gonio render`
 /// notes the samples per pixel written, those requested and whether the render was interrupted.
 pub fn write_image_with_notes(path: &Path, img: &Image, notes: &[(&str, String)]) -> Result<()> {
+    write_image_with_channels(path, img, &Channels::none(), notes)
+}
+
+/// [`write_image_with_notes`] with further channels beside the RGB, written to an EXR file under their
+/// names; PNG and Radiance files hold the RGB only (the caller says so where it matters).
+pub fn write_image_with_channels(path: &Path, img: &Image, extra: &Channels, notes: &[(&str, String)]) -> Result<()> {
     let format = writable_format(path)?;
     img.check_shape(path)?;
     if img.width == 0 || img.height == 0 {
         return Err(Error::format(path, "image", "cannot write an image with no pixels"));
     }
+    if extra.data.len() != extra.names.len() * img.width * img.height {
+        return Err(Error::format(
+            path,
+            "image",
+            format!("expected {}·{}·{} floats of further channels, found {}", extra.names.len(), img.width, img.height, extra.data.len()),
+        ));
+    }
     let bytes = guard(path, || match format {
-        Format::Exr => exr::encode(path, img, notes),
+        Format::Exr => exr::encode(path, img, extra, notes),
         Format::Png => ldr::encode_png(path, img),
         Format::Hdr => ldr::encode_hdr(path, img),
         Format::Jpeg | Format::Bmp => {
@@ -583,6 +618,26 @@ mod tests {
         assert!(read_notes(&png).unwrap().is_empty());
         let err = write_image_with_notes(&dir.join("bad.exr"), &test_pattern(1, 1), &[("x", "\u{1F600}".to_string())]).unwrap_err();
         assert!(err.to_string().contains("bad.exr"), "{err}");
+    }
+
+    /// Further channels are written to EXR files under their names, each the values given for it; the RGB
+    /// reads back as before, and a count that does not match the image is refused.
+    #[test]
+    fn exr_files_carry_further_channels() {
+        let dir = scratch_dir("channels");
+        let path = dir.join("aov.exr");
+        let extra = Channels { names: vec!["dd.y.T".into(), "nn.X".into()], data: (0..12).map(|i| i as f32 * 0.5).collect() };
+        write_image_with_channels(&path, &test_pattern(3, 2), &extra, &[]).unwrap();
+        assert_eq!(read_image(&path).unwrap(), test_pattern(3, 2));
+        let image = ::exr::prelude::read_all_flat_layers_from_file(&path).unwrap();
+        let channels = &image.layer_data[0].channel_data.list;
+        let names: Vec<String> = channels.iter().map(|c| c.name.to_string()).collect();
+        assert_eq!(names, ["B", "G", "R", "dd.y.T", "nn.X"]);
+        let values = |c: usize| channels[c].sample_data.values_as_f32().collect::<Vec<f32>>();
+        assert_eq!((values(3), values(4)), (vec![0.0, 1.0, 2.0, 3.0, 4.0, 5.0], vec![0.5, 1.5, 2.5, 3.5, 4.5, 5.5]));
+        let short = Channels { names: vec!["d.T".into()], data: vec![0.0; 5] };
+        let e = write_image_with_channels(&dir.join("short.exr"), &test_pattern(3, 2), &short, &[]).unwrap_err();
+        assert!(e.to_string().contains("expected 1·3·2 floats of further channels, found 5"), "{e}");
     }
 
     #[test]

@@ -2,9 +2,13 @@
 //! both with next-event estimation combined with BSDF sampling by the power heuristic (Veach & Guibas 1995,
 //! "Optimally Combining Sampling Techniques for Monte Carlo Rendering", eq. 8 with β = 2).
 //!
+//! [`aov`] adds Mitsuba 3's arbitrary output variables (values at the camera rays' first hits) beside the
+//! image of a nested integrator.
+//!
 //! The two techniques below are shared: [`sample_emitter`] (a light sample and its weight) and
 //! [`emitter_hit`] (radiance found by a BSDF-sampled ray and its weight).
 
+pub mod aov;
 pub mod direct;
 pub mod path;
 
@@ -95,9 +99,15 @@ pub fn start_lanes(scene: &Scene, mixed: &[u64; 8], samples: &[CameraSample; 8],
     scene.camera.rays(x, y)
 }
 
-/// The radiance of each camera sample (`out[i]` for `samples[i]`), by the scene's integrator.
+/// The radiance of each camera sample (`out[i]` for `samples[i]`), by the scene's integrator (for `aov`, by
+/// its first nested integrator, [`IntegratorKind::rgb`]: black when it has none).
 pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [Rgb]) {
-    match scene.integrator {
+    radiance_by(&scene.integrator, scene, seed, samples, out);
+}
+
+/// [`radiance`] by integrator `kind` (a `path` or `direct`; an `aov` renders its first nested one).
+pub(crate) fn radiance_by(kind: &IntegratorKind, scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [Rgb]) {
+    match *kind {
         IntegratorKind::Path { max_depth, rr_depth, hide_emitters } => {
             path::radiance(scene, seed, samples, out, path::Settings::path(max_depth, rr_depth, hide_emitters));
         }
@@ -110,6 +120,10 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
             let settings = path::Settings { max_depth: 2, rr_depth: i32::MAX, hide_emitters, light_samples: emitter_samples, bsdf_samples };
             path::radiance(scene, seed, samples, out, settings);
         }
+        IntegratorKind::Aov { .. } => match kind.rgb() {
+            Some(inner) => radiance_by(inner, scene, seed, samples, out),
+            None => out.fill(Rgb::ZERO),
+        },
     }
 }
 

@@ -3,7 +3,7 @@
 //! know is an error naming the place in the file.
 
 use super::mitsuba_xml::SceneDescription;
-use super::{IntegratorKind, Material, SamplerSpec, Scene};
+use super::{Aov, AovKind, IntegratorKind, Material, SamplerSpec, Scene};
 use crate::bsdf::{Bsdf, Diffuse};
 use crate::camera::Camera;
 use crate::error::{Error, Result};
@@ -71,7 +71,7 @@ impl Scene {
             Some(p) => integrator_from_props(p)?,
             None => IntegratorKind::Path { max_depth: -1, rr_depth: 5, hide_emitters: false },
         };
-        if let (IntegratorKind::Direct { emitter_samples: n @ 2.., .. }, Some(p)) = (integrator, &desc.integrator) {
+        if let (Some(IntegratorKind::Direct { emitter_samples: n @ 2.., .. }), Some(p)) = (integrator.rgb(), &desc.integrator) {
             if lights.iter().any(Light::is_delta) {
                 // Mitsuba 3's `direct` gives a delta light's sample the MIS weight 1 instead of 1/n
                 // (`src/integrators/direct.cpp`: `select(ds.delta, 1, mis_weight(…) * m_weight_lum)`), so
@@ -337,9 +337,64 @@ fn integrator_from_props(p: &Props) -> Result<IntegratorKind> {
                 hide_emitters: p.bool("hide_emitters", false)?,
             }
         }
-        other => return Err(Error::spec(p.at(), format!("unsupported integrator `{other}` (gonio has: path, direct, moment)"))),
+        "aov" => aov_from_props(p)?,
+        other => return Err(Error::spec(p.at(), format!("unsupported integrator `{other}` (gonio has: path, direct, moment, aov)"))),
     };
     p.finish()?;
+    Ok(kind)
+}
+
+/// Mitsuba 3's `aov` integrator: `aovs`, a list of `name:type` separated by commas or spaces (as Mitsuba
+/// splits it), and nested integrators (`path` or `direct`), named by their parameter names. Every channel
+/// name must be new.
+fn aov_from_props(p: &Props) -> Result<IntegratorKind> {
+    let kinds = || AovKind::ALL.map(|(_, name, _)| name).join(", ");
+    let list =
+        p.string("aovs")?.ok_or_else(|| Error::spec(p.at(), format!("`aov` needs `aovs`, a list of name:type (types: {})", kinds())))?;
+    let at = p.at_param("aovs");
+    let mut outputs = Vec::new();
+    for item in list.split([',', ' ', '\t', '\n']).filter(|t| !t.is_empty()) {
+        let Some((name, kind)) = item.split_once(':').filter(|(n, k)| !n.is_empty() && !k.is_empty() && !k.contains(':')) else {
+            return Err(Error::spec(at, format!("`aovs`: `{item}` is not a name:type pair (e.g. \"dd.y:depth\")")));
+        };
+        let Some(&(kind, _, _)) = AovKind::ALL.iter().find(|(_, n, _)| *n == kind) else {
+            let known = if ["albedo", "dp_du", "dp_dv", "duv_dx", "duv_dy", "boundary_test"].contains(&kind) {
+                "a Mitsuba 3 type gonio does not output yet"
+            } else {
+                "an unknown type"
+            };
+            return Err(Error::spec(at, format!("`aovs`: `{kind}` in `{item}` is {known} (gonio has: {})", kinds())));
+        };
+        outputs.push(Aov { name: name.to_string(), kind });
+    }
+    let mut integrators = Vec::new();
+    for (name, nested) in p.nested_named() {
+        let integrator = match nested.class() {
+            "integrator" => true,
+            "" => matches!(nested.plugin_type(), "path" | "direct" | "moment" | "aov"),
+            _ => false,
+        };
+        if !integrator {
+            return Err(Error::spec(
+                nested.at(),
+                format!("`aov` nests integrators (gonio's: path, direct), not the {} `{}`", nested.class(), nested.plugin_type()),
+            ));
+        }
+        if matches!(nested.plugin_type(), "aov" | "moment") {
+            // Their own further channels (Mitsuba's `name.…` after every nested integrator's RGBA) are not
+            // rendered by gonio.
+            return Err(Error::spec(
+                nested.at(),
+                format!("an `aov` integrator cannot nest `{}` in gonio (only path, direct)", nested.plugin_type()),
+            ));
+        }
+        integrators.push((name.to_string(), integrator_from_props(nested)?));
+    }
+    let kind = IntegratorKind::Aov { integrators, outputs };
+    let channels = kind.channels();
+    if let Some(twice) = channels.iter().enumerate().find_map(|(i, c)| channels[..i].contains(c).then_some(c)) {
+        return Err(Error::spec(at, format!("`aov`: the channel `{twice}` is named twice")));
+    }
     Ok(kind)
 }
 
@@ -459,5 +514,49 @@ mod tests {
         assert!(e.contains("unknown parameter `radius` for `shapegroup`"), "{e}");
         let e = error(r#"<shape type="instance"><shape type="sphere"/></shape>"#);
         assert!(e.contains("an `instance` takes one <ref id=\"…\"> to a `shapegroup`"), "{e}");
+    }
+
+    /// Mitsuba 3's `aov` integrator: its channels in Mitsuba's order (unnamed nested integrators as
+    /// `_arg_0`, …), and every malformed or unsupported part refused at its place.
+    #[test]
+    fn aov_integrators_read_as_mitsubas() {
+        let load = |integrator: &str| {
+            let text = format!(
+                "<scene version=\"3.0.0\">\n{integrator}\n<sensor type=\"perspective\"><film type=\"hdrfilm\"><integer name=\"width\" value=\"4\"/>\
+                 <integer name=\"height\" value=\"4\"/></film></sensor><shape type=\"sphere\"/></scene>"
+            );
+            mitsuba_xml::load_str(&text, "t.xml", Path::new("."), &[]).and_then(Scene::build)
+        };
+        let scene = load(
+            r#"<integrator type="aov"><string name="aovs" value=" a.b:uv,c:prim_index  s:shape_index"/>
+            <integrator type="path"/><integrator type="direct" name="d"/><integrator type="path"/></integrator>"#,
+        )
+        .unwrap();
+        let want = "R G B _arg_0.R _arg_0.G _arg_0.B _arg_0.A d.R d.G d.B d.A _arg_1.R _arg_1.G _arg_1.B _arg_1.A a.b.U a.b.V c.I s.I";
+        assert_eq!(scene.integrator.channels().join(" "), want);
+        assert_eq!(scene.integrator.rgb(), Some(&IntegratorKind::Path { max_depth: -1, rr_depth: 5, hide_emitters: false }));
+        let none = load(r#"<integrator type="aov"><string name="aovs" value="dd:depth"/></integrator>"#).unwrap();
+        assert_eq!((none.integrator.channels().join(" "), none.integrator.rgb()), ("R G B dd.T".to_string(), None));
+        for (aovs, nested, want) in [
+            ("dd:depthx", "", "t.xml:2:24: `aovs`: `depthx` in `dd:depthx` is an unknown type (gonio has: depth, position, uv, geo_normal, sh_normal, prim_index, shape_index)"),
+            ("nn:sh_normal, al:albedo", "", "`albedo` in `al:albedo` is a Mitsuba 3 type gonio does not output yet"),
+            ("dd", "", "t.xml:2:24: `aovs`: `dd` is not a name:type pair"),
+            ("dd:depth:x", "", "`dd:depth:x` is not a name:type pair"),
+            (":depth", "", "`:depth` is not a name:type pair"),
+            ("a:depth, a:depth", "", "t.xml:2:24: `aov`: the channel `a.T` is named twice"),
+            ("a:position a:geo_normal", "", "the channel `a.X` is named twice"),
+            ("a:depth", r#"<bsdf type="diffuse"/>"#, "t.xml:2:61: `aov` nests integrators (gonio's: path, direct), not the bsdf `diffuse`"),
+            ("a:depth", r#"<integrator type="aov"><string name="aovs" value=""/></integrator>"#, "t.xml:2:61: an `aov` integrator cannot nest `aov`"),
+            ("a:depth", r#"<integrator type="moment"><integrator type="path"/></integrator>"#, "cannot nest `moment` in gonio"),
+            ("a:depth", r#"<integrator type="path"><integer name="max_depth" value="-2"/></integrator>"#, "`max_depth`"),
+        ] {
+            let text = format!(r#"<integrator type="aov"><string name="aovs" value="{aovs}"/>{nested}</integrator>"#);
+            match load(&text) {
+                Ok(_) => panic!("{text} loads"),
+                Err(e) => assert!(e.to_string().contains(want), "{text}: {e}"),
+            }
+        }
+        let e = load(r#"<integrator type="aov"><integrator type="path"/></integrator>"#).err().unwrap().to_string();
+        assert!(e.contains("t.xml:2:1: `aov` needs `aovs`"), "{e}");
     }
 }

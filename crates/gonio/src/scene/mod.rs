@@ -29,7 +29,7 @@ use std::borrow::Cow;
 use std::path::Path;
 
 /// Which integrator renders the scene.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq, Eq)]
 pub enum IntegratorKind {
     /// Mitsuba's `path`: `max_depth` (−1 = unbounded; 1 = emitters only, 2 = direct lighting),
     /// Russian roulette from depth `rr_depth`.
@@ -37,6 +37,89 @@ pub enum IntegratorKind {
     /// Mitsuba's `direct`: one bounce, `emitter_samples` light samples and `bsdf_samples` BSDF samples
     /// combined with the power heuristic.
     Direct { emitter_samples: u32, bsdf_samples: u32, hide_emitters: bool },
+    /// Mitsuba's `aov` ([`crate::integrator::aov`]): the nested integrators (name, kind; each `path` or
+    /// `direct`), the first of which gives the image's RGB (black when there is none), and the values of
+    /// the camera rays' first hits in `outputs`, all as further channels of the film.
+    Aov { integrators: Vec<(String, IntegratorKind)>, outputs: Vec<Aov> },
+}
+
+/// One output of the `aov` integrator: channels `name.X`, … of a value at the camera ray's first hit.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Aov {
+    pub name: String,
+    pub kind: AovKind,
+}
+
+/// What an [`Aov`] holds (Mitsuba 3's `aovs` types); zero where the camera ray hits nothing.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AovKind {
+    /// `depth` (`.T`): the ray's distance to the hit, from its origin on the camera's near plane.
+    Depth,
+    /// `position` (`.X`, `.Y`, `.Z`): the hit point in world space.
+    Position,
+    /// `uv` (`.U`, `.V`): the texture coordinates.
+    Uv,
+    /// `geo_normal` (`.X`, `.Y`, `.Z`): the geometric normal (the shape's outward side).
+    GeoNormal,
+    /// `sh_normal` (`.X`, `.Y`, `.Z`): the shading normal.
+    ShNormal,
+    /// `prim_index` (`.I`): the triangle's index in its mesh (0 for other shapes).
+    PrimIndex,
+    /// `shape_index` (`.I`): the shape's position in the file, counted from 1.
+    ShapeIndex,
+}
+
+impl AovKind {
+    /// Every kind with its name in `aovs` and its channels' suffixes.
+    pub const ALL: [(AovKind, &'static str, &'static [&'static str]); 7] = [
+        (AovKind::Depth, "depth", &["T"]),
+        (AovKind::Position, "position", &["X", "Y", "Z"]),
+        (AovKind::Uv, "uv", &["U", "V"]),
+        (AovKind::GeoNormal, "geo_normal", &["X", "Y", "Z"]),
+        (AovKind::ShNormal, "sh_normal", &["X", "Y", "Z"]),
+        (AovKind::PrimIndex, "prim_index", &["I"]),
+        (AovKind::ShapeIndex, "shape_index", &["I"]),
+    ];
+
+    /// The channels' suffixes (`T`; `X`, `Y`, `Z`; `U`, `V`; `I`).
+    #[must_use]
+    pub fn suffixes(self) -> &'static [&'static str] {
+        AovKind::ALL.iter().find(|(k, _, _)| *k == self).map_or(&[], |(_, _, s)| s)
+    }
+}
+
+impl IntegratorKind {
+    /// The names of the film's channels: `R`, `G`, `B`, then for `aov` each nested integrator's `name.R`,
+    /// `name.G`, `name.B`, `name.A` and each output's `name.X`, … (Mitsuba 3.9.1's order).
+    #[must_use]
+    pub fn channels(&self) -> Vec<String> {
+        let mut names: Vec<String> = ["R", "G", "B"].map(String::from).to_vec();
+        if let IntegratorKind::Aov { integrators, outputs } = self {
+            for (name, _) in integrators {
+                names.extend(["R", "G", "B", "A"].map(|c| format!("{name}.{c}")));
+            }
+            for aov in outputs {
+                names.extend(aov.kind.suffixes().iter().map(|c| format!("{}.{c}", aov.name)));
+            }
+        }
+        names
+    }
+
+    /// The integrator whose radiance is the image's RGB: this one, or an `aov`'s first nested integrator
+    /// (`None` when it has none: the RGB is black).
+    #[must_use]
+    pub fn rgb(&self) -> Option<&IntegratorKind> {
+        match self {
+            IntegratorKind::Aov { integrators, .. } => integrators.first().and_then(|(_, k)| k.rgb()),
+            _ => Some(self),
+        }
+    }
+
+    /// Whether an `aov` output of this kind is asked for.
+    #[must_use]
+    pub fn outputs(&self, kind: AovKind) -> bool {
+        matches!(self, IntegratorKind::Aov { outputs, .. } if outputs.iter().any(|a| a.kind == kind))
+    }
 }
 
 /// Sampler settings (`independent`).
@@ -419,7 +502,11 @@ impl Scene {
         integrator: IntegratorKind,
         warnings: Vec<String>,
     ) -> Scene {
-        let textured: Vec<bool> = (0..shapes.len()).map(|s| materials.get(s).is_some_and(Material::is_textured)).collect();
+        // The `aov` integrator's `uv` output needs texture coordinates at every hit, and its `prim_index`
+        // each triangle as its own primitive (not paired into a parallelogram, whose test gives the first).
+        let all_uv = integrator.outputs(AovKind::Uv);
+        let pair = !integrator.outputs(AovKind::PrimIndex);
+        let textured: Vec<bool> = (0..shapes.len()).map(|s| all_uv || materials.get(s).is_some_and(Material::is_textured)).collect();
         let start = std::time::Instant::now();
         let (mut refs, mut bounds, mut alone) = (Vec::new(), Vec::new(), Vec::new());
         for (s, shape) in shapes.iter().enumerate() {
@@ -428,7 +515,7 @@ impl Scene {
                 // Two triangles that form a parallelogram are one primitive (its test costs as much as a
                 // triangle's): a `rectangle` is one, a `cube` six.
                 let corner = match shape {
-                    Shape::Mesh(m) => m.parallelogram(p, textured[s]),
+                    Shape::Mesh(m) if pair => m.parallelogram(p, textured[s]),
                     _ => None,
                 };
                 refs.push(SlotRef { shape: s as u32, prim: p, corner, uv_map: NO_UV_MAP });

@@ -183,6 +183,7 @@ def _render_part(boxed: List[Any], first: int, count: int, seed: int) -> Dict[st
 @dataclasses.dataclass
 class RenderResult:
     """What ``render`` produced: ``image`` (H, W, 3) float32 linear RGB holding ``spp`` samples per pixel
+    (H, W, C with an ``aov`` integrator's further channels after the RGB, as ``Scene.render`` returns them)
     (fewer than ``spp_requested`` when ``cancelled``; ``None`` if nothing was merged), and per task
     (first sample, samples, seconds in the task, node id)."""
 
