@@ -50,7 +50,6 @@ const MAX_ROUNDS: u32 = 4;
 const REFUSED: &[(&str, &str)] = &[
     ("t_media_area", "test_homo_area_light_volpath.xml:8:5: unsupported element <medium> in <scene>"),
     ("d_sss", "medium_homogeneous_sss.xml:14:5: unsupported element <medium> in <scene>"),
-    ("d_mesh_attribute", "texture_mesh_attribute_vertex.xml:6:13: unsupported texture `mesh_attribute`"),
     ("tu_shadow_art", "shadow_art.xml:60:2: unsupported shape `bsplinecurve`"),
 ];
 

@@ -14,6 +14,7 @@
 //! Rays are intersected with Möller & Trumbore 1997, "Fast, Minimum Storage Ray/Triangle Intersection".
 
 use super::interaction::{PositionSample, SurfaceInteraction};
+use super::mesh_io::VertexAttribute;
 use super::{Bounds3, PrimHit, Ray};
 use crate::error::{Error, Result};
 use crate::math::lanes::{Real, V3};
@@ -46,6 +47,8 @@ pub struct Mesh {
     /// gave per face or gonio computed, as Mitsuba does, for a mesh file without them). Empty where no
     /// triangle is flat.
     flat_frames: Vec<Option<Frame>>,
+    /// Per-vertex attributes (a PLY file's), for `mesh_attribute` textures.
+    attributes: Vec<VertexAttribute>,
 }
 
 impl Mesh {
@@ -129,9 +132,47 @@ impl Mesh {
             area,
             tri_normals,
             flat_frames: Vec::new(),
+            attributes: Vec::new(),
         };
         mesh.update_flat_frames();
         Ok(mesh)
+    }
+
+    /// The mesh with the per-vertex attributes `attributes` (a PLY file's, each `dim` values per vertex).
+    #[must_use]
+    pub fn with_attributes(self, attributes: Vec<VertexAttribute>) -> Self {
+        debug_assert!(attributes.iter().all(|a| a.values.len() == a.dim * self.positions.len()));
+        Mesh { attributes, ..self }
+    }
+
+    /// The per-vertex attributes, named as Mitsuba names them (`vertex_color`, …).
+    #[must_use]
+    pub fn attributes(&self) -> &[VertexAttribute] {
+        &self.attributes
+    }
+
+    /// Attribute `attribute` (of [`Self::attributes`]) at the point `p` of triangle `tri`, interpolated with
+    /// the barycentrics of `p`'s projection onto the triangle, as a colour: one value for all three channels,
+    /// otherwise the first three (a missing third is 0).
+    #[must_use]
+    pub fn attribute_at(&self, attribute: usize, tri: u32, p: Vec3) -> crate::spectrum::Rgb {
+        let a = &self.attributes[attribute];
+        let [p0, e1, e2] = self.triangle_edges(tri);
+        let d = p - p0;
+        let (d00, d01, d11, d20, d21) = (e1.dot(e1), e1.dot(e2), e2.dot(e2), d.dot(e1), d.dot(e2));
+        let den = d00 * d11 - d01 * d01;
+        let (b1, b2) = if den > 0.0 { ((d11 * d20 - d01 * d21) / den, (d00 * d21 - d01 * d20) / den) } else { (0.0, 0.0) };
+        let idx = self.indices[tri as usize];
+        let value = |c: usize| {
+            if a.dim == 1 || c < a.dim {
+                let c = if a.dim == 1 { 0 } else { c };
+                let at = |v: u32| a.values[v as usize * a.dim + c];
+                at(idx[0]) * (1.0 - b1 - b2) + at(idx[1]) * b1 + at(idx[2]) * b2
+            } else {
+                0.0
+            }
+        };
+        crate::spectrum::Rgb::new(value(0), value(1), value(2))
     }
 
     /// Fill [`Mesh::flat_frames`]. A triangle with vertex normals is flat when they agree to

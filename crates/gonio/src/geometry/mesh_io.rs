@@ -21,7 +21,10 @@
 //! `ascii 1.0`, `binary_little_endian 1.0`, `binary_big_endian 1.0`. From the `vertex` element: `x y z`,
 //! `nx ny nz`, and texture coordinates as `u v`, `s t`, `texture_u texture_v` or `texture_s texture_t`;
 //! from the `face` element: the list `vertex_indices` (or `vertex_index`) with any count and index types.
-//! All other properties and elements are skipped by their declared types.
+//! Other scalar vertex properties become named attributes ([`VertexAttribute`], grouped as Mitsuba 3's
+//! `ply` groups them: `color_0 color_1 color_2` or `red green blue` make `vertex_color`); integer-typed
+//! colours (`uchar red`, …) are divided by 255. All other properties and elements are skipped by their
+//! declared types.
 //!
 //! ## Mitsuba `.serialized`
 //! The layout, as documented for Mitsuba's `serialized` shape plugin (Mitsuba 0.5 documentation,
@@ -60,6 +63,32 @@ pub struct MeshData {
     pub uvs: Option<Vec<Vec2>>,
     /// Counter-clockwise as stored in the file; every index is `< positions.len()`.
     pub indices: Vec<[u32; 3]>,
+    /// Further per-vertex values (PLY files), named as Mitsuba names them (`vertex_color`, …).
+    pub attributes: Vec<VertexAttribute>,
+}
+
+/// A per-vertex attribute: `dim` values per vertex, vertex after vertex.
+#[derive(Clone, Debug, PartialEq)]
+pub struct VertexAttribute {
+    pub name: String,
+    pub dim: usize,
+    pub values: Vec<f32>,
+}
+
+/// The attribute a PLY vertex property belongs to, as Mitsuba 3's `ply` groups them: a name
+/// `{prefix}_{c}` with c one of x y z w, r g b a, 0 1 2 3 or 1 2 3 4 belongs to `vertex_{prefix}`, the bare
+/// colour names (r g b a, red green blue alpha) to `vertex_color`, any other name to `vertex_{name}`
+/// alone. Consecutive properties of one prefix make one attribute.
+fn attribute_prefix(name: &str) -> &str {
+    match name {
+        "r" | "g" | "b" | "a" | "red" | "green" | "blue" | "alpha" => "color",
+        _ => match name.rsplit_once('_') {
+            Some((prefix, c)) if !prefix.is_empty() && ["x", "y", "z", "w", "r", "g", "b", "a", "0", "1", "2", "3", "4"].contains(&c) => {
+                prefix
+            }
+            _ => name,
+        },
+    }
 }
 
 impl MeshData {
@@ -186,7 +215,7 @@ fn parse_obj(path: &Path, text: &str) -> Result<MeshData> {
     let positions = unique.iter().map(|c| v[c.0 as usize]).collect();
     let uvs = unique.iter().all(|c| c.1 != NONE).then(|| unique.iter().map(|c| vt[c.1 as usize]).collect());
     let normals = unique.iter().all(|c| c.2 != NONE).then(|| unique.iter().map(|c| vn[c.2 as usize]).collect());
-    let mesh = MeshData { positions, normals, uvs, indices };
+    let mesh = MeshData { positions, normals, uvs, indices, attributes: Vec::new() };
     mesh.validate(path)?;
     Ok(mesh)
 }
@@ -564,19 +593,51 @@ fn read_ply_vertices(body: &mut PlyBody, element: &Element, mesh: &mut MeshData)
     let has_normals = present[3..6].iter().all(|&b| b);
     let has_uvs = present[6..8].iter().all(|&b| b);
 
+    // The other scalar properties, grouped into attributes: per property its attribute, or none.
+    let mut attributes: Vec<VertexAttribute> = Vec::new();
+    let mut feeds: Vec<Option<usize>> = Vec::with_capacity(element.properties.len());
+    let mut last_prefix: Option<&str> = None;
+    for p in &element.properties {
+        match p {
+            Property::Scalar { name, .. } if slot(name).is_none() => {
+                let prefix = attribute_prefix(name);
+                if last_prefix != Some(prefix) || attributes.last().is_some_and(|a| a.dim == 4) {
+                    attributes.push(VertexAttribute { name: format!("vertex_{prefix}"), dim: 0, values: Vec::new() });
+                }
+                last_prefix = Some(prefix);
+                let a = attributes.len() - 1;
+                attributes[a].dim += 1;
+                feeds.push(Some(a));
+            }
+            _ => {
+                last_prefix = None;
+                feeds.push(None);
+            }
+        }
+    }
+    if let Some(twice) = attributes.iter().enumerate().find(|(i, a)| attributes[..*i].iter().any(|b| b.name == a.name)) {
+        return Err(Error::format(body.path, "header", format!("the vertex attribute `{}` is given twice", twice.1.name)));
+    }
+
     let n = element.count;
     mesh.positions = Vec::with_capacity(n);
     let mut normals = Vec::with_capacity(if has_normals { n } else { 0 });
     let mut uvs = Vec::with_capacity(if has_uvs { n } else { 0 });
+    for a in &mut attributes {
+        a.values.reserve(n * a.dim);
+    }
     for i in 0..n {
         let at = body.next_at();
         let mut values = [0.0f32; 8];
-        for p in &element.properties {
+        for (p, feed) in element.properties.iter().zip(&feeds) {
             match p {
                 Property::Scalar { name, ty } => {
                     let value = body.read(*ty)? as f32;
                     if let Some(s) = slot(name) {
                         values[s] = value;
+                    } else if let Some(a) = feed {
+                        let colour = attributes[*a].name == "vertex_color" && !matches!(ty, Scalar::F32 | Scalar::F64);
+                        attributes[*a].values.push(if colour { value / 255.0 } else { value });
                     }
                 }
                 Property::List { count, item, .. } => {
@@ -601,6 +662,7 @@ fn read_ply_vertices(body: &mut PlyBody, element: &Element, mesh: &mut MeshData)
     }
     mesh.normals = has_normals.then_some(normals);
     mesh.uvs = has_uvs.then_some(uvs);
+    mesh.attributes = attributes;
     Ok(())
 }
 
@@ -861,7 +923,7 @@ fn decode_serialized_mesh(path: &Path, compressed: &[u8], stream_at: usize, vers
         }
         indices.push(tri);
     }
-    let mesh = MeshData { positions, normals, uvs, indices };
+    let mesh = MeshData { positions, normals, uvs, indices, attributes: Vec::new() };
     mesh.validate(path)?;
     Ok(mesh)
 }
@@ -1005,6 +1067,27 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// Further vertex properties become attributes grouped as Mitsuba groups them: `color_0..2` into
+    /// `vertex_color`, `n_x n_y` into `vertex_n`, a lone name into its own; 8-bit bare colours / 255.
+    #[test]
+    fn ply_vertex_attributes_are_grouped_by_prefix() {
+        let text = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n\
+                    property float color_0\nproperty float color_1\nproperty float color_2\nproperty float quality\n\
+                    property float n_x\nproperty float n_y\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n\
+                    0 0 0 0.1 0.2 0.3 5 1 2\n1 0 0 0.4 0.5 0.6 6 3 4\n0 1 0 0.7 0.8 0.9 7 5 6\n3 0 1 2\n";
+        let mesh = ply_from_bytes(Path::new("a.ply"), text.as_bytes()).unwrap();
+        let names: Vec<(&str, usize)> = mesh.attributes.iter().map(|a| (a.name.as_str(), a.dim)).collect();
+        assert_eq!(names, vec![("vertex_color", 3), ("vertex_quality", 1), ("vertex_n", 2)]);
+        assert_eq!(mesh.attributes[0].values, vec![0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9]);
+        assert_eq!(mesh.attributes[2].values, vec![1.0, 2.0, 3.0, 4.0, 5.0, 6.0]);
+        let text = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n\
+                    property uchar red\nproperty uchar green\nproperty uchar blue\nelement face 1\n\
+                    property list uchar int vertex_indices\nend_header\n0 0 0 255 0 51\n1 0 0 0 0 0\n0 1 0 0 0 0\n3 0 1 2\n";
+        let mesh = ply_from_bytes(Path::new("b.ply"), text.as_bytes()).unwrap();
+        assert_eq!(mesh.attributes[0].name, "vertex_color");
+        assert_eq!(&mesh.attributes[0].values[..3], &[1.0, 0.0, 0.2]);
     }
 
     #[test]

@@ -403,7 +403,7 @@ fn shading<'a>(scene: &'a Scene, p: &Packet, hit: &Surfaces8) -> Shading<'a> {
                     rho_rows.set_rgb(lane, r);
                     diffuse_rows |= 1 << lane;
                 }
-                None if material.reads_differentials() => models[lane] = Some(scene.bsdf_at(&hit.interaction(lane, 0.0))),
+                None if material.reads_surface() => models[lane] = Some(scene.bsdf_at(&hit.interaction(lane, 0.0))),
                 None => models[lane] = Some(material.at(uv)),
             }
         }

@@ -114,6 +114,21 @@ impl Built {
             [one] => Material::from_props(one)?,
             [_, second, ..] => return Err(Error::spec(second.at(), "a shape takes one <bsdf>")),
         });
+        if let (Some(material), Some(shape)) = (self.materials.last(), self.shapes.last()) {
+            for m in material.mesh_attributes() {
+                let names: Vec<&str> = match shape {
+                    Shape::Mesh(mesh) => mesh.attributes().iter().map(|a| a.name.as_str()).collect(),
+                    _ => Vec::new(),
+                };
+                if !names.contains(&m.name.as_str()) {
+                    let has = if names.is_empty() { "none".to_string() } else { names.join(", ") };
+                    return Err(Error::spec(
+                        m.at.as_str(),
+                        format!("mesh_attribute `{}`: the shape at {} has no such attribute (it has: {has})", m.name, p.at()),
+                    ));
+                }
+            }
+        }
         self.shape_lights.push(match emitters.as_slice() {
             [] => None,
             [e] => {
@@ -212,16 +227,19 @@ fn shape_from_props(p: &Props, outer: &Transform) -> Result<Shape> {
             let shape_index = if kind == "serialized" { p.integer_in("shape_index", 0, 0, i64::from(u32::MAX))? as usize } else { 0 };
             let data = super::mesh_files::load(kind, std::path::Path::new(&filename), shape_index, p.at_param("filename"))?;
             let uvs = data.uvs.map(|uv| uv.into_iter().map(|t| if flip_tex { glam::Vec2::new(t.x, 1.0 - t.y) } else { t }).collect());
-            Shape::Mesh(Mesh::from_file_data(
-                data.positions,
-                data.normals,
-                uvs,
-                data.indices,
-                &to_world,
-                face_normals,
-                flip,
-                &format!("{at} ({filename})"),
-            )?)
+            Shape::Mesh(
+                Mesh::from_file_data(
+                    data.positions,
+                    data.normals,
+                    uvs,
+                    data.indices,
+                    &to_world,
+                    face_normals,
+                    flip,
+                    &format!("{at} ({filename})"),
+                )?
+                .with_attributes(data.attributes),
+            )
         }
         other => return Err(Error::spec(at, format!("unsupported shape `{other}` (gonio has: {SHAPES})"))),
     })

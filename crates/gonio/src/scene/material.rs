@@ -3,11 +3,12 @@
 
 use crate::bsdf::{Bsdf, Diffuse};
 use crate::error::{Error, Result};
+use crate::geometry::Mesh;
 use crate::math::simd::Float8;
 use crate::math::Frame;
 use crate::props::{Props, Value};
 use crate::spectrum::Rgb;
-use crate::texture::Texture;
+use crate::texture::{MeshAttribute, SurfaceTexture, Texture};
 use glam::{Vec2, Vec3};
 use std::borrow::Cow;
 use std::collections::HashMap;
@@ -51,7 +52,7 @@ pub enum Material {
     /// build from the same values, without `Props`. Each texture with its parameter and how it is read.
     Slotted {
         model: Bsdf,
-        textures: Vec<(String, Texture, Lookup)>,
+        textures: Vec<(String, SurfaceTexture, Lookup)>,
     },
     /// Any other BSDF with texture parameters: the description without them, and the textures with their
     /// parameter paths. Rebuilt at every hit from a copy of the template (`Props` tracks which parameters
@@ -62,7 +63,7 @@ pub enum Material {
     /// entries, so textures with few distinct values (checkerboards, masks) build each model once.
     Textured {
         template: Mutex<Props>,
-        textures: Vec<(Vec<String>, Texture, Lookup)>,
+        textures: Vec<(Vec<String>, SurfaceTexture, Lookup)>,
         cache: RwLock<HashMap<Vec<u32>, Bsdf>>,
     },
 }
@@ -79,14 +80,30 @@ pub enum Lookup {
     Bump { scale: f32 },
 }
 
-/// The surface at a hit where a bump map is read: the geometric normal, the shading frame, and ∂p/∂u,
-/// ∂p/∂v of the shape's parameterisation (world space; [`crate::geometry::Shape::uv_partials`]).
+/// The surface at a hit where bump maps and mesh attributes are read: the geometric normal, the shading
+/// frame, ∂p/∂u and ∂p/∂v of the shape's parameterisation (world space;
+/// [`crate::geometry::Shape::uv_partials`]), and the mesh, triangle and point (where the shape is a mesh).
 #[derive(Clone, Copy, Debug)]
-pub struct Differentials {
+pub struct Differentials<'a> {
     pub n: Vec3,
     pub shading: Frame,
     pub dp_du: Vec3,
     pub dp_dv: Vec3,
+    pub mesh: Option<&'a Mesh>,
+    pub prim: u32,
+    pub p: Vec3,
+}
+
+impl Differentials<'_> {
+    /// The mesh attribute `m` here, scaled (black where the shape has no such attribute: the scene checks
+    /// that when it is built).
+    fn attribute(&self, m: &MeshAttribute) -> Rgb {
+        let Some(mesh) = self.mesh else { return Rgb::ZERO };
+        match mesh.attributes().iter().position(|a| a.name == m.name) {
+            Some(i) => mesh.attribute_at(i, self.prim, self.p) * m.scale,
+            None => Rgb::ZERO,
+        }
+    }
 }
 
 /// The normal a height field with gradient `grad` (∂h/∂u, ∂h/∂v, already scaled) gives the surface `d`,
@@ -95,7 +112,7 @@ pub struct Differentials {
 /// shading normal, likewise for v, n′ = ∂p/∂u′ × ∂p/∂v′ turned to the side of the geometric normal.
 /// Without a surface (`None`), or where n′ is degenerate, the shading normal itself.
 #[must_use]
-pub fn bump_normal(grad: Vec2, d: Option<&Differentials>) -> Rgb {
+pub fn bump_normal(grad: Vec2, d: Option<&Differentials<'_>>) -> Rgb {
     let flat = Rgb::new(0.5, 0.5, 1.0);
     let Some(d) = d else { return flat };
     let ns = d.shading.n;
@@ -141,10 +158,13 @@ impl Material {
         let mut bumped: Vec<&[String]> = Vec::new();
         let mut textures = Vec::with_capacity(taken.len());
         for (path, t) in &taken {
-            let texture = Texture::from_props(t)?;
+            let texture = SurfaceTexture::from_props(t)?;
             let parent = &path[..path.len() - 1];
             let bump = template.nested_at(parent).filter(|b| b.plugin_type() == "bumpmap");
             if let Some(b) = bump {
+                if matches!(texture, SurfaceTexture::MeshAttribute(_)) {
+                    return Err(Error::spec(t.at(), "a `bumpmap`'s height field must be a texture with a gradient (bitmap, checkerboard)"));
+                }
                 // The height field sets the bumpmap's normal (a parameter `normalmap` of that model).
                 if bumped.contains(&parent) {
                     return Err(Error::spec(t.at(), "a `bumpmap` takes one texture (its height field)"));
@@ -158,12 +178,14 @@ impl Material {
             }
         }
         Ok(match (template.plugin_type(), textures.as_slice()) {
-            ("diffuse", [(path, t, Lookup::Colour)]) if path == &["reflectance"] => Material::TexturedDiffuse(t.clone()),
+            ("diffuse", [(path, SurfaceTexture::Uv(t), Lookup::Colour)]) if path == &["reflectance"] => {
+                Material::TexturedDiffuse(t.clone())
+            }
             _ => Material::Textured { template: Mutex::new(template), textures, cache: RwLock::new(HashMap::new()) },
         })
     }
 
-    fn try_at(&self, uv: Vec2, surface: Option<&Differentials>) -> Result<Cow<'_, Bsdf>> {
+    fn try_at(&self, uv: Vec2, surface: Option<&Differentials<'_>>) -> Result<Cow<'_, Bsdf>> {
         Ok(match self {
             Material::Fixed(b) => Cow::Borrowed(b),
             Material::TexturedDiffuse(t) => Cow::Owned(Bsdf::Diffuse(Diffuse::new(Self::texel(t, uv)))),
@@ -271,21 +293,33 @@ impl Material {
         self.at_surface(uv, None)
     }
 
-    /// Whether the material reads the surface's differential geometry (it has a bump map): evaluate it
-    /// with [`Self::at_surface`] then.
+    /// Whether the material reads the surface (a bump map, a mesh attribute): evaluate it with
+    /// [`Self::at_surface`] then.
     #[must_use]
-    pub fn reads_differentials(&self) -> bool {
+    pub fn reads_surface(&self) -> bool {
+        let reads = |l: &Lookup, t: &SurfaceTexture| matches!(l, Lookup::Bump { .. }) || matches!(t, SurfaceTexture::MeshAttribute(_));
         match self {
-            Material::Slotted { textures, .. } => textures.iter().any(|(_, _, l)| matches!(l, Lookup::Bump { .. })),
-            Material::Textured { textures, .. } => textures.iter().any(|(_, _, l)| matches!(l, Lookup::Bump { .. })),
+            Material::Slotted { textures, .. } => textures.iter().any(|(_, t, l)| reads(l, t)),
+            Material::Textured { textures, .. } => textures.iter().any(|(_, t, l)| reads(l, t)),
             Material::Fixed(_) | Material::TexturedDiffuse(_) => false,
         }
+    }
+
+    /// The mesh attributes the material reads, for the scene to check that its shape has them.
+    #[must_use]
+    pub fn mesh_attributes(&self) -> Vec<&MeshAttribute> {
+        let textures: Vec<&SurfaceTexture> = match self {
+            Material::Slotted { textures, .. } => textures.iter().map(|(_, t, _)| t).collect(),
+            Material::Textured { textures, .. } => textures.iter().map(|(_, t, _)| t).collect(),
+            Material::Fixed(_) | Material::TexturedDiffuse(_) => Vec::new(),
+        };
+        textures.into_iter().filter_map(|t| if let SurfaceTexture::MeshAttribute(m) = t { Some(m) } else { None }).collect()
     }
 
     /// [`Self::at`] on the surface `surface` (where bump maps read it; without it, they leave the shading
     /// normal as it is).
     #[must_use]
-    pub fn at_surface(&self, uv: Vec2, surface: Option<&Differentials>) -> Cow<'_, Bsdf> {
+    pub fn at_surface(&self, uv: Vec2, surface: Option<&Differentials<'_>>) -> Cow<'_, Bsdf> {
         if let Material::Fixed(b) = self {
             return Cow::Borrowed(b);
         }
@@ -300,11 +334,18 @@ enum TextureValue {
 }
 
 impl TextureValue {
-    fn of(t: &Texture, lookup: Lookup, uv: Vec2, surface: Option<&Differentials>) -> Self {
-        match lookup {
-            Lookup::Float => TextureValue::Scalar(t.eval_1(uv)),
-            Lookup::Colour => TextureValue::Colour(t.eval(uv)),
-            Lookup::Bump { scale } => TextureValue::Colour(bump_normal(t.eval_1_grad(uv) * scale, surface)),
+    fn of(t: &SurfaceTexture, lookup: Lookup, uv: Vec2, surface: Option<&Differentials<'_>>) -> Self {
+        match (t, lookup) {
+            (SurfaceTexture::Uv(t), Lookup::Float) => TextureValue::Scalar(t.eval_1(uv)),
+            (SurfaceTexture::Uv(t), Lookup::Colour) => TextureValue::Colour(t.eval(uv)),
+            (SurfaceTexture::Uv(t), Lookup::Bump { scale }) => TextureValue::Colour(bump_normal(t.eval_1_grad(uv) * scale, surface)),
+            (SurfaceTexture::MeshAttribute(m), lookup) => {
+                let c = surface.map_or(Rgb::ZERO, |s| s.attribute(m));
+                match lookup {
+                    Lookup::Float => TextureValue::Scalar(c.luminance()),
+                    _ => TextureValue::Colour(c),
+                }
+            }
         }
     }
 
@@ -411,6 +452,9 @@ mod tests {
             shading: Frame::from_normal(Vec3::Z),
             dp_du: Vec3::new(2.0, 0.0, 0.0),
             dp_dv: Vec3::new(0.0, 3.0, 0.0),
+            mesh: None,
+            prim: 0,
+            p: Vec3::ZERO,
         };
         let decode = |c: Rgb| Vec3::new(2.0 * c.r() - 1.0, 2.0 * c.g() - 1.0, 2.0 * c.b() - 1.0);
         for (a, b) in [(0.5f32, -1.0f32), (3.0, 2.0), (0.0, 0.0)] {

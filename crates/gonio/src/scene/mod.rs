@@ -585,15 +585,18 @@ impl Scene {
     }
 
     /// The reflection model of the surface `si`: its shape's material at its texture coordinates, and, for
-    /// a material with a bump map, on its differential geometry ([`Shape::uv_partials`]).
+    /// a material with a bump map or a mesh attribute, on its surface ([`Shape::uv_partials`], the mesh).
     #[must_use]
     pub fn bsdf_at(&self, si: &SurfaceInteraction) -> Cow<'_, Bsdf> {
         let material = &self.materials[si.shape as usize];
-        if !material.reads_differentials() {
+        if !material.reads_surface() {
             return material.at(si.uv);
         }
-        let (dp_du, dp_dv) = self.shapes[si.shape as usize].uv_partials(si.prim, si.p, &si.shading);
-        material.at_surface(si.uv, Some(&material::Differentials { n: si.n, shading: si.shading, dp_du, dp_dv }))
+        let shape = &self.shapes[si.shape as usize];
+        let (dp_du, dp_dv) = shape.uv_partials(si.prim, si.p, &si.shading);
+        let mesh = if let Shape::Mesh(m) = shape { Some(m) } else { None };
+        material
+            .at_surface(si.uv, Some(&material::Differentials { n: si.n, shading: si.shading, dp_du, dp_dv, mesh, prim: si.prim, p: si.p }))
     }
 
     /// The closest surface along `ray`.

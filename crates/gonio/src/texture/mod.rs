@@ -1,13 +1,16 @@
 //! Textures: colours that vary over a surface, evaluated at a hit's uv. Materials evaluate them into a
 //! plain [`crate::bsdf::Bsdf`] (see [`crate::scene::material`]).
 //!
-//! Plugins: `checkerboard` ([`checkerboard`]) and `bitmap` ([`bitmap`]).
+//! Plugins: `checkerboard` ([`checkerboard`]) and `bitmap` ([`bitmap`]), read at texture coordinates; and
+//! `mesh_attribute` ([`mesh_attribute`]), read from the mesh at a hit, for BSDF parameters only.
 
 pub mod bitmap;
 pub mod checkerboard;
+pub mod mesh_attribute;
 
 pub use bitmap::Bitmap;
 pub use checkerboard::Checkerboard;
+pub use mesh_attribute::MeshAttribute;
 
 use crate::error::{Error, Result};
 use crate::props::Props;
@@ -22,12 +25,18 @@ pub enum Texture {
 }
 
 impl Texture {
-    /// Build from a `<texture>` description.
+    /// Build from a `<texture>` description: a texture read at texture coordinates (`mesh_attribute`,
+    /// which reads the surface, is refused here: see [`SurfaceTexture::from_props`]).
     pub fn from_props(p: &Props) -> Result<Texture> {
         let t = match p.plugin_type() {
             "checkerboard" => Texture::Checkerboard(Checkerboard::from_props(p)?),
             "bitmap" => Texture::Bitmap(Bitmap::from_props(p)?),
-            other => return Err(Error::spec(p.at(), format!("unsupported texture `{other}` (gonio has: checkerboard, bitmap)"))),
+            "mesh_attribute" => {
+                return Err(Error::spec(p.at(), "a `mesh_attribute` texture can only be a BSDF parameter (it reads the mesh at a hit)"))
+            }
+            other => {
+                return Err(Error::spec(p.at(), format!("unsupported texture `{other}` (gonio has: checkerboard, bitmap, mesh_attribute)")))
+            }
         };
         p.finish()?;
         Ok(t)
@@ -72,5 +81,24 @@ impl Texture {
             Texture::Checkerboard(_) => Vec2::ZERO,
             Texture::Bitmap(b) => b.eval_1_grad(uv),
         }
+    }
+}
+
+/// A texture on a BSDF parameter: one read at texture coordinates, or a mesh attribute read at the hit.
+#[derive(Clone, Debug, PartialEq)]
+pub enum SurfaceTexture {
+    Uv(Texture),
+    MeshAttribute(MeshAttribute),
+}
+
+impl SurfaceTexture {
+    /// Build from a `<texture>` description given to a BSDF.
+    pub fn from_props(p: &Props) -> Result<SurfaceTexture> {
+        if p.plugin_type() == "mesh_attribute" {
+            let m = MeshAttribute::from_props(p)?;
+            p.finish()?;
+            return Ok(SurfaceTexture::MeshAttribute(m));
+        }
+        Texture::from_props(p).map(SurfaceTexture::Uv)
     }
 }
