@@ -135,25 +135,23 @@ impl NormalMap {
     }
 }
 
-/// `v` in the frame (s, t, n) of each lane: `a` where `pick` is false, `b` where it is true.
+/// Each lane's frame axes (s, t, n): `a`'s where `pick` is false, `b`'s where it is true.
+#[inline(always)]
+fn lane_axes<R: Real>(a: &Frame, b: &Frame, pick: R::Mask) -> [V3<R>; 3] {
+    [(a.s, b.s), (a.t, b.t), (a.n, b.n)].map(|(x, y)| V3::select(pick, V3::splat(y), V3::splat(x)))
+}
+
+/// `v` in the frame of each lane ([`lane_axes`]).
 #[inline(always)]
 fn to_frame<R: Real>(a: &Frame, b: &Frame, pick: R::Mask, v: V3<R>) -> V3<R> {
-    let (s, t, n) = (
-        V3::select(pick, V3::splat(b.s), V3::splat(a.s)),
-        V3::select(pick, V3::splat(b.t), V3::splat(a.t)),
-        V3::select(pick, V3::splat(b.n), V3::splat(a.n)),
-    );
+    let [s, t, n] = lane_axes(a, b, pick);
     V3::new(v.dot(s), v.dot(t), v.dot(n))
 }
 
-/// `v`, given in the frame (s, t, n) of each lane, in the shading frame.
+/// `v`, given in the frame of each lane ([`lane_axes`]), in the shading frame.
 #[inline(always)]
 fn from_frame<R: Real>(a: &Frame, b: &Frame, pick: R::Mask, v: V3<R>) -> V3<R> {
-    let (s, t, n) = (
-        V3::select(pick, V3::splat(b.s), V3::splat(a.s)),
-        V3::select(pick, V3::splat(b.t), V3::splat(a.t)),
-        V3::select(pick, V3::splat(b.n), V3::splat(a.n)),
-    );
+    let [s, t, n] = lane_axes(a, b, pick);
     s.scale(v.x).add(t.scale(v.y)).add(n.scale(v.z))
 }
 
