@@ -631,7 +631,8 @@ impl Props {
                     match ctag {
                         "float" => Value::Number(parse_number(&raw).ok_or_else(|| bad("a number"))?),
                         "integer" => Value::Number(raw.trim().parse::<i64>().map_err(|_| bad("an integer"))? as f64),
-                        "boolean" => Value::Bool(match raw.trim() {
+                        // In any case, as Mitsuba 3 reads them (the Blender exporter's tests write "False").
+                        "boolean" => Value::Bool(match raw.trim().to_ascii_lowercase().as_str() {
                             "true" => true,
                             "false" => false,
                             _ => return Err(bad("true or false")),
@@ -797,6 +798,17 @@ mod tests {
         assert_eq!(inner.at(), "m.xml:2:3");
         let bad = Props::from_xml_bsdf("<bsdf type=\"diffuse\">\n<float name=\"x\" value=\"abc\"/></bsdf>", "m.xml").unwrap_err();
         assert!(bad.to_string().starts_with("m.xml:2:1"), "{bad}");
+    }
+
+    /// Booleans in any case, as Mitsuba reads them; anything else is an error.
+    #[test]
+    fn xml_booleans_ignore_case() {
+        for (text, want) in [("True", true), ("FALSE", false), ("false", false)] {
+            let p = Props::from_xml_bsdf(&format!("<bsdf type=\"plastic\"><boolean name=\"nonlinear\" value=\"{text}\"/></bsdf>"), "m.xml")
+                .unwrap();
+            assert_eq!(p.bool("nonlinear", !want).unwrap(), want, "{text}");
+        }
+        assert!(Props::from_xml_bsdf("<bsdf type=\"plastic\"><boolean name=\"nonlinear\" value=\"yes\"/></bsdf>", "m.xml").is_err());
     }
 
     #[test]
