@@ -293,27 +293,28 @@ impl Material {
         self.at_surface(uv, None)
     }
 
+    /// Each texture with how it is read (none for `Fixed`, and `TexturedDiffuse`'s reads a colour at uv).
+    fn lookups(&self) -> impl Iterator<Item = (&SurfaceTexture, Lookup)> {
+        let (slotted, textured) = match self {
+            Material::Slotted { textures, .. } => (Some(textures), None),
+            Material::Textured { textures, .. } => (None, Some(textures)),
+            Material::Fixed(_) | Material::TexturedDiffuse(_) => (None, None),
+        };
+        let slotted = slotted.into_iter().flatten().map(|(_, t, l)| (t, *l));
+        slotted.chain(textured.into_iter().flatten().map(|(_, t, l)| (t, *l)))
+    }
+
     /// Whether the material reads the surface (a bump map, a mesh attribute): evaluate it with
     /// [`Self::at_surface`] then.
     #[must_use]
     pub fn reads_surface(&self) -> bool {
-        let reads = |l: &Lookup, t: &SurfaceTexture| matches!(l, Lookup::Bump { .. }) || matches!(t, SurfaceTexture::MeshAttribute(_));
-        match self {
-            Material::Slotted { textures, .. } => textures.iter().any(|(_, t, l)| reads(l, t)),
-            Material::Textured { textures, .. } => textures.iter().any(|(_, t, l)| reads(l, t)),
-            Material::Fixed(_) | Material::TexturedDiffuse(_) => false,
-        }
+        self.lookups().any(|(t, l)| matches!(l, Lookup::Bump { .. }) || matches!(t, SurfaceTexture::MeshAttribute(_)))
     }
 
     /// The mesh attributes the material reads, for the scene to check that its shape has them.
     #[must_use]
     pub fn mesh_attributes(&self) -> Vec<&MeshAttribute> {
-        let textures: Vec<&SurfaceTexture> = match self {
-            Material::Slotted { textures, .. } => textures.iter().map(|(_, t, _)| t).collect(),
-            Material::Textured { textures, .. } => textures.iter().map(|(_, t, _)| t).collect(),
-            Material::Fixed(_) | Material::TexturedDiffuse(_) => Vec::new(),
-        };
-        textures.into_iter().filter_map(|t| if let SurfaceTexture::MeshAttribute(m) = t { Some(m) } else { None }).collect()
+        self.lookups().filter_map(|(t, _)| if let SurfaceTexture::MeshAttribute(m) = t { Some(m) } else { None }).collect()
     }
 
     /// [`Self::at`] on the surface `surface` (where bump maps read it; without it, they leave the shading
