@@ -9,8 +9,8 @@
 - overhead per task: (nodes · wall − Σ seconds inside the tasks) / tasks, for each run, and for a run of
   many tiny tasks (1 spp of a 16 × 16 image each).
 
-Each configuration runs once untimed first (worker processes start, gonio is imported, the scene is
-loaded and cached per worker), then timed: a persistent cluster's steady state. The cluster listens on
+Each configuration runs untimed first until every node has run its tasks (worker processes start, gonio
+is imported, the scene is loaded and cached per worker), then timed: a persistent cluster's steady state. The cluster listens on
 127.0.0.1 only. On a machine shared with other work the numbers are those of the machine: the report
 prints the load average before and after.
 """
@@ -42,8 +42,21 @@ def overhead(nodes: int, wall: float, seconds: list) -> float:
     return (nodes * wall - sum(seconds)) / len(seconds)
 
 
+def warm_render(scene, nodes: int) -> None:
+    """Untimed renders of 1-spp tasks until every node has run one: its worker started, gonio imported,
+    the scene loaded and cached. (A node that joined last starts its worker while the first node's warm
+    worker already finishes the tasks, so one render does not warm it.)"""
+    seen: set = set()
+    for _ in range(50):
+        r = distributed.render(scene, spp=4 * nodes, seed=1, chunk_spp=1, progress=False)
+        seen |= {node for _, _, _, node in r.tasks}
+        if len(seen) >= nodes:
+            return
+    raise SystemExit(f"warm-up: tasks ran on {len(seen)} of {nodes} nodes after 50 renders")
+
+
 def run_render(scene: str, spp: int, nodes: int) -> dict:
-    distributed.render(scene, spp=2 * nodes, seed=1, progress=False)  # warm-up: workers, import, scene cache
+    warm_render(scene, nodes)
     t = time.perf_counter()
     r = distributed.render(scene, spp=spp, seed=1, progress=False)
     wall = time.perf_counter() - t
@@ -52,6 +65,7 @@ def run_render(scene: str, spp: int, nodes: int) -> dict:
 
 
 def run_fit(files: list, models: list, strata: int, nodes: int) -> dict:
+    distributed.fit(files, models, strata=strata, progress=False)  # warm-up: the fit's workers on every node
     t = time.perf_counter()
     rows = distributed.fit(files, models, strata=strata, progress=False)
     wall = time.perf_counter() - t
@@ -65,7 +79,7 @@ def run_fit(files: list, models: list, strata: int, nodes: int) -> dict:
 def run_tiny(nodes: int, tasks: int = 40) -> dict:
     scene = {"type": "scene", "sensor": {"type": "perspective", "film": {"type": "hdrfilm", "width": 16, "height": 16, "rfilter": {"type": "box"}}},
              "ball": {"type": "sphere"}, "sky": {"type": "constant"}}
-    distributed.render(scene, spp=2 * nodes, chunk_spp=1, progress=False)
+    warm_render(scene, nodes)
     t = time.perf_counter()
     r = distributed.render(scene, spp=tasks, chunk_spp=1, progress=False)
     wall = time.perf_counter() - t

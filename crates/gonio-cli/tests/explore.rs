@@ -260,3 +260,34 @@ fn lit_sphere_verdict_and_export() {
     let (status, json) = server.json("/api/export", &[("format", "json"), ("spec", GGX)]);
     assert_eq!((status, json["alpha"].as_f64()), (200, Some(0.3)));
 }
+
+#[test]
+fn models_on_the_command_line_in_xml_are_shown_as_json() {
+    let dir = Scratch::new("explore-xml");
+    let file = dir.join("coat.xml");
+    std::fs::write(
+        &file,
+        r#"<bsdf type="roughplastic"><float name="alpha" value="0.25"/><rgb name="diffuse_reflectance" value="0.1, 0.2, 0.3"/></bsdf>"#,
+    )
+    .unwrap();
+    let inline = r#"<bsdf type="diffuse"><rgb name="reflectance" value="0.5"/></bsdf>"#;
+    let server = Server::start(&[&dir.arg("coat.xml"), inline]);
+    let (status, models) = server.json("/api/models", &[]);
+    assert_eq!(status, 200);
+    let initial: Vec<Value> =
+        models["initial"].as_array().unwrap().iter().map(|s| serde_json::from_str(s.as_str().unwrap()).unwrap()).collect();
+    assert_eq!(initial[0], serde_json::json!({"type": "roughplastic", "alpha": 0.25, "diffuse_reflectance": [0.1, 0.2, 0.3]}));
+    assert_eq!(initial[1], serde_json::json!({"type": "diffuse", "reflectance": 0.5}));
+    // The page's numbers for it are those of the model read from the XML file.
+    let (_, polar) = server.json("/api/plot", &[("spec", &initial[0].to_string()), ("kind", "polar")]);
+    let bsdf = gonio::Bsdf::from_props(&gonio::props::Props::from_xml_bsdf(&std::fs::read_to_string(&file).unwrap(), "coat.xml").unwrap())
+        .unwrap();
+    let lobe = lobe_data(&bsdf, 30.0, POLAR_SAMPLES, 0, 0).unwrap();
+    assert_same(&floats(&polar["incidence"]), &Channel::Lum.of_all(&lobe.incidence), "polar of the XML model");
+    // A broken XML file stops the server before it listens, naming the file and place.
+    let bad = dir.join("bad.xml");
+    std::fs::write(&bad, r#"<bsdf type="roughplastic"><float name="alpha" value="-1"/></bsdf>"#).unwrap();
+    let out = gonio_command().args(["explore", "--port", "0", &dir.arg("bad.xml")]).output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && err.contains("bad.xml") && err.contains("alpha"), "{err}");
+}

@@ -524,6 +524,32 @@ impl Props {
         Ok(props)
     }
 
+    /// The description in Mitsuba's dictionary form, which [`Props::from_json`] reads back to the same
+    /// parameters: numbers, booleans, strings, lists (colours), points and vectors as three numbers,
+    /// transforms as their 4 × 4 row-major matrix, nested plugins as objects with their `type` (and `id`).
+    #[must_use]
+    pub fn to_json(&self) -> serde_json::Value {
+        use serde_json::{json, Value as J};
+        let mut map = serde_json::Map::new();
+        map.insert("type".into(), J::String(self.plugin.clone()));
+        if let Some(id) = &self.id {
+            map.insert("id".into(), J::String(id.clone()));
+        }
+        for e in &self.entries {
+            let v = match &e.value {
+                Value::Number(x) => json!(x),
+                Value::Bool(b) => J::Bool(*b),
+                Value::String(s) => J::String(s.clone()),
+                Value::List(l) => json!(l),
+                Value::Vector(v) => json!([v.x, v.y, v.z]),
+                Value::Transform(t) => J::Array(t.matrix.transpose().to_cols_array_2d().iter().map(|row| json!(row)).collect()),
+                Value::Nested(p) => p.to_json(),
+            };
+            map.insert(e.name.clone(), v);
+        }
+        J::Object(map)
+    }
+
     // ---------------------------------------------------------------- XML
 
     /// Parse an XML document whose root is a `<bsdf>` element, or whose root holds exactly one.
@@ -755,6 +781,32 @@ fn json_value(v: &serde_json::Value, at: &str, scope: Option<&dyn JsonScope>) ->
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn xml_descriptions_read_back_from_their_json() {
+        let xml = r#"<bsdf type="twosided" id="coat"><bsdf type="roughplastic"><float name="alpha" value="0.3"/>
+            <rgb name="diffuse_reflectance" value="0.2, 0.4, 0.6"/><boolean name="nonlinear" value="true"/>
+            <string name="distribution" value="ggx"/><texture type="checkerboard" name="specular_reflectance">
+            <transform name="to_uv"><scale x="4" y="2"/><translate x="0.5"/></transform></texture></bsdf></bsdf>"#;
+        let p = Props::from_xml_bsdf(xml, "t.xml").unwrap();
+        let json = p.to_json();
+        assert_eq!(json["type"], "twosided");
+        assert_eq!(json["id"], "coat");
+        let inner = json.as_object().unwrap().values().find(|v| v.is_object()).unwrap();
+        assert_eq!(
+            (inner["alpha"].as_f64(), inner["nonlinear"].as_bool(), inner["distribution"].as_str()),
+            (Some(0.3), Some(true), Some("ggx"))
+        );
+        let back = Props::from_json(&json.to_string()).unwrap();
+        // The same parameters with the same values (places differ: a JSON path instead of file:line:col).
+        let values = |p: &Props| p.to_json().to_string();
+        assert_eq!(values(&back), values(&p));
+        let texture = &inner["specular_reflectance"];
+        assert_eq!(
+            (&texture["to_uv"][0], &texture["to_uv"][1]),
+            (&serde_json::json!([4.0, 0.0, 0.0, 0.5]), &serde_json::json!([0.0, 2.0, 0.0, 0.0]))
+        );
+    }
 
     #[test]
     fn json_values_of_every_kind() {

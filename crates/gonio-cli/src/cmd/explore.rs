@@ -14,7 +14,7 @@
 //! answered 4xx; a panic in a computation is answered 500 by [`Explorer::handle`]: no request stops the
 //! server.
 
-use crate::spec::{load_props, measured_plugin};
+use crate::spec::{in_json_file, load_props, measured_plugin};
 use crate::stdout::outln;
 use gonio::explore::{Explorer, Reply};
 use gonio::Error;
@@ -40,8 +40,9 @@ const IDLE: Duration = Duration::from_secs(30);
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// Models shown first: JSON in Mitsuba's dictionary form, a JSON file, or a measured file (.binary MERL,
-    /// .bsdf RGL). Without any, a rough conductor.
+    /// Models shown first, as every command takes them: JSON in Mitsuba's dictionary form, a `<bsdf>` (inline
+    /// or an XML file), a JSON file, or a measured file (.binary MERL, .bsdf RGL). Without any, a rough
+    /// conductor.
     #[arg(value_name = "BSDF")]
     bsdf: Vec<String>,
     /// Port to listen on (0: any free port; the address is printed).
@@ -63,28 +64,22 @@ pub struct Args {
     env: Option<PathBuf>,
 }
 
-/// A command-line model as a JSON spec, and the measured file it names (offered to the page).
+/// A command-line model as a JSON spec, and the measured file it names (offered to the page). The page
+/// edits JSON: a model given as XML (inline or in a file, as every command takes it) is converted.
 fn initial_spec(arg: &str) -> Result<(String, Option<PathBuf>), Error> {
-    let trimmed = arg.trim_start();
-    if trimmed.starts_with('{') {
-        gonio::Bsdf::from_json(trimmed)?;
-        return Ok((trimmed.to_string(), None));
-    }
     let path = Path::new(arg);
     if let Some(plugin) = measured_plugin(path) {
         let absolute = path.canonicalize().map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
         let spec = serde_json::json!({"type": plugin, "filename": absolute.display().to_string()}).to_string();
         return Ok((spec, Some(absolute)));
     }
-    let text = std::fs::read_to_string(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
-    if text.trim_start().starts_with('{') {
-        gonio::Bsdf::from_props(&load_props(arg)?)?;
-        return Ok((text.trim().to_string(), None));
-    }
-    Err(Error::Spec {
-        at: arg.into(),
-        message: "the explorer takes models as JSON (inline or in a file) or measured files (.binary, .bsdf)".into(),
-    })
+    let props = load_props(arg)?;
+    gonio::Bsdf::from_props(&props).map_err(|e| in_json_file(arg, e))?;
+    // JSON as the user wrote it; XML in the dictionary form.
+    let json = |text: &str| text.trim_start().starts_with('{').then(|| text.trim().to_string());
+    let given =
+        if arg.trim_start().starts_with(['{', '<']) { json(arg) } else { std::fs::read_to_string(path).ok().and_then(|t| json(&t)) };
+    Ok((given.unwrap_or_else(|| props.to_json().to_string()), None))
 }
 
 pub fn run(args: Args) -> Result<ExitCode, Error> {
