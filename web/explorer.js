@@ -141,8 +141,11 @@ class Explorer {
     const st = this.state;
     this.el.theta = h('input', { type: 'range', min: 0, max: 89, step: 1, value: st.theta_o, oninput: (e) => { st.theta_o = +e.target.value; this.changed(); } });
     this.el.thetaText = h('span', { class: 'gx-note' });
+    this.el.phi = h('input', { type: 'range', class: 'gx-phi-d', min: 0, max: 180, step: 1, value: st.phi_d, oninput: (e) => { st.phi_d = +e.target.value; this.changed(); } });
+    this.el.phiText = h('span', { class: 'gx-note' });
     const view = h('div', { class: 'gx-view' },
       h('label', {}, 'θo ', this.el.theta, this.el.thetaText),
+      h('label', {}, 'φd of the slice ', this.el.phi, this.el.phiText),
       h('label', {}, 'channel ', h('select', { onchange: (e) => { st.channel = e.target.value; this.changed(); } },
         ['lum', 'r', 'g', 'b'].map((c) => h('option', { value: c, selected: c === st.channel }, c)))),
       h('label', {}, h('input', { type: 'checkbox', checked: st.log, onchange: (e) => { st.log = e.target.checked; this.draw(); this.saveState(); } }), ' log scale'));
@@ -183,7 +186,7 @@ class Explorer {
     const main = h('main', { class: 'gx-main' },
       panel('polar', 'f·cos θi: plane of incidence | perpendicular plane', this.el.polar, exp('polar', this.el.polar)),
       panel('lobe', '3-D lobe (drag to turn)', this.el.lobe, exp('lobe', this.el.lobe).slice(1)),
-      panel('slice', 'θh × θd slice of the selected model (φd = 90°)', this.el.slice, exp('slice', this.el.slice).slice(1)),
+      panel('slice', 'θh × θd slice of the selected model', this.el.slice, exp('slice', this.el.slice).slice(1)),
       panel('albedo', 'directional albedo and white furnace', this.el.albedo, exp('albedo', this.el.albedo)),
       panel('sphere', 'lit sphere (path traced)', h('div', {}, this.el.sphere, h('div', {}, this.el.light, ' ', this.el.sphereNote))));
     this.root.replaceChildren(h('div', { class: 'gx-app' }, side, main));
@@ -327,6 +330,7 @@ class Explorer {
 
   changed() {
     this.el.thetaText.textContent = ` ${this.state.theta_o}°`;
+    this.el.phiText.textContent = ` ${this.state.phi_d}°`;
     this.saveState();
     this.refreshPlots();
     this.changedSphere();
@@ -339,7 +343,10 @@ class Explorer {
   }
 
   async plotData(spec, kind) {
-    const params = { spec: JSON.stringify(spec), kind, theta_o: this.state.theta_o, channel: this.state.channel, phi_d: this.state.phi_d };
+    // Each view's own arguments only (moving θo does not recompute the slice or the albedo curve, nor φd
+    // the others): θo for the polar plot and the 3-D lobe, φd for the slice.
+    const own = { polar: ['theta_o'], lobe: ['theta_o'], slice: ['phi_d'], albedo: [] }[kind];
+    const params = { spec: JSON.stringify(spec), kind, channel: this.state.channel, ...Object.fromEntries(own.map((k) => [k, this.state[k]])) };
     const key = JSON.stringify(params);
     if (this.cache.has(key)) return this.cache.get(key);
     const r = await this.api('/api/plot', params);
@@ -629,6 +636,7 @@ class Explorer {
     g.fillText(`${this.label(selected)}`, 330, 24);
     g.fillText(`max ${max.toPrecision(3)} sr⁻¹`, 330, 42);
     g.fillText('log, 4 decades', 330, 60);
+    g.fillText(`φd = ${d.phi_d}°`, 330, 78);
     for (let k = 0; k <= 10; k++) { g.fillStyle = `rgb(${heat(k / 10).join(',')})`; g.fillRect(330, 280 - k * 20, 16, 20); }
   }
 

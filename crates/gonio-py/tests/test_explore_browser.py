@@ -117,6 +117,22 @@ def test_alpha_slider_changes_plots_and_sphere_and_keeps_the_mirror_peak(page):
         assert abs(peak_angle(s) + s["theta_o"]) <= 2.0, f"lobe peak at {peak_angle(s)}°, mirror at {-s['theta_o']}°"
 
 
+def test_phi_d_slider_moves_the_slice_only(page):
+    t = tokens(page)
+    page.select_option(".gx-form select", "roughconductor")
+    settle(page, t)
+    read = "() => { const a = document.querySelector('.gx').gxExplorer; return [a.data.slice.d, a.data.polar.list[0]]; }"
+    slice_before, polar_before = page.evaluate(read)
+    t = tokens(page)
+    page.evaluate("() => { const s = document.querySelector('.gx-phi-d'); s.value = 30; s.dispatchEvent(new Event('input')); }")
+    settle(page, t)
+    slice_after, polar_after = page.evaluate(read)
+    assert (slice_before["phi_d"], slice_after["phi_d"]) == (90, 30)
+    assert slice_after["values"] != slice_before["values"], "the slice at φd = 30° differs from φd = 90°"
+    assert polar_after == polar_before, "the polar plot does not depend on φd"
+    assert page.evaluate("() => JSON.parse(decodeURIComponent(location.hash.slice(1))).phi_d") == 30, "φd is in the URL's state"
+
+
 def test_bad_value_shows_the_clis_message_next_to_the_field(page):
     page.fill("[data-param=alpha] input[type=number]", "20")
     page.press("[data-param=alpha] input[type=number]", "Enter")
