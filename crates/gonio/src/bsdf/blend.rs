@@ -43,6 +43,11 @@ impl BlendBsdf {
 
     /// The two-term sum this blend is.
     #[inline(always)]
+    /// The k-th nested model (0: the first, 1: the second), to change parameters it reads as it is.
+    pub(crate) fn model_mut(&mut self, k: usize) -> Option<&mut Bsdf> {
+        self.mix.components_mut().get_mut(k)
+    }
+
     pub(crate) fn mix(&self) -> &Sum {
         &self.mix
     }

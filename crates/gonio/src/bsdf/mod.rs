@@ -819,6 +819,19 @@ impl Bsdf {
         }
     }
 
+    /// The models this one built from the k-th of its `count` nested descriptions (`Props::nested`'s
+    /// order) and holds as they are, where a texture on a parameter of that description can be set at a
+    /// hit ([`Self::reflectance_slot`], [`Self::set_unit_float`]) without building this model again:
+    /// `twosided` (a single nested model is both sides) and `blendbsdf`; none for other models.
+    /// Calls `f` on each of them; returns how many there were.
+    pub fn for_nested_models(&mut self, k: usize, count: usize, f: &mut dyn FnMut(&mut Bsdf)) -> usize {
+        match self {
+            Bsdf::TwoSided(t) => t.for_sides(k, count, f),
+            Bsdf::Blend(b) if count == 2 => b.model_mut(k).map(f).map_or(0, |()| 1),
+            _ => 0,
+        }
+    }
+
     /// The field that holds this model's colour parameter `name`, where a texture can set it at a hit
     /// without building the model again: a reflectance in [0, 1] per channel (`Props::reflectance`) that
     /// the model reads as it is, deriving nothing from it when built. `None` where the model must be

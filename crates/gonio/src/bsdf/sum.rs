@@ -63,6 +63,11 @@ impl Sum {
         &self.components
     }
 
+    /// The components, to change parameters they read as they are (`Bsdf::reflectance_slot`).
+    pub(crate) fn components_mut(&mut self) -> &mut [Bsdf] {
+        &mut self.components
+    }
+
     #[must_use]
     pub fn weights(&self) -> &[f32] {
         &self.weights

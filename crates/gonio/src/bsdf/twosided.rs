@@ -39,6 +39,26 @@ impl TwoSided {
         TwoSided { front: Box::new(front), back: Box::new(back), mirrored }
     }
 
+    /// The models built from the k-th of `count` nested descriptions, to change parameters they read as
+    /// they are: one nested model is both sides; of two, the front (k = 0) or the back (k = 1), after
+    /// which the sides are run as one only if they are still equal (as [`Self::new`] decides).
+    /// Calls `f` on each; returns how many.
+    pub(crate) fn for_sides(&mut self, k: usize, count: usize, f: &mut dyn FnMut(&mut Bsdf)) -> usize {
+        match (count, k) {
+            (1, 0) => {
+                f(&mut self.front);
+                f(&mut self.back);
+                2
+            }
+            (2, 0 | 1) => {
+                f(if k == 0 { &mut self.front } else { &mut self.back });
+                self.mirrored = self.front == self.back;
+                1
+            }
+            _ => 0,
+        }
+    }
+
     pub fn from_props(p: &Props) -> Result<Self> {
         let nested = p.nested();
         let models = nested.iter().map(|n| Bsdf::from_props(n)).collect::<Result<Vec<_>>>()?;

@@ -52,7 +52,7 @@ pub enum Material {
     /// build from the same values, without `Props`. Each texture with its parameter and how it is read.
     Slotted {
         model: Bsdf,
-        textures: Vec<(String, SurfaceTexture, Lookup)>,
+        textures: Vec<(Slot, SurfaceTexture, Lookup)>,
     },
     /// Any other BSDF with texture parameters: the description without them, and the textures with their
     /// parameter paths. Rebuilt at every hit from a copy of the template (`Props` tracks which parameters
@@ -66,6 +66,46 @@ pub enum Material {
         textures: Vec<(Vec<String>, SurfaceTexture, Lookup)>,
         cache: RwLock<HashMap<Vec<u32>, Bsdf>>,
     },
+}
+
+/// Where a slotted texture's value is written: the nested models on the way from the material's model
+/// (at each level the index of the description among its parent's nested ones and their count, in
+/// `Props::nested`'s order: see [`Bsdf::for_nested_models`]) and the parameter's name in the last.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Slot {
+    route: Vec<(usize, usize)>,
+    name: String,
+}
+
+impl Slot {
+    /// The slot of the texture at `path` (from `Props::take_textures`) in a model built from `template`.
+    fn of(template: &Props, path: &[String]) -> Option<Slot> {
+        let (name, parents) = path.split_last()?;
+        let mut props = template;
+        let mut route = Vec::with_capacity(parents.len());
+        for parent in parents {
+            let nested = props.nested_named();
+            let k = nested.iter().position(|(n, _)| n == parent)?;
+            route.push((k, nested.len()));
+            props = nested[k].1;
+        }
+        Some(Slot { route, name: name.clone() })
+    }
+
+    /// Call `set` on every model the route reaches: whether it reached one and `set` returned true for each.
+    fn write(&self, model: &mut Bsdf, set: &mut dyn FnMut(&mut Bsdf, &str) -> bool) -> bool {
+        fn visit(model: &mut Bsdf, route: &[(usize, usize)], name: &str, set: &mut dyn FnMut(&mut Bsdf, &str) -> bool) -> bool {
+            match route {
+                [] => set(model, name),
+                [(k, count), rest @ ..] => {
+                    let mut ok = true;
+                    let reached = model.for_nested_models(*k, *count, &mut |m| ok &= visit(m, rest, name, set));
+                    ok && reached > 0
+                }
+            }
+        }
+        visit(model, &self.route, &self.name, set)
+    }
 }
 
 /// How a material reads one of its textures at a hit.
@@ -132,17 +172,28 @@ impl Material {
     /// Build from a `<bsdf>` description (textures included).
     pub fn from_props(p: &Props) -> Result<Material> {
         let material = Self::rebuilt(p)?;
-        let Material::Textured { textures, .. } = &material else { return Ok(material) };
+        let Material::Textured { template, textures, .. } = &material else { return Ok(material) };
         // Built once now, so that parameter errors surface at load time; that model is the slotted form's
-        // where every texture has a slot in it.
+        // where every texture has a slot in it (in the model itself or in models it holds as they are).
         let model = material.try_at(Vec2::splat(0.5), None)?.into_owned();
-        let slotted = textures.iter().all(|(path, _, lookup)| match (path.as_slice(), lookup) {
-            ([name], Lookup::Float) => model.clone().set_unit_float(name, 0.5),
-            ([name], _) => model.clone().reflectance_slot(name).is_some(),
-            _ => false,
-        });
-        if slotted {
-            let textures = textures.iter().map(|(path, t, lookup)| (path[0].clone(), t.clone(), *lookup)).collect();
+        let template = template.lock().map_or_else(|poisoned| poisoned.into_inner().clone(), |t| t.clone());
+        let slots: Option<Vec<Slot>> = textures
+            .iter()
+            .map(|(path, _, lookup)| {
+                let slot = Slot::of(&template, path)?;
+                let float = matches!(lookup, Lookup::Float);
+                slot.write(&mut model.clone(), &mut |m, name| {
+                    if float {
+                        m.set_unit_float(name, 0.5)
+                    } else {
+                        m.reflectance_slot(name).is_some()
+                    }
+                })
+                .then_some(slot)
+            })
+            .collect();
+        if let Some(slots) = slots {
+            let textures = slots.into_iter().zip(textures).map(|(slot, (_, t, lookup))| (slot, t.clone(), *lookup)).collect();
             return Ok(Material::Slotted { model, textures });
         }
         Ok(material)
@@ -191,25 +242,27 @@ impl Material {
             Material::TexturedDiffuse(t) => Cow::Owned(Bsdf::Diffuse(Diffuse::new(Self::texel(t, uv)))),
             Material::Slotted { model, textures } => {
                 let mut model = model.clone();
-                for (name, t, lookup) in textures {
+                for (slot, t, lookup) in textures {
                     // The range of `Props::reflectance` and of the floats' `float_in`, so that a value out of
                     // it fails as the rebuilt model would.
-                    let outside =
-                        |v: &dyn std::fmt::Debug| crate::error::Error::spec("", format!("texture value {v:?} of `{name}` outside [0, 1]"));
-                    match TextureValue::of(t, *lookup, uv, surface) {
+                    let outside = |v: &dyn std::fmt::Debug| {
+                        crate::error::Error::spec("", format!("texture value {v:?} of `{}` outside [0, 1]", slot.name))
+                    };
+                    let written = match TextureValue::of(t, *lookup, uv, surface) {
                         TextureValue::Scalar(value) => {
                             if !(0.0..=1.0).contains(&value) {
                                 return Err(outside(&value));
                             }
-                            model.set_unit_float(name, value);
+                            slot.write(&mut model, &mut |m, name| m.set_unit_float(name, value))
                         }
                         TextureValue::Colour(value) => {
                             if !value.0.iter().all(|c| (0.0..=1.0).contains(c)) {
                                 return Err(outside(&value));
                             }
-                            *model.reflectance_slot(name).expect("slots checked when the material was built") = value;
+                            slot.write(&mut model, &mut |m, name| m.reflectance_slot(name).map(|r| *r = value).is_some())
                         }
-                    }
+                    };
+                    debug_assert!(written, "slots checked when the material was built");
                 }
                 Cow::Owned(model)
             }
@@ -440,6 +493,52 @@ mod tests {
         ] {
             let m = Material::from_props(&props(plugin, extra, &textured)).unwrap();
             assert!(matches!(m, Material::Textured { .. }), "{plugin} {textured:?}");
+        }
+    }
+
+    /// Textures on models held by `twosided` and `blendbsdf` (as Blender's exporter writes every
+    /// material) are slotted too, and give the rebuilt models bit for bit: one nested model (both sides),
+    /// two (each side its own), a blend inside a two-sided model, a blend's nested model and weight.
+    #[test]
+    fn textures_in_nested_models_are_slotted() {
+        let checker = |name: &str, c0: &str, c1: &str| {
+            format!(
+                r#"<texture type="checkerboard" name="{name}"><rgb name="color0" value="{c0}"/><rgb name="color1" value="{c1}"/>
+                   <transform name="to_uv"><scale x="3" y="2"/></transform></texture>"#
+            )
+        };
+        let (a, b) = ("0.9, 0.25, 0.5", "0.1, 0.7, 1");
+        let diffuse = format!(r#"<bsdf type="diffuse">{}</bsdf>"#, checker("reflectance", a, b));
+        let plastic = format!(r#"<bsdf type="roughplastic">{}</bsdf>"#, checker("diffuse_reflectance", b, a));
+        let metal =
+            format!(r#"<bsdf type="conductor"><string name="material" value="Au"/>{}</bsdf>"#, checker("specular_reflectance", a, a));
+        let blend = format!(r#"<bsdf type="blendbsdf">{}{diffuse}<bsdf type="dielectric"/></bsdf>"#, checker("weight", "0.2", "0.7"));
+        for (xml, slotted) in [
+            (format!(r#"<bsdf type="twosided">{diffuse}</bsdf>"#), true),
+            (format!(r#"<bsdf type="twosided">{plastic}{metal}</bsdf>"#), true),
+            (format!(r#"<bsdf type="twosided">{diffuse}<bsdf type="diffuse"/></bsdf>"#), true),
+            (
+                format!(
+                    r#"<bsdf type="twosided"><bsdf type="blendbsdf">{}{diffuse}{metal}</bsdf></bsdf>"#,
+                    checker("weight", "0.1", "0.6")
+                ),
+                true,
+            ),
+            (blend.clone(), true),
+            (format!(r#"<bsdf type="twosided"><bsdf type="roughconductor">{}</bsdf></bsdf>"#, checker("alpha", "0.1", "0.3")), false),
+            (format!(r#"<bsdf type="mask">{diffuse}</bsdf>"#), false),
+        ] {
+            let p = Props::from_xml_bsdf(&xml, "test.xml").unwrap();
+            let m = Material::from_props(&p).unwrap();
+            assert_eq!(matches!(m, Material::Slotted { .. }), slotted, "{xml}");
+            let rebuilt = Material::rebuilt(&p).unwrap();
+            let mut sides = std::collections::HashSet::new();
+            for i in 0..64 {
+                let uv = Vec2::new((i as f32 * 0.37).fract(), (i as f32 * 0.61).fract());
+                assert_eq!(m.at(uv), rebuilt.at(uv), "{xml} at {uv}");
+                sides.insert(format!("{:?}", m.at(uv)));
+            }
+            assert!(sides.len() > 1, "the texture changes the model: {xml}");
         }
     }
 
