@@ -532,8 +532,20 @@ struct CellIntegral {
 
 /// Adaptive tensor-product Gauss–Legendre quadrature of a density over rectangles: rule n against rule
 /// 2n, split into 4 where they disagree, optionally forced down along sample positions.
+/// A density evaluated at many points at once: `out[k]` = the density at `points[k]`.
+type Density<'a> = &'a (dyn Fn(&[(f64, f64)], &mut [f64]) + Sync);
+
+/// A density of one point as a [`Density`].
+fn pointwise(density: impl Fn(f64, f64) -> f64 + Sync) -> impl Fn(&[(f64, f64)], &mut [f64]) + Sync {
+    move |points, out| {
+        for (o, &(a, b)) in out.iter_mut().zip(points) {
+            *o = density(a, b);
+        }
+    }
+}
+
 struct Quadrature<'a> {
-    density: &'a (dyn Fn(f64, f64) -> f64 + Sync),
+    density: Density<'a>,
     low: Rule,
     high: Rule,
     /// N, to turn probabilities into expected counts for the tolerance.
@@ -543,11 +555,16 @@ struct Quadrature<'a> {
 impl Quadrature<'_> {
     fn rule(&self, rule: &Rule, a: [f64; 2], b: [f64; 2]) -> f64 {
         let (ha, hb) = (0.5 * (a[1] - a[0]), 0.5 * (b[1] - b[0]));
+        // Every node's density in one call (the model's batches), then the sum in the nodes' order.
+        let points: Vec<(f64, f64)> =
+            rule.nodes.iter().flat_map(|xa| rule.nodes.iter().map(move |xb| (a[0] + ha * (xa + 1.0), b[0] + hb * (xb + 1.0)))).collect();
+        let mut values = vec![0.0; points.len()];
+        (self.density)(&points, &mut values);
         let mut sum = 0.0;
-        for (xa, wa) in rule.nodes.iter().zip(&rule.weights) {
-            let u = a[0] + ha * (xa + 1.0);
-            for (xb, wb) in rule.nodes.iter().zip(&rule.weights) {
-                sum += wa * wb * (self.density)(u, b[0] + hb * (xb + 1.0));
+        let mut value = values.iter();
+        for wa in &rule.weights {
+            for wb in &rule.weights {
+                sum += wa * wb * value.next().expect("a value per node");
             }
         }
         sum * ha * hb
@@ -646,14 +663,7 @@ impl Grid {
 
     /// ∫ density over each cell, in `f64`, cells in parallel: adaptively (see the module docs), then
     /// again along the samples of cells whose observed count contradicts the first answer.
-    fn integrate(
-        &self,
-        density: &(dyn Fn(f64, f64) -> f64 + Sync),
-        n: usize,
-        tally: &Tally,
-        samples: usize,
-        names: [&str; 2],
-    ) -> CellIntegrals {
+    fn integrate(&self, density: Density<'_>, n: usize, tally: &Tally, samples: usize, names: [&str; 2]) -> CellIntegrals {
         let n = n.max(1);
         let quad = Quadrature { density, low: Rule::new(n), high: Rule::new(2 * n), samples: samples.max(1) as f64 };
         let mut cells: Vec<CellIntegral> = (0..self.len())
@@ -1056,7 +1066,14 @@ pub fn chi2_bsdf<M: BsdfModel + Sync + ?Sized>(bsdf: &M, wo: Vec3, cfg: &Chi2Con
         }
     };
     let tally = draw_chunks(cfg, grid.len(), &chunk);
-    let density = |c: f64, phi: f64| f64::from(bsdf.pdf(wo, sphere_direction(c, phi)));
+    let density = |points: &[(f64, f64)], out: &mut [f64]| {
+        let wi: Vec<Vec3> = points.iter().map(|&(c, phi)| sphere_direction(c, phi)).collect();
+        let mut pdf = vec![0.0; wi.len()];
+        bsdf.pdf_batch(&vec![wo; wi.len()], &wi, &mut pdf);
+        for (o, p) in out.iter_mut().zip(pdf) {
+            *o = f64::from(p);
+        }
+    };
     let integrals = grid.integrate(&density, cfg.integration_res, &tally, cfg.samples, ["cos θ", "φ"]);
     verdict(tally, &grid, integrals, cfg, ["cos θ", "φ"], sphere_domain(&grid))
 }
@@ -1068,7 +1085,7 @@ pub fn chi2_warp(sample: impl Fn(Vec2) -> Vec3 + Sync, pdf: impl Fn(Vec3) -> f64
     let grid = Grid::sphere(cfg);
     let one = |rng: &mut Pcg32, t: &mut Tally| count_direction(&grid, sample(rng.next_vec2()), t);
     let tally = draw(cfg, grid.len(), &one);
-    let density = |c: f64, phi: f64| pdf(sphere_direction(c, phi));
+    let density = pointwise(|c: f64, phi: f64| pdf(sphere_direction(c, phi)));
     let integrals = grid.integrate(&density, cfg.integration_res, &tally, cfg.samples, ["cos θ", "φ"]);
     verdict(tally, &grid, integrals, cfg, ["cos θ", "φ"], sphere_domain(&grid))
 }
@@ -1102,7 +1119,7 @@ pub fn chi2_plane(
         }
     };
     let tally = draw(cfg, grid.len(), &one);
-    let density = |x: f64, y: f64| pdf(Vec2::new(x as f32, y as f32));
+    let density = pointwise(|x: f64, y: f64| pdf(Vec2::new(x as f32, y as f32)));
     let integrals = grid.integrate(&density, cfg.integration_res, &tally, cfg.samples, ["x", "y"]);
     let domain = format!(
         "plane: rows = {} bins of x over [{}, {}], columns = {} bins of y over [{}, {}]",
@@ -1118,9 +1135,10 @@ mod tests {
     use crate::sampling::warp::{cosine_hemisphere_pdf, sample_uniform_hemisphere};
     use std::time::Instant;
 
-    /// The test written one `sample` and one `pdf` call at a time, as `chi2_bsdf` was before it took
-    /// the model's batches: the batched test must give the same result, field for field (same random
-    /// numbers in the same order, the same counts and points), for smooth, delta and mixed models, a model
+    /// The test written one `sample` and one `pdf` call at a time (the draw and the quadrature), as
+    /// `chi2_bsdf` was before it took the model's batches: the batched test must give the same result,
+    /// field for field (same random numbers in the same order, the same counts, points and cell
+    /// integrals), for smooth, delta and mixed models, a model
     /// that rejects samples, and a sample count that ends on a partial batch.
     #[test]
     fn batched_bsdf_test_is_the_single_call_test() {
@@ -1146,7 +1164,7 @@ mod tests {
                 }
             };
             let tally = draw(cfg, grid.len(), &one);
-            let density = |c: f64, phi: f64| f64::from(bsdf.pdf(wo, sphere_direction(c, phi)));
+            let density = pointwise(|c: f64, phi: f64| f64::from(bsdf.pdf(wo, sphere_direction(c, phi))));
             let integrals = grid.integrate(&density, cfg.integration_res, &tally, cfg.samples, ["cos θ", "φ"]);
             verdict(tally, &grid, integrals, cfg, ["cos θ", "φ"], sphere_domain(&grid))
         };
@@ -1422,7 +1440,7 @@ mod tests {
             let r2 = (x - x0) * (x - x0) + (y - y0) * (y - y0);
             (-0.5 * r2 / (sigma * sigma)).exp() / (2.0 * PI * sigma * sigma)
         };
-        let quad = Quadrature { density: &density, low: Rule::new(6), high: Rule::new(12), samples: 1e6 };
+        let quad = Quadrature { density: &pointwise(density), low: Rule::new(6), high: Rule::new(12), samples: 1e6 };
         let blind = quad.integrate([0.0, 1.0], [0.0, 1.0], 0, &[], None);
         assert!(blind.value < 1e-3, "{}", blind.value);
         let guide = [(x0 + 1e-4, y0 - 2e-4)];
@@ -1442,7 +1460,7 @@ mod tests {
             let (dx, dy) = ((x - x0) / sx, (y - y0) / sy);
             (-0.5 * (dx * dx + dy * dy)).exp() / (2.0 * PI * sx * sy)
         };
-        let quad = Quadrature { density: &density, low: Rule::new(6), high: Rule::new(12), samples: 1e6 };
+        let quad = Quadrature { density: &pointwise(density), low: Rule::new(6), high: Rule::new(12), samples: 1e6 };
         let guide = [(0.3, 0.5), (-0.8, -0.4), (1.1, 0.9), (-0.2, -1.0)].map(|(u, v)| (x0 + u * sx, y0 + v * sy));
         let guided = quad.integrate([0.0, 1.0], [0.0, 1.0], 0, &guide, Focus::around(&guide).as_ref());
         assert!((guided.value - 1.0).abs() < 1e-6, "{guided:?}");
