@@ -10,9 +10,9 @@
   many tiny tasks (1 spp of a 16 × 16 image each).
 
 Each configuration runs untimed first until every node has run its tasks (worker processes start, gonio
-is imported, the scene is loaded and cached per worker), then timed: a persistent cluster's steady state. The cluster listens on
-127.0.0.1 only. On a machine shared with other work the numbers are those of the machine: the report
-prints the load average before and after.
+is imported, the scene is loaded and cached per worker), then timed: a persistent cluster's steady state.
+The cluster listens on 127.0.0.1 only. On a machine shared with other work the numbers are those of the
+machine: the report prints the load average before and after.
 """
 
 from __future__ import annotations

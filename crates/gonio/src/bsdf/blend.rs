@@ -41,13 +41,13 @@ impl BlendBsdf {
         self.mix.set_weights(vec![1.0 - weight, weight]);
     }
 
-    /// The two-term sum this blend is.
-    #[inline(always)]
     /// The k-th nested model (0: the first, 1: the second), to change parameters it reads as it is.
     pub(crate) fn model_mut(&mut self, k: usize) -> Option<&mut Bsdf> {
         self.mix.components_mut().get_mut(k)
     }
 
+    /// The two-term sum this blend is.
+    #[inline(always)]
     pub(crate) fn mix(&self) -> &Sum {
         &self.mix
     }
