@@ -92,19 +92,21 @@ impl Slot {
         Some(Slot { route, name: name.clone() })
     }
 
-    /// Call `set` on every model the route reaches: whether it reached one and `set` returned true for each.
-    fn write(&self, model: &mut Bsdf, set: &mut dyn FnMut(&mut Bsdf, &str) -> bool) -> bool {
-        fn visit(model: &mut Bsdf, route: &[(usize, usize)], name: &str, set: &mut dyn FnMut(&mut Bsdf, &str) -> bool) -> bool {
-            match route {
-                [] => set(model, name),
-                [(k, count), rest @ ..] => {
+    /// Write `value` into every model the route reaches (a float with [`Bsdf::set_unit_float`], a colour
+    /// into [`Bsdf::reflectance_slot`]): whether it reached one and each took the value.
+    fn write(&self, model: &mut Bsdf, value: &TextureValue) -> bool {
+        fn visit(model: &mut Bsdf, route: &[(usize, usize)], name: &str, value: &TextureValue) -> bool {
+            match (route, value) {
+                ([], TextureValue::Scalar(v)) => model.set_unit_float(name, *v),
+                ([], TextureValue::Colour(c)) => model.reflectance_slot(name).map(|r| *r = *c).is_some(),
+                ([(k, count), rest @ ..], _) => {
                     let mut ok = true;
-                    let reached = model.for_nested_models(*k, *count, &mut |m| ok &= visit(m, rest, name, set));
+                    let reached = model.for_nested_models(*k, *count, &mut |m| ok &= visit(m, rest, name, value));
                     ok && reached > 0
                 }
             }
         }
-        visit(model, &self.route, &self.name, set)
+        visit(model, &self.route, &self.name, value)
     }
 }
 
@@ -181,15 +183,8 @@ impl Material {
             .iter()
             .map(|(path, _, lookup)| {
                 let slot = Slot::of(&template, path)?;
-                let float = matches!(lookup, Lookup::Float);
-                slot.write(&mut model.clone(), &mut |m, name| {
-                    if float {
-                        m.set_unit_float(name, 0.5)
-                    } else {
-                        m.reflectance_slot(name).is_some()
-                    }
-                })
-                .then_some(slot)
+                let probe = if matches!(lookup, Lookup::Float) { TextureValue::Scalar(0.5) } else { TextureValue::Colour(Rgb::splat(0.5)) };
+                slot.write(&mut model.clone(), &probe).then_some(slot)
             })
             .collect();
         if let Some(slots) = slots {
@@ -248,20 +243,13 @@ impl Material {
                     let outside = |v: &dyn std::fmt::Debug| {
                         crate::error::Error::spec("", format!("texture value {v:?} of `{}` outside [0, 1]", slot.name))
                     };
-                    let written = match TextureValue::of(t, *lookup, uv, surface) {
-                        TextureValue::Scalar(value) => {
-                            if !(0.0..=1.0).contains(&value) {
-                                return Err(outside(&value));
-                            }
-                            slot.write(&mut model, &mut |m, name| m.set_unit_float(name, value))
-                        }
-                        TextureValue::Colour(value) => {
-                            if !value.0.iter().all(|c| (0.0..=1.0).contains(c)) {
-                                return Err(outside(&value));
-                            }
-                            slot.write(&mut model, &mut |m, name| m.reflectance_slot(name).map(|r| *r = value).is_some())
-                        }
-                    };
+                    let value = TextureValue::of(t, *lookup, uv, surface);
+                    match &value {
+                        TextureValue::Scalar(v) if !(0.0..=1.0).contains(v) => return Err(outside(v)),
+                        TextureValue::Colour(c) if !c.0.iter().all(|c| (0.0..=1.0).contains(c)) => return Err(outside(c)),
+                        _ => {}
+                    }
+                    let written = slot.write(&mut model, &value);
                     debug_assert!(written, "slots checked when the material was built");
                 }
                 Cow::Owned(model)

@@ -47,7 +47,7 @@
 //! assert!(r.passed, "{r}");
 //! ```
 
-use crate::bsdf::{BsdfFlags, BsdfModel, SampleBuffers};
+use crate::bsdf::{BsdfFlags, BsdfModel};
 use crate::math::{Vec2, Vec3};
 use crate::sampling::Pcg32;
 use rayon::prelude::*;
@@ -1013,34 +1013,21 @@ fn sphere_domain(grid: &Grid) -> String {
 /// "no scattering from this wo".
 #[must_use]
 pub fn chi2_bsdf<M: BsdfModel + Sync + ?Sized>(bsdf: &M, wo: Vec3, cfg: &Chi2Config) -> Chi2Result {
-    /// Samples per batch call (the model's lanes give each as a single call would).
-    const BATCH: usize = 256;
     let grid = Grid::sphere(cfg);
     let chunk = |rng: &mut Pcg32, n: usize, t: &mut Tally| {
-        let wos = [wo; BATCH];
-        let (mut uc, mut u) = (Vec::with_capacity(BATCH), Vec::with_capacity(BATCH));
-        let mut rows = SampleBuffers::new(BATCH);
-        let (mut smooth, mut wi, mut pdf) = (Vec::with_capacity(BATCH), Vec::with_capacity(BATCH), vec![0.0; BATCH]);
-        for start in (0..n).step_by(BATCH) {
-            let m = BATCH.min(n - start);
-            uc.clear();
-            u.clear();
-            for _ in 0..m {
-                uc.push(rng.next_f32());
-                u.push(rng.next_vec2());
-            }
-            bsdf.sample_batch(&wos[..m], &uc, &u, &mut rows.columns());
+        let (mut wi, mut pdf) = (Vec::new(), Vec::new());
+        let draw = |_| {
+            let uc = rng.next_f32();
+            (uc, rng.next_vec2())
+        };
+        super::sample_batches(bsdf, wo, n, draw, |rows, m| {
             // The model's own pdf at every smooth sample's direction, in one batch too.
-            smooth.clear();
+            let smooth = |r: usize| rows.valid[r] && rows.pdf[r] > 0.0 && rows.pdf[r].is_finite() && !BsdfFlags(rows.flags[r]).has_delta();
             wi.clear();
-            for r in 0..m {
-                if rows.valid[r] && rows.pdf[r] > 0.0 && rows.pdf[r].is_finite() && !BsdfFlags(rows.flags[r]).has_delta() {
-                    smooth.push(r);
-                    wi.push(rows.wi[r]);
-                }
-            }
-            bsdf.pdf_batch(&wos[..wi.len()], &wi, &mut pdf[..wi.len()]);
-            let mut next_smooth = 0;
+            wi.extend((0..m).filter(|&r| smooth(r)).map(|r| rows.wi[r]));
+            pdf.resize(wi.len(), 0.0);
+            bsdf.pdf_batch(&vec![wo; wi.len()], &wi, &mut pdf);
+            let mut pdfs = pdf.iter();
             for r in 0..m {
                 let (s_wi, s_pdf) = (rows.wi[r], rows.pdf[r]);
                 if !rows.valid[r] {
@@ -1054,16 +1041,14 @@ pub fn chi2_bsdf<M: BsdfModel + Sync + ?Sized>(bsdf: &M, wo: Vec3, cfg: &Chi2Con
                         t.delta(s_wi, s_pdf);
                     }
                 } else {
-                    debug_assert_eq!(smooth[next_smooth], r);
-                    let pdf = pdf[next_smooth];
-                    next_smooth += 1;
+                    let pdf = *pdfs.next().expect("a pdf per smooth sample");
                     if (pdf - s_pdf).abs() > PDF_TOLERANCE * s_pdf {
                         t.mismatch(format!("wi = {s_wi}: sample says {s_pdf}, pdf says {pdf}"));
                     }
                     count_direction(&grid, s_wi, t);
                 }
             }
-        }
+        });
     };
     let tally = draw_chunks(cfg, grid.len(), &chunk);
     let density = |points: &[(f64, f64)], out: &mut [f64]| {

@@ -7,7 +7,7 @@
 //! average (1/π)∫ a(ωo) |cos θo| dωo: the fraction of uniform incident light that a surface reflects or
 //! transmits.
 
-use crate::bsdf::{BsdfFlags, BsdfModel, SampleBuffers};
+use crate::bsdf::{BsdfFlags, BsdfModel};
 use crate::math::{Vec2, Vec3};
 use crate::sampling::Pcg32;
 use crate::spectrum::Rgb;
@@ -17,28 +17,19 @@ use crate::spectrum::Rgb;
 /// The samples go to the model in batches (its lanes), which give each sample as a single call would.
 #[must_use]
 pub fn albedo<M: BsdfModel + ?Sized>(bsdf: &M, wo: Vec3, n: usize, seed: u64) -> Rgb {
-    /// Samples per batch.
-    const BATCH: usize = 256;
     let side = (n as f64).sqrt().ceil().max(1.0) as usize;
     let mut rng = Pcg32::new(seed, 0x0a1b);
     let mut sum = [0f64; 3];
     let count = side * side;
-    let wos = [wo; BATCH];
-    let (mut uc, mut u) = (Vec::with_capacity(BATCH), Vec::with_capacity(BATCH));
-    let mut rows = SampleBuffers::new(BATCH);
-    for start in (0..count).step_by(BATCH) {
-        let end = (start + BATCH).min(count);
-        uc.clear();
-        u.clear();
-        for k in start..end {
-            let (i, j) = (k % side, k / side);
-            u.push(Vec2::new((i as f32 + rng.next_f32()) / side as f32, (j as f32 + rng.next_f32()) / side as f32));
-            // A Latin-hypercube permutation of the lobe-selection strata.
-            let c = ((k * 7919 + 13) % count) as f32 / count as f32 + rng.next_f32() / count as f32;
-            uc.push(c.min(1.0 - f32::EPSILON));
-        }
-        bsdf.sample_batch(&wos[..end - start], &uc, &u, &mut rows.columns());
-        for r in 0..end - start {
+    let draw = |k: usize| {
+        let (i, j) = (k % side, k / side);
+        let u = Vec2::new((i as f32 + rng.next_f32()) / side as f32, (j as f32 + rng.next_f32()) / side as f32);
+        // A Latin-hypercube permutation of the lobe-selection strata.
+        let uc = ((k * 7919 + 13) % count) as f32 / count as f32 + rng.next_f32() / count as f32;
+        (uc.min(1.0 - f32::EPSILON), u)
+    };
+    super::sample_batches(bsdf, wo, count, draw, |rows, m| {
+        for r in 0..m {
             if rows.valid[r] {
                 let transmits = BsdfFlags(rows.flags[r]).intersects(BsdfFlags::TRANSMISSION);
                 let scale = if transmits { rows.eta[r] * rows.eta[r] } else { 1.0 };
@@ -47,7 +38,7 @@ pub fn albedo<M: BsdfModel + ?Sized>(bsdf: &M, wo: Vec3, n: usize, seed: u64) ->
                 }
             }
         }
-    }
+    });
     Rgb::new((sum[0] / count as f64) as f32, (sum[1] / count as f64) as f32, (sum[2] / count as f64) as f32)
 }
 

@@ -22,7 +22,7 @@ pub mod energy;
 pub mod reciprocity;
 pub mod sweep;
 
-use crate::bsdf::{BsdfFlags, BsdfModel};
+use crate::bsdf::{BsdfFlags, BsdfModel, SampleBuffers};
 use crate::math::{Vec2, Vec3};
 use crate::sampling::warp::sample_uniform_sphere;
 use crate::sampling::Pcg32;
@@ -306,6 +306,36 @@ pub fn expect_violation(report: &Report, row_kind: &str) -> Result<(), String> {
         return Err(format!("only `{row_kind}` may fail, but so did {}:\n{}", others.join(", "), report.to_table()));
     }
     Ok(())
+}
+
+/// Samples per call of a model's `sample_batch` in the checks.
+const SAMPLE_BATCH: usize = 256;
+
+/// `count` samples of `bsdf` from `wo`, through the model's batches (its lanes give each sample as a
+/// single call would): `draw(k)` gives the k-th sample's (uc, u), called for k in order; `take(rows, m)`
+/// sees each batch's first `m` rows, batches in order.
+pub(crate) fn sample_batches<M: BsdfModel + ?Sized>(
+    bsdf: &M,
+    wo: Vec3,
+    count: usize,
+    mut draw: impl FnMut(usize) -> (f32, Vec2),
+    mut take: impl FnMut(&SampleBuffers, usize),
+) {
+    let wos = [wo; SAMPLE_BATCH];
+    let (mut uc, mut u) = (Vec::with_capacity(SAMPLE_BATCH), Vec::with_capacity(SAMPLE_BATCH));
+    let mut rows = SampleBuffers::new(SAMPLE_BATCH);
+    for start in (0..count).step_by(SAMPLE_BATCH) {
+        let m = SAMPLE_BATCH.min(count - start);
+        uc.clear();
+        u.clear();
+        for k in start..start + m {
+            let (c, v) = draw(k);
+            uc.push(c);
+            u.push(v);
+        }
+        bsdf.sample_batch(&wos[..m], &uc, &u, &mut rows.columns());
+        take(&rows, m);
+    }
 }
 
 #[cfg(test)]
