@@ -586,3 +586,42 @@ fn direct_is_the_path_tracer_at_depth_two() {
     }
     std::fs::remove_file(&obj).unwrap();
 }
+
+/// A glass whose index equals its surroundings' bends and reflects nothing, so a scene with index-matched
+/// `thindielectric` and `dielectric` spheres is the scene without them. Not trivially: a shadow ray stops at
+/// glass, so the wall in the spheres' shadow is lit only by BSDF-sampled paths through two delta
+/// transmissions each (weight 1 at the light, the last lobe being delta), and the spheres are seen through
+/// by the same delta lobes; everywhere else light sampling and BSDF sampling share the work by MIS. Any
+/// error in the delta lobes' weights or in the MIS weights after them shifts the mean of the difference.
+#[test]
+fn index_matched_glass_is_invisible() {
+    let scene_with = |spheres: &str| {
+        scene(&format!(
+            r#"<scene version="3.0.0"><integrator type="path"><integer name="max_depth" value="8"/></integrator>
+            <sensor type="orthographic">
+                <transform name="to_world"><scale x="2.5" y="2.5"/><lookat origin="0, 0, 10" target="0, 0, 0" up="0, 1, 0"/></transform>
+                <sampler type="independent"><integer name="sample_count" value="512"/></sampler>
+                <film type="hdrfilm"><integer name="width" value="32"/><integer name="height" value="32"/><rfilter type="box"/></film></sensor>
+            <shape type="rectangle"><transform name="to_world"><scale value="8"/><translate z="-2"/></transform>
+                <bsdf type="diffuse"><rgb name="reflectance" value="0.5"/></bsdf></shape>
+            {spheres}
+            <shape type="disk"><transform name="to_world"><scale value="0.6"/><lookat origin="3, 4, 5" target="0, 0, 0" up="0, 1, 0"/></transform>
+                <emitter type="area"><rgb name="radiance" value="10"/></emitter></shape></scene>"#
+        ))
+    };
+    let glass = r#"<shape type="sphere"><point name="center" x="-1.2" y="0" z="0"/><float name="radius" value="1"/>
+            <bsdf type="thindielectric"><float name="int_ior" value="1.5"/><float name="ext_ior" value="1.5"/></bsdf></shape>
+        <shape type="sphere"><point name="center" x="1.2" y="0" z="0"/><float name="radius" value="1"/>
+            <bsdf type="dielectric"><float name="int_ior" value="1.33"/><float name="ext_ior" value="1.33"/></bsdf></shape>"#;
+    let (with, without) = (run(&scene_with(glass)), run(&scene_with("")));
+    // Each pixel's difference is an independent sample: its mean must be 0 within 5 standard errors. (A
+    // weight that is not 1 after the delta lobes moves it by 25 standard errors.)
+    for c in 0..3 {
+        let d: Vec<f64> = with.data.iter().zip(&without.data).skip(c).step_by(3).map(|(a, b)| f64::from(a - b)).collect();
+        let n = d.len() as f64;
+        let mean = d.iter().sum::<f64>() / n;
+        let se = (d.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt();
+        let (level, _) = mean_and_se(&without, c);
+        assert!(mean.abs() <= 5.0 * se, "channel {c}: with − without = {mean} ± {se} (image mean {level})");
+    }
+}
