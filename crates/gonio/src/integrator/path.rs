@@ -373,8 +373,8 @@ impl Shading<'_> {
 #[inline(always)]
 fn shading<'a>(scene: &'a Scene, p: &Packet, hit: &Surfaces8) -> Shading<'a> {
     // The lanes on one shape, or on shapes of one constant reflectance (`Scene::material_class`), share
-    // their material: a constant or checkerboard reflectance is found for them together, other materials
-    // lane by lane.
+    // their material: a constant, checkerboard or bitmap reflectance is found for them together, other
+    // materials lane by lane.
     let (mut rho, mut rho_rows, mut diffuse, mut diffuse_rows) = ([Float8::splat(0.0); 3], Rows3::default(), 0u32, 0u32);
     let mut models: [Option<Cow<'_, Bsdf>>; W] = Default::default();
     let (u, v) = (Float8::load(&hit.uv[0]), Float8::load(&hit.uv[1]));
@@ -390,7 +390,7 @@ fn shading<'a>(scene: &'a Scene, p: &Packet, hit: &Surfaces8) -> Shading<'a> {
     });
     for (first, same) in groups(p.live, |l| p.live & lanes_where(|k| class[k] == class[l])) {
         let material = &scene.materials[hit.shape[first] as usize];
-        if let Some(r) = material.diffuse_reflectance_lanes(u, v) {
+        if let Some(r) = material.diffuse_reflectance_lanes(u, v, same) {
             let m = Mask8::from_bitmask(same);
             rho = std::array::from_fn(|c| Float8::select(m, r[c], rho[c]));
             diffuse |= same;

@@ -4,6 +4,7 @@
 use crate::bsdf::{Bsdf, Diffuse};
 use crate::error::{Error, Result};
 use crate::geometry::Mesh;
+use crate::math::lanes::Real;
 use crate::math::simd::Float8;
 use crate::math::Frame;
 use crate::props::{Props, Value};
@@ -306,14 +307,15 @@ impl Material {
         }
     }
 
-    /// [`Self::diffuse_reflectance`] in lanes, at texture coordinates (`u`, `v`), where it needs no lookup
-    /// per lane: a constant `diffuse`'s reflectance or a checkerboard's. `None` for other materials (and
-    /// for bitmaps, read per lane).
+    /// [`Self::diffuse_reflectance`] in lanes, at texture coordinates (`u`, `v`) of the lanes set in `lanes`
+    /// (the others are left unspecified): a constant `diffuse`'s reflectance, a checkerboard's or a
+    /// bitmap's (the same values as one lane at a time). `None` for other materials.
     #[inline]
     #[must_use]
-    pub fn diffuse_reflectance_lanes(&self, u: Float8, v: Float8) -> Option<[Float8; 3]> {
+    pub fn diffuse_reflectance_lanes(&self, u: Float8, v: Float8, lanes: u32) -> Option<[Float8; 3]> {
         match self {
             Material::Fixed(Bsdf::Diffuse(d)) => Some(d.reflectance.0.map(Float8::splat)),
+            Material::TexturedDiffuse(Texture::Bitmap(b)) => Some(b.eval_lanes(u, v, lanes).map(|c| Real::clamp(c, 0.0, 1.0))),
             Material::TexturedDiffuse(Texture::Checkerboard(c)) => {
                 let first = c.same_side_lanes(u, v);
                 let (c0, c1) = (Self::clamped(c.color0), Self::clamped(c.color1));

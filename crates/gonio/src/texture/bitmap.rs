@@ -12,7 +12,10 @@
 //! (v = 0 is the first row); bilinear lookups blend the four texels around (u W − ½, v H − ½).
 
 use crate::error::{Error, Result};
+use crate::geometry::bvh::bits;
 use crate::image::{linear_to_srgb, read_stored_image, srgb8_table, Bytes8, Image, Stored};
+use crate::math::lanes::V3;
+use crate::math::simd::Float8;
 use crate::math::Transform;
 use crate::props::Props;
 use crate::spectrum::Rgb;
@@ -149,19 +152,14 @@ impl Bitmap {
         let (x, y) = (q.x * w - 0.5, q.y * h - 0.5);
         let (x0, y0) = (x.floor(), y.floor());
         let (fx, fy) = (x - x0, y - y0);
-        let (c0, c1) = (self.wrap.apply(x0 as i64, iw), self.wrap.apply(x0 as i64 + 1, iw));
-        let (r0, r1) = (self.wrap.apply(y0 as i64, ih), self.wrap.apply(y0 as i64 + 1, ih));
-        let texel = |x: usize, y: usize| {
-            let i = 3 * (y * iw + x);
-            match &self.texels {
-                Texels::Linear(image) => Rgb::new(image.data[i], image.data[i + 1], image.data[i + 2]).luminance(),
-                Texels::Bytes { image, table } => {
-                    let v = |k: usize| table[usize::from(image.data[k])];
-                    Rgb::new(v(i), v(i + 1), v(i + 2)).luminance()
-                }
+        let texel = |i: usize| match &self.texels {
+            Texels::Linear(image) => Rgb::new(image.data[i], image.data[i + 1], image.data[i + 2]).luminance(),
+            Texels::Bytes { image, table } => {
+                let v = |k: usize| table[usize::from(image.data[k])];
+                Rgb::new(v(i), v(i + 1), v(i + 2)).luminance()
             }
         };
-        let (f00, f10, f01, f11) = (texel(c0, r0), texel(c1, r0), texel(c0, r1), texel(c1, r1));
+        let [f00, f10, f01, f11] = self.corner_texels(x0, y0, iw, ih).map(texel);
         // ∂f/∂x and ∂f/∂y in texels, then per unit of the transformed coordinates (× resolution).
         let (dx, dy) = (((f10 - f00) * (1.0 - fy) + (f11 - f01) * fy) * w, ((f01 - f00) * (1.0 - fx) + (f11 - f10) * fx) * h);
         let (du, dv) = (self.to_uv.vector(Vec3::X), self.to_uv.vector(Vec3::Y));
@@ -174,20 +172,88 @@ impl Bitmap {
     fn filter(&self, uv: Vec2, iw: usize, ih: usize, texel: impl Fn(usize) -> Rgb) -> Rgb {
         let q = self.to_uv.point(Vec3::new(uv.x, uv.y, 0.0));
         let (w, h) = (iw as f32, ih as f32);
-        let at = |x: usize, y: usize| texel(3 * (y * iw + x));
         if !self.bilinear {
-            return at(self.wrap.apply((q.x * w).floor() as i64, iw), self.wrap.apply((q.y * h).floor() as i64, ih));
+            return texel(self.nearest_texel(q.x * w, q.y * h, iw, ih));
         }
         let (x, y) = (q.x * w - 0.5, q.y * h - 0.5);
         let (x0, y0) = (x.floor(), y.floor());
         let (fx, fy) = (x - x0, y - y0);
+        let [t00, t10, t01, t11] = self.corner_texels(x0, y0, iw, ih).map(texel);
+        let top = t00 * (1.0 - fx) + t10 * fx;
+        let bottom = t01 * (1.0 - fx) + t11 * fx;
+        top * (1.0 - fy) + bottom * fy
+    }
+
+    /// The colour lookup ([`Self::eval`]) at eight points (`u`, `v`) in lanes, by the same operations in
+    /// each lane of `lanes` (the same value bit for bit; the other lanes are 0). The texels are read lane by
+    /// lane; the coordinates and the blend are in lanes.
+    #[must_use]
+    pub fn eval_lanes(&self, u: Float8, v: Float8, lanes: u32) -> [Float8; 3] {
+        match &self.texels {
+            Texels::Linear(image) => {
+                let d = &image.data;
+                self.filter_lanes(u, v, lanes, image.width, image.height, |i| [d[i], d[i + 1], d[i + 2]])
+            }
+            Texels::Bytes { image, table } => {
+                let d = &image.data;
+                let v8 = |i: usize| table[usize::from(d[i])];
+                self.filter_lanes(u, v, lanes, image.width, image.height, |i| [v8(i), v8(i + 1), v8(i + 2)])
+            }
+        }
+    }
+
+    /// [`Self::filter`] in lanes.
+    #[inline(always)]
+    fn filter_lanes(&self, u: Float8, v: Float8, lanes: u32, iw: usize, ih: usize, texel: impl Fn(usize) -> [f32; 3]) -> [Float8; 3] {
+        let q = self.to_uv.point_lanes(V3::new(u, v, Float8::splat(0.0)));
+        let (w, h) = (Float8::splat(iw as f32), Float8::splat(ih as f32));
+        // Each corner's channels as rows of lanes.
+        let gather = |corners: &mut [[[f32; 8]; 3]], at: &dyn Fn(usize) -> [usize; 4]| {
+            for lane in bits(lanes) {
+                for (k, i) in at(lane).into_iter().take(corners.len()).enumerate() {
+                    let t = texel(i);
+                    for c in 0..3 {
+                        corners[k][c][lane] = t[c];
+                    }
+                }
+            }
+        };
+        if !self.bilinear {
+            let (x, y) = ((q.x * w).to_array(), (q.y * h).to_array());
+            let mut one = [[[0.0; 8]; 3]; 1];
+            gather(&mut one, &|l| [self.nearest_texel(x[l], y[l], iw, ih); 4]);
+            return one[0].map(|row| Float8::load(&row));
+        }
+        let half = Float8::splat(0.5);
+        let (x, y) = (q.x * w - half, q.y * h - half);
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let (x0s, y0s) = (x0.to_array(), y0.to_array());
+        let mut t = [[[0.0; 8]; 3]; 4];
+        gather(&mut t, &|l| self.corner_texels(x0s[l], y0s[l], iw, ih));
+        let one = Float8::splat(1.0);
+        std::array::from_fn(|c| {
+            let [t00, t10, t01, t11] = [0, 1, 2, 3].map(|k| Float8::load(&t[k][c]));
+            let top = t00 * (one - fx) + t10 * fx;
+            let bottom = t01 * (one - fx) + t11 * fx;
+            top * (one - fy) + bottom * fy
+        })
+    }
+
+    /// The first sample of the texel a `nearest` lookup at texel coordinates (`x`, `y`) reads.
+    #[inline(always)]
+    fn nearest_texel(&self, x: f32, y: f32, iw: usize, ih: usize) -> usize {
+        3 * (self.wrap.apply(y.floor() as i64, ih) * iw + self.wrap.apply(x.floor() as i64, iw))
+    }
+
+    /// The first samples of the four texels a bilinear lookup blends, whose lower corner is (`x0`, `y0`):
+    /// (x0, y0), (x0 + 1, y0), (x0, y0 + 1), (x0 + 1, y0 + 1), each column and row wrapped once.
+    #[inline(always)]
+    fn corner_texels(&self, x0: f32, y0: f32, iw: usize, ih: usize) -> [usize; 4] {
         let (x0, y0) = (x0 as i64, y0 as i64);
-        // Each of the two columns and rows wrapped once.
         let (c0, c1) = (self.wrap.apply(x0, iw), self.wrap.apply(x0 + 1, iw));
         let (r0, r1) = (self.wrap.apply(y0, ih), self.wrap.apply(y0 + 1, ih));
-        let top = at(c0, r0) * (1.0 - fx) + at(c1, r0) * fx;
-        let bottom = at(c0, r1) * (1.0 - fx) + at(c1, r1) * fx;
-        top * (1.0 - fy) + bottom * fy
+        [(c0, r0), (c1, r0), (c0, r1), (c1, r1)].map(|(x, y)| 3 * (y * iw + x))
     }
 }
 
@@ -250,6 +316,56 @@ mod tests {
             v,
             Rgb::new(f32::from(samples.data[i]) / 255.0, f32::from(samples.data[i + 1]) / 255.0, f32::from(samples.data[i + 2]) / 255.0)
         );
+    }
+
+    /// The lookup in lanes is the single lookup in each lane, bit for bit, for both kinds of texels, every
+    /// filter and wrap mode, a `to_uv` transform, and coordinates on and off the image.
+    #[test]
+    fn lookups_in_lanes_are_the_single_lookups() {
+        use crate::image::write_image;
+        use crate::sampling::Pcg32;
+        let dir = crate::scratch::ScratchDir::new("bitmap_lanes");
+        let mut rng = Pcg32::new(5, 2);
+        let mut image = Image::new(11, 6);
+        for y in 0..6 {
+            for x in 0..11 {
+                image.set(x, y, Rgb::new(rng.next_f32(), rng.next_f32() * 4.0, rng.next_f32()));
+            }
+        }
+        // A PNG is kept as bytes, an EXR as floats.
+        let (png, exr) = (dir.join("t.png"), dir.join("t.exr"));
+        write_image(&png, &image).unwrap();
+        write_image(&exr, &image).unwrap();
+        for file in [&png, &exr] {
+            for (filter, wrap) in
+                [("bilinear", "repeat"), ("bilinear", "mirror"), ("bilinear", "clamp"), ("nearest", "repeat"), ("nearest", "mirror")]
+            {
+                let spec = format!(
+                    r#"{{"type": "bitmap", "filename": {:?}, "filter_type": "{filter}", "wrap_mode": "{wrap}",
+                        "to_uv": [[1.5, 0.25, 0, 0.1], [-0.3, 2, 0, 0.7], [0, 0, 1, 0], [0, 0, 0, 1]]}}"#,
+                    file.to_str().unwrap()
+                );
+                let b = Bitmap::from_props(&Props::from_json(&spec).unwrap()).unwrap();
+                for _ in 0..300 {
+                    let (u, v): ([f32; 8], [f32; 8]) =
+                        (std::array::from_fn(|_| rng.next_f32() * 4.0 - 2.0), std::array::from_fn(|_| rng.next_f32() * 4.0 - 2.0));
+                    let lanes = rng.next_u32() & 0xff;
+                    let got = b.eval_lanes(Float8::load(&u), Float8::load(&v), lanes).map(Float8::to_array);
+                    for l in bits(lanes) {
+                        let want = b.eval(Vec2::new(u[l], v[l]));
+                        for c in 0..3 {
+                            assert_eq!(
+                                got[c][l].to_bits(),
+                                want.0[c].to_bits(),
+                                "{file:?} {filter} {wrap} lane {l} at ({}, {})",
+                                u[l],
+                                v[l]
+                            );
+                        }
+                    }
+                }
+            }
+        }
     }
 
     #[test]
