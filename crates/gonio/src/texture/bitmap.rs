@@ -353,14 +353,8 @@ mod tests {
                     let got = b.eval_lanes(Float8::load(&u), Float8::load(&v), lanes).map(Float8::to_array);
                     for l in bits(lanes) {
                         let want = b.eval(Vec2::new(u[l], v[l]));
-                        for c in 0..3 {
-                            assert_eq!(
-                                got[c][l].to_bits(),
-                                want.0[c].to_bits(),
-                                "{file:?} {filter} {wrap} lane {l} at ({}, {})",
-                                u[l],
-                                v[l]
-                            );
+                        for (row, want) in got.iter().zip(want.0) {
+                            assert_eq!(row[l].to_bits(), want.to_bits(), "{file:?} {filter} {wrap} lane {l} at ({}, {})", u[l], v[l]);
                         }
                     }
                 }
