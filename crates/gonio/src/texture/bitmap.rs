@@ -185,8 +185,8 @@ impl Bitmap {
     }
 
     /// The colour lookup ([`Self::eval`]) at eight points (`u`, `v`) in lanes, by the same operations in
-    /// each lane of `lanes` (the same value bit for bit; the other lanes are 0). The texels are read lane by
-    /// lane; the coordinates and the blend are in lanes.
+    /// each lane of `lanes` (the same value bit for bit; the other lanes are unspecified). The texels are
+    /// read lane by lane; the coordinates and the blend are in lanes.
     #[must_use]
     pub fn eval_lanes(&self, u: Float8, v: Float8, lanes: u32) -> [Float8; 3] {
         match &self.texels {
