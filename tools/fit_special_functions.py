@@ -91,3 +91,6 @@ if __name__ == "__main__":
                 return s
             s -= term
     print("lambda h", fit(lambda v: 1.0 if v == 0 else 2 / v * one_minus(1 / math.sqrt(v)), 0.0, 1 / 2.5 ** 2, 8, npts=1500, iters=20))
+
+    # Beckmann: k(a) = a e^{a^2} Lambda(a) = (1/sqrt(pi) - a erfcx(a))/2 on a in [0, 2.5], u = a/1.25 - 1.
+    print("beckmann lambda k", fit(lambda a: (1 / SQRT_PI - a * erfcx(a)) / 2, 0.0, 2.5, 14, npts=2000, iters=30))

@@ -6,7 +6,7 @@
 
 use super::distribution::Distribution;
 use crate::math::lanes::{Real, V3};
-use crate::numerics::erf::{erf_inv_lanes, erfc, erfc_lanes, erfcx_cf, erfcx_lanes};
+use crate::numerics::erf::{erf_inv_lanes, erfc, erfc_lanes, erfcx_cf};
 use crate::numerics::exp_log::{exp_neg, exp_split, ln_unit, square_split};
 use crate::numerics::horner;
 use std::f32::consts::PI;
@@ -43,6 +43,29 @@ pub fn beckmann_lambda(a: f64) -> f64 {
 /// Where [`beckmann_lambda_lanes`] switches from the erfc form to the asymptotic fit.
 const LAMBDA_SWITCH: f32 = 2.5;
 
+/// k(a) = a e^{a²} Λ(a) = (1/√π − a erfcx a)/2 for a ∈ [0, 2.5], as a polynomial in u = a/1.25 − 1 (fit by
+/// `tools/fit_special_functions.py`; fit error 2.6·10⁻⁸ relative, 3.6·10⁻⁷ evaluated in `f32`): Λ(a) =
+/// e^{−a²} k(a)/a without erfcx's exponential and division, and without the cancellation of its
+/// difference (k is entire, so a polynomial converges fast).
+#[allow(clippy::excessive_precision)] // the fit's f64 digits; Rust stores the nearest f32
+const LAMBDA_K: [f32; 15] = [
+    0.052205468821129544,
+    -0.06674723892531512,
+    0.058849559357083595,
+    -0.04299069668847289,
+    0.02771457321284484,
+    -0.016267501000617378,
+    0.00885309668313377,
+    -0.0045077263966407976,
+    0.0021764913226163555,
+    -0.0010363257435348477,
+    0.000461386301424306,
+    -0.0001515918914855674,
+    5.912717647620757e-05,
+    -5.289640999447791e-05,
+    2.1111360764111782e-05,
+];
+
 /// h(v) = 2a² (1 − a√π e^{a²} erfc a), v = 1/a² ∈ [0, 0.16] (a ≥ 2.5), as a polynomial in u = (v − 0.08)
 /// 12.5 (fit by `tools/fit_special_functions.py`; fit error 6·10⁻⁹): Λ(a) = e^{−a²} h / (4a³√π) without
 /// the cancellation of the erfc form (h → 1 − 3/(2a²) + … as a → ∞).
@@ -60,14 +83,15 @@ const LAMBDA_H: [f32; 9] = [
 ];
 
 /// The exact Beckmann Λ(a) of [`beckmann_lambda`] in `f32` lanes for a ≥ 0 (∞ at 0): relative error
-/// ≤ 5·10⁻⁶ against the `f64` form at the same argument wherever Λ is at least f32's smallest normal
-/// number (a ≤ 9.2; beyond it is 0), and so G1 = 1/(1 + Λ) within 5·10⁻⁶ too (test
-/// `fast_lambda_matches_f64`). Mitsuba's rational G1 (Walter 2007 eq. 27) errs by up to 0.35 %.
-/// - a < 2.5: Λ = e^{−a²} (1/(a√π) − erfcx a)/2, whose difference loses at most a factor 2a² + 1 ≤ 13.5
-///   of [`erfcx_lanes`]'s accuracy.
+/// ≤ 10⁻⁶ against the `f64` form at the same argument wherever Λ is at least f32's smallest normal
+/// number (a ≤ 9.2; beyond it is 0), and so G1 = 1/(1 + Λ) within 10⁻⁶ too (test
+/// `fast_lambda_matches_f64`: 4.6·10⁻⁷ and 3.0·10⁻⁷ with FMA). Mitsuba's rational G1 (Walter 2007 eq. 27) errs by up to 0.35 %.
+/// - a < 2.5: Λ = e^{−a²} k(a)/a ([`LAMBDA_K`]);
 /// - a ≥ 2.5: Λ = e^{−a²} h(1/a²)/(4a³√π) ([`LAMBDA_H`]), no cancellation.
 ///
-/// e^{−a²} takes a² split exactly ([`square_split`]).
+/// e^{−a²} takes a² split exactly ([`square_split`]); 1/a is the one division. (2026-12-06: the near form
+/// was e^{−a²} (1/(a√π) − erfcx a)/2, with erfcx's own exponential and two more divisions: Λ was 54 % of
+/// the Beckmann `roughconductor`'s batched `f`.)
 ///
 /// Not inlined: one copy per lane type. Inlined into every lane driver (with its ten-step neighbour
 /// [`visible_slope_x`]), it made LLVM's loop passes run for over half an hour on one codegen unit
@@ -79,15 +103,16 @@ pub fn beckmann_lambda_lanes<R: Real>(a: R) -> R {
     let a = R::select(a.gt(R::splat(16.0)), R::splat(16.0), a);
     let (hi, lo) = square_split(a);
     let gauss = exp_split(-hi, -lo);
+    let r = R::splat(1.0) / a;
     // Each form only where some lane needs it (a single call computes one).
     let near_lanes = a.lt(R::splat(LAMBDA_SWITCH));
     let mut lambda = R::splat(0.0);
     if R::any(near_lanes) {
-        lambda = gauss * (R::splat(FRAC_1_SQRT_PI) / a - erfcx_lanes(a)) * 0.5;
+        lambda = gauss * horner(a * (1.0 / 1.25) - 1.0, &LAMBDA_K) * r;
     }
     if R::any(!near_lanes) {
-        let a2 = a * a;
-        let far = gauss * horner((R::splat(1.0) / a2 - 0.08) * 12.5, &LAMBDA_H) / (a2 * a * (4.0 / FRAC_1_SQRT_PI));
+        let v = r * r;
+        let far = gauss * horner((v - 0.08) * 12.5, &LAMBDA_H) * (v * r * (FRAC_1_SQRT_PI / 4.0));
         lambda = R::select(near_lanes, lambda, far);
     }
     lambda
@@ -275,7 +300,7 @@ mod tests {
             }
         }
         eprintln!("Beckmann Λ worst relative error {worst_lambda:.2e}, G1 {worst_g1:.2e}");
-        assert!(worst_lambda <= 5e-6 && worst_g1 <= 5e-6, "{worst_lambda} {worst_g1}");
+        assert!(worst_lambda <= 1e-6 && worst_g1 <= 1e-6, "{worst_lambda} {worst_g1}");
         assert_eq!(beckmann_lambda_lanes(0.0f32), f32::INFINITY);
         assert_eq!(beckmann_lambda_lanes(20.0f32), 0.0);
         assert!(beckmann_lambda_lanes(f32::NAN).is_nan());

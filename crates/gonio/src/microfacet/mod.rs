@@ -21,7 +21,7 @@
 //! # Masking–shadowing (Heitz 2014, "Understanding the Masking-Shadowing Function in Microfacet-Based
 //! BRDFs", JCGT 3(2))
 //! - Smith masking G1(ω, ωm) = χ⁺(ω·ωm) / (1 + Λ(ω)) (eq. 43), with Λ for Beckmann (Heitz 2014 §5: the exact
-//!   erf form, not Walter 2007's rational approximation, eq. 27, evaluated in `f32` lanes within 5·10⁻⁶:
+//!   erf form, not Walter 2007's rational approximation, eq. 27, evaluated in `f32` lanes within 10⁻⁶:
 //!   [`beckmann::beckmann_lambda_lanes`]) and GGX (exact closed form).
 //! - `Smith`: separable G = G1(ωo)·G1(ωi) (eq. 98); `SmithCorrelated`: height-correlated
 //!   G = χ⁺χ⁺ / (1 + Λ(ωo) + Λ(ωi)) (eq. 99).
