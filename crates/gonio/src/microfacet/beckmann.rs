@@ -40,7 +40,7 @@ pub fn beckmann_lambda(a: f64) -> f64 {
     }
 }
 
-/// Where [`beckmann_lambda_lanes`] switches from the erfc form to the asymptotic fit.
+/// Where [`beckmann_lambda_lanes`] switches from the fit of k ([`LAMBDA_K`]) to the asymptotic fit.
 const LAMBDA_SWITCH: f32 = 2.5;
 
 /// k(a) = a e^{a²} Λ(a) = (1/√π − a erfcx a)/2 for a ∈ [0, 2.5], as a polynomial in u = a/1.25 − 1 (fit by
@@ -49,21 +49,21 @@ const LAMBDA_SWITCH: f32 = 2.5;
 /// difference (k is entire, so a polynomial converges fast).
 #[allow(clippy::excessive_precision)] // the fit's f64 digits; Rust stores the nearest f32
 const LAMBDA_K: [f32; 15] = [
-    0.052205468821129544,
-    -0.06674723892531512,
-    0.058849559357083595,
-    -0.04299069668847289,
-    0.02771457321284484,
-    -0.016267501000617378,
-    0.00885309668313377,
-    -0.0045077263966407976,
-    0.0021764913226163555,
-    -0.0010363257435348477,
-    0.000461386301424306,
-    -0.0001515918914855674,
-    5.912717647620757e-05,
-    -5.289640999447791e-05,
-    2.1111360764111782e-05,
+    0.052_205_468_821_129_544,
+    -0.066_747_238_925_315_12,
+    0.058_849_559_357_083_595,
+    -0.042_990_696_688_472_89,
+    0.027_714_573_212_844_84,
+    -0.016_267_501_000_617_378,
+    0.008_853_096_683_133_77,
+    -0.004_507_726_396_640_797_6,
+    0.002_176_491_322_616_355_5,
+    -0.001_036_325_743_534_847_7,
+    0.000_461_386_301_424_306,
+    -0.000_151_591_891_485_567_4,
+    5.912_717_647_620_757e-5,
+    -5.289_640_999_447_791e-5,
+    2.111_136_076_411_178_2e-5,
 ];
 
 /// h(v) = 2a² (1 − a√π e^{a²} erfc a), v = 1/a² ∈ [0, 0.16] (a ≥ 2.5), as a polynomial in u = (v − 0.08)
@@ -85,7 +85,8 @@ const LAMBDA_H: [f32; 9] = [
 /// The exact Beckmann Λ(a) of [`beckmann_lambda`] in `f32` lanes for a ≥ 0 (∞ at 0): relative error
 /// ≤ 10⁻⁶ against the `f64` form at the same argument wherever Λ is at least f32's smallest normal
 /// number (a ≤ 9.2; beyond it is 0), and so G1 = 1/(1 + Λ) within 10⁻⁶ too (test
-/// `fast_lambda_matches_f64`: 4.6·10⁻⁷ and 3.0·10⁻⁷ with FMA). Mitsuba's rational G1 (Walter 2007 eq. 27) errs by up to 0.35 %.
+/// `fast_lambda_matches_f64`: 4.6·10⁻⁷ and 3.0·10⁻⁷ with FMA). Mitsuba's rational G1 (Walter 2007
+/// eq. 27) errs by up to 0.35 %.
 /// - a < 2.5: Λ = e^{−a²} k(a)/a ([`LAMBDA_K`]);
 /// - a ≥ 2.5: Λ = e^{−a²} h(1/a²)/(4a³√π) ([`LAMBDA_H`]), no cancellation.
 ///
