@@ -275,6 +275,18 @@ mod tests {
         assert_eq!(Wrap::Mirror.apply(-1, 4), 0);
     }
 
+    /// A `w` × `h` image of uniform random texels, green scaled by `green` (above 1: values an 8-bit file
+    /// clips and a float file keeps), drawn row by row.
+    fn random_image(rng: &mut crate::sampling::Pcg32, w: usize, h: usize, green: f32) -> Image {
+        let mut image = Image::new(w, h);
+        for y in 0..h {
+            for x in 0..w {
+                image.set(x, y, Rgb::new(rng.next_f32(), rng.next_f32() * green, rng.next_f32()));
+            }
+        }
+        image
+    }
+
     /// An 8-bit file kept as its samples gives every lookup the floats decoded at load would give, bit for
     /// bit, in every filter and wrap mode; `raw` gives the samples / 255.
     #[test]
@@ -283,12 +295,7 @@ mod tests {
         use crate::sampling::Pcg32;
         let dir = crate::scratch::ScratchDir::new("bitmap8");
         let mut rng = Pcg32::new(3, 1);
-        let mut image = Image::new(13, 7);
-        for y in 0..7 {
-            for x in 0..13 {
-                image.set(x, y, Rgb::new(rng.next_f32(), rng.next_f32(), rng.next_f32()));
-            }
-        }
+        let image = random_image(&mut rng, 13, 7, 1.0);
         let png = dir.join("t.png");
         write_image(&png, &image).unwrap();
         let decoded = Arc::new(read_image(&png).unwrap());
@@ -326,12 +333,7 @@ mod tests {
         use crate::sampling::Pcg32;
         let dir = crate::scratch::ScratchDir::new("bitmap_lanes");
         let mut rng = Pcg32::new(5, 2);
-        let mut image = Image::new(11, 6);
-        for y in 0..6 {
-            for x in 0..11 {
-                image.set(x, y, Rgb::new(rng.next_f32(), rng.next_f32() * 4.0, rng.next_f32()));
-            }
-        }
+        let image = random_image(&mut rng, 11, 6, 4.0);
         // A PNG is kept as bytes, an EXR as floats.
         let (png, exr) = (dir.join("t.png"), dir.join("t.exr"));
         write_image(&png, &image).unwrap();

@@ -530,8 +530,6 @@ struct CellIntegral {
     at_depth_limit: bool,
 }
 
-/// Adaptive tensor-product Gauss–Legendre quadrature of a density over rectangles: rule n against rule
-/// 2n, split into 4 where they disagree, optionally forced down along sample positions.
 /// A density evaluated at many points at once: `out[k]` = the density at `points[k]`.
 type Density<'a> = &'a (dyn Fn(&[(f64, f64)], &mut [f64]) + Sync);
 
@@ -544,6 +542,8 @@ fn pointwise(density: impl Fn(f64, f64) -> f64 + Sync) -> impl Fn(&[(f64, f64)],
     }
 }
 
+/// Adaptive tensor-product Gauss–Legendre quadrature of a density over rectangles: rule n against rule
+/// 2n, split into 4 where they disagree, optionally forced down along sample positions.
 struct Quadrature<'a> {
     density: Density<'a>,
     low: Rule,
@@ -1015,7 +1015,7 @@ fn sphere_domain(grid: &Grid) -> String {
 pub fn chi2_bsdf<M: BsdfModel + Sync + ?Sized>(bsdf: &M, wo: Vec3, cfg: &Chi2Config) -> Chi2Result {
     let grid = Grid::sphere(cfg);
     let chunk = |rng: &mut Pcg32, n: usize, t: &mut Tally| {
-        let (mut wi, mut pdf) = (Vec::new(), Vec::new());
+        let (mut wi, mut pdf, wos) = (Vec::new(), Vec::new(), vec![wo; super::SAMPLE_BATCH]);
         let draw = |_| {
             let uc = rng.next_f32();
             (uc, rng.next_vec2())
@@ -1026,7 +1026,7 @@ pub fn chi2_bsdf<M: BsdfModel + Sync + ?Sized>(bsdf: &M, wo: Vec3, cfg: &Chi2Con
             wi.clear();
             wi.extend((0..m).filter(|&r| smooth(r)).map(|r| rows.wi[r]));
             pdf.resize(wi.len(), 0.0);
-            bsdf.pdf_batch(&vec![wo; wi.len()], &wi, &mut pdf);
+            bsdf.pdf_batch(&wos[..wi.len()], &wi, &mut pdf);
             let mut pdfs = pdf.iter();
             for r in 0..m {
                 let (s_wi, s_pdf) = (rows.wi[r], rows.pdf[r]);
