@@ -72,6 +72,9 @@ struct Entry {
     value: Value,
     at: String,
     used: Cell<bool>,
+    /// A texture's value at a hit ([`Props::set_texture_value`]): the range-checked readers clamp it into
+    /// their range instead of rejecting it.
+    clamped: bool,
 }
 
 /// The parameters of one plugin.
@@ -107,7 +110,7 @@ impl Props {
     /// Add a parameter (the last of equal names wins, as in Mitsuba's dictionaries).
     pub fn set(&mut self, name: &str, value: Value, at: &str) {
         self.entries.retain(|e| e.name != name);
-        self.entries.push(Entry { name: name.into(), value, at: at.into(), used: Cell::new(false) });
+        self.entries.push(Entry { name: name.into(), value, at: at.into(), used: Cell::new(false), clamped: false });
         self.plugins = 1 + self.entries.iter().map(|e| if let Value::Nested(p) = &e.value { p.plugins } else { 0 }).sum::<usize>();
     }
 
@@ -181,6 +184,7 @@ impl Props {
             Value::Number(v) => *v,
             _ => return Err(self.wrong(e, "a number")),
         };
+        let v = if e.clamped && v.is_finite() { v.clamp(f64::from(lo), f64::from(hi)) } else { v };
         if !(v >= lo as f64 && v <= hi as f64) {
             return Err(Error::spec(
                 &e.at,
@@ -217,6 +221,7 @@ impl Props {
             }
             _ => return Err(self.wrong(e, "a colour (a number or three numbers)")),
         };
+        let c = if e.clamped { c.map(|v| if v.is_finite() { v.clamp(f64::from(lo), f64::from(hi)) } else { v }) } else { c };
         if c.iter().any(|v| !(*v >= lo as f64 && *v <= hi as f64)) {
             return Err(Error::spec(
                 &e.at,
@@ -425,15 +430,34 @@ impl Props {
 
     /// Set a parameter at a path returned by [`Props::take_textures`]; `at` locates it in messages.
     pub fn set_path(&mut self, path: &[String], value: Value, at: &str) {
+        self.put_path(path, value, at, false);
+    }
+
+    fn put_path(&mut self, path: &[String], value: Value, at: &str, clamped: bool) {
         match path {
             [] => {}
-            [name] => self.set(name, value, at),
+            [name] => {
+                self.set(name, value, at);
+                if let Some(e) = self.entries.last_mut() {
+                    e.clamped = clamped;
+                }
+            }
             [first, rest @ ..] => {
                 if let Some(Value::Nested(p)) = self.entries.iter_mut().find(|e| &e.name == first).map(|e| &mut e.value) {
-                    p.set_path(rest, value, at);
+                    p.put_path(rest, value, at, clamped);
                 }
             }
         }
+    }
+
+    /// [`Props::set_path`] for a texture's value at a hit: where a reader checks a range (`float_in`,
+    /// `rgb_in`, `reflectance`), a finite value outside it is clamped into it rather than rejected — a
+    /// roughness to at least 10⁻⁴ as Mitsuba's microfacet distributions take it, a blend weight into
+    /// [0, 1] as Mitsuba's `blendbsdf` clips it, a reflectance per channel into [0, 1] as a textured
+    /// `diffuse` always was. A texture's values are only known at the hits, so an error there could only
+    /// have been a wrong (black) surface.
+    pub fn set_texture_value(&mut self, path: &[String], value: Value, at: &str) {
+        self.put_path(path, value, at, true);
     }
 
     /// Reject parameters that no model asked for.

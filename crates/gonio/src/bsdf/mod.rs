@@ -805,23 +805,34 @@ impl Bsdf {
         Bsdf::from_props(&Props::from_xml_bsdf(text, source)?)
     }
 
-    /// Set this model's float parameter `name` in [0, 1] (a texture's value at a hit) without building it
-    /// again, where the model has such a parameter: the blend `weight`, `principled`'s floats. `false` (the
-    /// model unchanged) otherwise. The float counterpart of [`Self::reflectance_slot`].
-    pub fn set_unit_float(&mut self, name: &str, value: f32) -> bool {
+    /// Set this model's float parameter `name` to a texture's value at a hit without building the model
+    /// again, where the model has such a parameter: the blend `weight` and `principled`'s floats (clamped
+    /// to [0, 1]), and the roughness `alpha`, `alpha_u`, `alpha_v` of the microfacet conductors and of
+    /// `roughdielectric` without energy compensation (whose tables are built for one roughness), clamped
+    /// to [10⁻⁴, 10] — the values the model built again from a description holding `value` would take
+    /// (`Props::set_texture_value`). `false` (the model unchanged) otherwise. The float counterpart of
+    /// [`Self::reflectance_slot`].
+    pub fn set_float(&mut self, name: &str, value: f32) -> bool {
+        use rough_conductor::{ALPHA_MAX, ALPHA_MIN};
         match (self, name) {
             (Bsdf::Blend(b), "weight") => {
-                b.set_weight(value);
+                b.set_weight(value.clamp(0.0, 1.0));
                 true
             }
-            (Bsdf::Principled(p), name) => p.set_unit_float(name, value),
+            (Bsdf::Principled(p), name) => p.set_unit_float(name, value.clamp(0.0, 1.0)),
+            (Bsdf::RoughConductor(RoughConductor(c)) | Bsdf::TorranceSparrow(TorranceSparrow(c)), name) if c.compensation.is_none() => {
+                c.distribution.set_roughness(name, value.clamp(ALPHA_MIN, ALPHA_MAX))
+            }
+            (Bsdf::RoughDielectric(d), name) if d.compensation.is_none() => {
+                d.distribution.set_roughness(name, value.clamp(ALPHA_MIN, ALPHA_MAX))
+            }
             _ => false,
         }
     }
 
     /// The models this one built from the k-th of its `count` nested descriptions (`Props::nested`'s
     /// order) and holds as they are, where a texture on a parameter of that description can be set at a
-    /// hit ([`Self::reflectance_slot`], [`Self::set_unit_float`]) without building this model again:
+    /// hit ([`Self::reflectance_slot`], [`Self::set_float`]) without building this model again:
     /// `twosided` (a single nested model is both sides) and `blendbsdf`; none for other models.
     /// Calls `f` on each of them; returns how many there were.
     pub fn for_nested_models(&mut self, k: usize, count: usize, f: &mut dyn FnMut(&mut Bsdf)) -> usize {

@@ -189,6 +189,19 @@ impl MicrofacetDistribution {
         MicrofacetDistribution { kind, alpha_x, alpha_y }
     }
 
+    /// Set roughness parameter `name` to `alpha` (> 0): `alpha` both, `alpha_u` the roughness along x,
+    /// `alpha_v` along y (for Beckmann and GGX: Blinn is isotropic). Whether the distribution has `name`.
+    pub fn set_roughness(&mut self, name: &str, alpha: f32) -> bool {
+        debug_assert!(alpha > 0.0, "roughness must be positive");
+        match (name, self.kind) {
+            ("alpha", _) => (self.alpha_x, self.alpha_y) = (alpha, alpha),
+            ("alpha_u", MicrofacetKind::Beckmann | MicrofacetKind::Ggx) => self.alpha_x = alpha,
+            ("alpha_v", MicrofacetKind::Beckmann | MicrofacetKind::Ggx) => self.alpha_y = alpha,
+            _ => return false,
+        }
+        true
+    }
+
     /// The normalised Blinn distribution with exponent `exponent` ≥ 0.
     #[must_use]
     pub fn blinn(exponent: f32) -> Self {

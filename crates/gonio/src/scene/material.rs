@@ -48,7 +48,7 @@ pub enum Material {
     /// A `diffuse` whose reflectance is a texture (the common case, built without `Props`).
     TexturedDiffuse(Texture),
     /// A model whose every texture sets a reflectance it reads as it is ([`Bsdf::reflectance_slot`]) or a
-    /// float in [0, 1] it can take at once ([`Bsdf::set_unit_float`]: a blend's weight): built once, and
+    /// float it can take at once ([`Bsdf::set_float`]: a blend's weight, a roughness): built once, and
     /// at a hit copied with the textures' values written into it — the model [`Material::Textured`] would
     /// build from the same values, without `Props`. Each texture with its parameter and how it is read.
     Slotted {
@@ -93,13 +93,14 @@ impl Slot {
         Some(Slot { route, name: name.clone() })
     }
 
-    /// Write `value` into every model the route reaches (a float with [`Bsdf::set_unit_float`], a colour
-    /// into [`Bsdf::reflectance_slot`]): whether it reached one and each took the value.
+    /// Write `value` into every model the route reaches (a float with [`Bsdf::set_float`], a colour into
+    /// [`Bsdf::reflectance_slot`] clamped to [0, 1]: both clamped as the rebuilt model's readers clamp a
+    /// texture's value, [`Props::set_texture_value`]): whether it reached one and each took the value.
     fn write(&self, model: &mut Bsdf, value: &TextureValue) -> bool {
         fn visit(model: &mut Bsdf, route: &[(usize, usize)], name: &str, value: &TextureValue) -> bool {
             match (route, value) {
-                ([], TextureValue::Scalar(v)) => model.set_unit_float(name, *v),
-                ([], TextureValue::Colour(c)) => model.reflectance_slot(name).map(|r| *r = *c).is_some(),
+                ([], TextureValue::Scalar(v)) => model.set_float(name, *v),
+                ([], TextureValue::Colour(c)) => model.reflectance_slot(name).map(|r| *r = c.map(|v| v.clamp(0.0, 1.0))).is_some(),
                 ([(k, count), rest @ ..], _) => {
                     let mut ok = true;
                     let reached = model.for_nested_models(*k, *count, &mut |m| ok &= visit(m, rest, name, value));
@@ -239,16 +240,11 @@ impl Material {
             Material::Slotted { model, textures } => {
                 let mut model = model.clone();
                 for (slot, t, lookup) in textures {
-                    // The range of `Props::reflectance` and of the floats' `float_in`, so that a value out of
-                    // it fails as the rebuilt model would.
-                    let outside = |v: &dyn std::fmt::Debug| {
-                        crate::error::Error::spec("", format!("texture value {v:?} of `{}` outside [0, 1]", slot.name))
-                    };
                     let value = TextureValue::of(t, *lookup, uv, surface);
-                    match &value {
-                        TextureValue::Scalar(v) if !(0.0..=1.0).contains(v) => return Err(outside(v)),
-                        TextureValue::Colour(c) if !c.0.iter().all(|c| (0.0..=1.0).contains(c)) => return Err(outside(c)),
-                        _ => {}
+                    // A value in range is clamped into it (`Slot::write`); one that is not a number fails
+                    // as it would in the rebuilt model.
+                    if !value.is_finite() {
+                        return Err(Error::spec("", format!("texture value of `{}` is not a finite number", slot.name)));
                     }
                     let written = slot.write(&mut model, &value);
                     debug_assert!(written, "slots checked when the material was built");
@@ -264,7 +260,7 @@ impl Material {
                 let mut p = template.lock().map_or_else(|poisoned| poisoned.into_inner().clone(), |t| t.clone());
                 let at = p.at().to_string();
                 for ((path, ..), value) in textures.iter().zip(&values) {
-                    p.set_path(path, value.to_value(), &at);
+                    p.set_texture_value(path, value.to_value(), &at);
                 }
                 let bsdf = Bsdf::from_props(&p)?;
                 if let Ok(mut c) = cache.write() {
@@ -325,8 +321,9 @@ impl Material {
         }
     }
 
-    /// The BSDF at texture coordinates `uv`. A texture value a model rejects (e.g. a reflectance above 1)
-    /// gives a black diffuse rather than a panic; load-time validation catches constant mistakes.
+    /// The BSDF at texture coordinates `uv`. A texture's value outside its parameter's range is clamped
+    /// into it (`Props::set_texture_value`); one a model still rejects (not a number) gives a black
+    /// diffuse rather than a panic; load-time validation catches constant mistakes.
     #[must_use]
     pub fn at(&self, uv: Vec2) -> Cow<'_, Bsdf> {
         // The common case without the `Result` around a large `Cow` (2026-11: 2 % of a Cornell box render).
@@ -393,6 +390,13 @@ impl TextureValue {
         }
     }
 
+    fn is_finite(&self) -> bool {
+        match self {
+            TextureValue::Scalar(v) => v.is_finite(),
+            TextureValue::Colour(c) => c.0.iter().all(|v| v.is_finite()),
+        }
+    }
+
     fn bits(&self) -> Vec<u32> {
         match self {
             TextureValue::Scalar(v) => vec![v.to_bits()],
@@ -430,9 +434,11 @@ mod tests {
     }
 
     /// Every texture the slotted form writes gives the model that building it again from the texture's
-    /// values gives, bit for bit, over each model's reflectances (one and two textures at once), and a
-    /// value out of [0, 1] gives the same black diffuse (a colour's and a blend weight's); models whose
-    /// textures have no slot (a roughness, energy compensation, a nested model) are built again.
+    /// values gives, bit for bit, over each model's reflectances and roughnesses (one and two textures at
+    /// once); a value out of the parameter's range is clamped into it in both forms (a reflectance to
+    /// [0, 1], a blend weight to [0, 1], a roughness to [10⁻⁴, 10]: Mitsuba's floor) — never a black
+    /// surface; models whose textures have no slot (energy compensation, a nested model) are built again
+    /// and clamp alike.
     #[test]
     fn slotted_textures_give_the_rebuilt_models() {
         let (a, b) = ("0.9, 0.25, 0.5", "0.1, 0.7, 1");
@@ -457,6 +463,12 @@ mod tests {
             ),
             ("principled", "", vec![("roughness", "0.05", "0.8"), ("anisotropic", "0.05", "0.8"), ("flatness", "1", "0")]),
             ("blendbsdf", blend, vec![("weight", "1.5", "0.3")]),
+            ("roughconductor", "", vec![("alpha", "0.1", "0.3")]),
+            ("roughconductor", r#"<string name="distribution" value="ggx"/>"#, vec![("alpha_u", "0.05", "0.4"), ("alpha_v", "0.3", "0")]),
+            ("roughconductor", r#"<string name="material" value="Cu"/>"#, vec![("alpha", "0", "0.2"), ("specular_reflectance", a, b)]),
+            ("roughdielectric", "", vec![("alpha", "0", "20")]),
+            ("roughdielectric", r#"<string name="distribution" value="ggx"/>"#, vec![("alpha_v", "0.01", "0.5")]),
+            ("torrance_sparrow", "", vec![("alpha", "0.02", "0.6")]),
         ];
         for (plugin, extra, textured) in &cases {
             let p = props(plugin, extra, textured);
@@ -468,16 +480,27 @@ mod tests {
                 assert_eq!(slotted.at(uv), rebuilt.at(uv), "{plugin} {textured:?} at {uv}");
             }
         }
-        // The out-of-range colour gave black somewhere: the test above compared a failure too.
-        let p = props("roughplastic", "", &[("diffuse_reflectance", a, "0.5, 1.5, 0.5")]);
-        let m = Material::from_props(&p).unwrap();
-        let black = Bsdf::Diffuse(Diffuse::new(crate::spectrum::Rgb::ZERO));
-        assert!((0..64).any(|i| *m.at(Vec2::new(i as f32 / 64.0, 0.3)) == black));
-        let m = Material::from_props(&props("blendbsdf", blend, &[("weight", "1.5", "0.3")])).unwrap();
-        assert!((0..64).any(|i| *m.at(Vec2::new(i as f32 / 64.0, 0.3)) == black));
+        // Out-of-range values are the clamped ones (the test above compared those cases to the rebuilt
+        // models, which clamp alike).
+        for (plugin, extra, outside, inside) in [
+            ("roughplastic", "", ("diffuse_reflectance", a, "0.5, 1.5, 0.5"), ("diffuse_reflectance", a, "0.5, 1, 0.5")),
+            ("blendbsdf", blend, ("weight", "1.5", "0.3"), ("weight", "1", "0.3")),
+            ("roughdielectric", "", ("alpha", "0", "20"), ("alpha", "0.0001", "10")),
+            ("roughconductor", r#"<boolean name="energy_compensation" value="true"/>"#, ("alpha", "0", "0.3"), ("alpha", "0.0001", "0.3")),
+        ] {
+            let (clamped, within) = (
+                Material::from_props(&props(plugin, extra, &[outside])).unwrap(),
+                Material::from_props(&props(plugin, extra, &[inside])).unwrap(),
+            );
+            for i in 0..64 {
+                let uv = Vec2::new(i as f32 / 64.0, 0.3);
+                assert_eq!(clamped.at(uv), within.at(uv), "{plugin} {outside:?} at {uv}");
+                assert!(!matches!(*clamped.at(uv), Bsdf::Diffuse(_)), "{plugin} {outside:?} at {uv}");
+            }
+        }
 
         for (plugin, extra, textured) in [
-            ("roughconductor", "", vec![("alpha", "0.1", "0.3")]),
+            ("roughconductor", r#"<boolean name="energy_compensation" value="true"/>"#, vec![("alpha", "0.1", "0.3")]),
             ("roughconductor", r#"<boolean name="energy_compensation" value="true"/>"#, vec![("specular_reflectance", a, b)]),
             ("roughplastic", r#"<boolean name="energy_compensation" value="true"/>"#, vec![("diffuse_reflectance", a, b)]),
         ] {
@@ -515,7 +538,14 @@ mod tests {
                 true,
             ),
             (blend.clone(), true),
-            (format!(r#"<bsdf type="twosided"><bsdf type="roughconductor">{}</bsdf></bsdf>"#, checker("alpha", "0.1", "0.3")), false),
+            (format!(r#"<bsdf type="twosided"><bsdf type="roughconductor">{}</bsdf></bsdf>"#, checker("alpha", "0.1", "0.3")), true),
+            (
+                format!(
+                    r#"<bsdf type="twosided"><bsdf type="roughconductor"><boolean name="energy_compensation" value="true"/>{}</bsdf></bsdf>"#,
+                    checker("alpha", "0.1", "0.3")
+                ),
+                false,
+            ),
             (format!(r#"<bsdf type="mask">{diffuse}</bsdf>"#), false),
         ] {
             let p = Props::from_xml_bsdf(&xml, "test.xml").unwrap();
