@@ -587,6 +587,86 @@ fn direct_is_the_path_tracer_at_depth_two() {
     std::fs::remove_file(&obj).unwrap();
 }
 
+/// A textured material whose textures only tint its model (a conductor's `specular_reflectance`, a
+/// dielectric's `specular_reflectance` and `specular_transmittance`, also inside a `twosided`) runs one
+/// model for all its lanes in the packets and scales each lane's values by its texels
+/// (`Material::tinted_lanes`). The scalar `direct` integrator, which builds each hit's model with the texel
+/// written into it, is its reference: every camera sample's radiance the same to rounding (the model
+/// multiplies its tint in its own order, so not bit for bit), with paths through both lobes of the
+/// dielectrics and through a tinted material seen through another.
+#[test]
+fn tinted_textures_in_packets_are_the_textured_models() {
+    use gonio::integrator::{direct_each, radiance, CameraSample};
+    let checker = |name: &str, c0: &str, c1: &str| {
+        format!(
+            r#"<texture type="checkerboard" name="{name}"><rgb name="color0" value="{c0}"/><rgb name="color1" value="{c1}"/>
+               <transform name="to_uv"><scale x="6" y="4"/></transform></texture>"#
+        )
+    };
+    let spheres = [
+        format!(
+            r#"<bsdf type="conductor"><string name="material" value="Au"/>{}</bsdf>"#,
+            checker("specular_reflectance", "0.9, 0.2, 0.4", "0.1, 0.8, 1")
+        ),
+        format!(r#"<bsdf type="roughconductor">{}</bsdf>"#, checker("specular_reflectance", "1, 0.5, 0.2", "0.3, 0.3, 0.9")),
+        format!(
+            r#"<bsdf type="dielectric">{}{}</bsdf>"#,
+            checker("specular_reflectance", "0.5, 1, 0.5", "1, 1, 1"),
+            checker("specular_transmittance", "1, 0.4, 0.4", "0.6, 0.8, 1")
+        ),
+        format!(r#"<bsdf type="thindielectric">{}</bsdf>"#, checker("specular_transmittance", "0.2, 0.9, 0.9", "1, 1, 0.3")),
+        format!(
+            r#"<bsdf type="roughdielectric"><string name="distribution" value="ggx"/><float name="alpha" value="0.2"/>{}</bsdf>"#,
+            checker("specular_transmittance", "1, 0.6, 0.6", "0.6, 0.8, 1")
+        ),
+        format!(
+            r#"<bsdf type="twosided"><bsdf type="roughconductor"><float name="alpha" value="0.3"/>{}</bsdf></bsdf>"#,
+            checker("specular_reflectance", "0.9, 0.9, 0.2", "0.2, 0.5, 0.9")
+        ),
+    ];
+    let shapes: String = spheres
+        .iter()
+        .enumerate()
+        .map(|(i, bsdf)| {
+            let (x, y) = ((i % 3) as f32 * 1.1 - 1.1, (i / 3) as f32 * 1.1 - 0.55);
+            format!(r#"<shape type="sphere"><point name="center" x="{x}" y="{y}" z="0"/><float name="radius" value="0.5"/>{bsdf}</shape>"#)
+        })
+        .collect();
+    let xml = format!(
+        r#"<scene version="3.0.0"><integrator type="direct"><integer name="emitter_samples" value="2"/><integer name="bsdf_samples" value="2"/></integrator>{sensor}
+        {shapes}
+        <shape type="rectangle"><transform name="to_world"><scale value="10"/><translate z="-1"/></transform>
+            <bsdf type="diffuse">{floor}</bsdf></shape>
+        <shape type="sphere"><point name="center" x="2" y="2" z="1.5"/><float name="radius" value="0.3"/>
+            <emitter type="area"><rgb name="radiance" value="10"/></emitter></shape>
+        <emitter type="point"><point name="position" x="-2" y="1" z="2"/><rgb name="intensity" value="3"/></emitter>
+        <emitter type="constant"><rgb name="radiance" value="0.3"/></emitter></scene>"#,
+        sensor = sensor(6.0, 60.0, 32, 4),
+        floor = checker("reflectance", "0.8, 0.8, 0.8", "0.2, 0.2, 0.2"),
+    );
+    let s = scene(&xml);
+    let tinted = s
+        .materials
+        .iter()
+        .filter(|m| m.tinted_lanes(gonio::math::simd::Float8::splat(0.5), gonio::math::simd::Float8::splat(0.5), 1).is_some())
+        .count();
+    assert_eq!(tinted, spheres.len(), "every sphere's material is in the tinted form");
+    let samples: Vec<CameraSample> =
+        (0..32).flat_map(|y| (0..32).flat_map(move |x| (0..4).map(move |k| CameraSample { x, y, k }))).collect();
+    let (mut packets, mut each) = (vec![gonio::spectrum::Rgb::ZERO; samples.len()], vec![gonio::spectrum::Rgb::ZERO; samples.len()]);
+    radiance(&s, 5, &samples, &mut packets);
+    direct_each(&s, 5, &samples, &mut each, 2, 2, false);
+    let mut lit = 0;
+    for (i, (a, b)) in packets.iter().zip(&each).enumerate() {
+        for c in 0..3 {
+            let (a, b) = (a.0[c], b.0[c]);
+            assert!((a - b).abs() <= 1e-5 * b.abs() + 1e-7, "sample {:?}, channel {c}: packets {a}, single {b}", samples[i]);
+        }
+        lit += usize::from(b.0.iter().any(|&v| v > 0.0));
+    }
+    assert!(lit > samples.len() / 2, "the scene is lit ({lit} of {} samples)", samples.len());
+}
+
 /// A glass whose index equals its surroundings' bends and reflects nothing, so a scene with index-matched
 /// `thindielectric` and `dielectric` spheres is the scene without them. Not trivially: a shadow ray stops at
 /// glass, so the wall in the spheres' shadow is lit only by BSDF-sampled paths through two delta

@@ -792,6 +792,15 @@ bsdf_models! {
     NormalMap(NormalMap) = "normalmap",
 }
 
+/// The lobe a colour parameter tints ([`Bsdf::tint`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Tint {
+    /// Directions on ωo's side of the surface (ωo·n and ωi·n of one sign).
+    Reflection,
+    /// Directions through the surface.
+    Transmission,
+}
+
 impl Bsdf {
     /// Build a model from a JSON object in Mitsuba's dictionary form, e.g.
     /// `{"type": "conductor", "material": "Au"}`.
@@ -840,6 +849,37 @@ impl Bsdf {
             Bsdf::TwoSided(t) => t.for_sides(k, count, f),
             Bsdf::Blend(b) if count == 2 => b.model_mut(k).map(f).map_or(0, |()| 1),
             _ => 0,
+        }
+    }
+
+    /// Which lobe colour parameter `name` tints, where it is a pure tint of this model: it scales `f` (and
+    /// a sample's `f` and weight) channel by channel for the directions on ωo's side of the surface
+    /// ([`Tint::Reflection`]) or through it ([`Tint::Transmission`]), and changes neither `pdf` nor the
+    /// sampled directions. A texture on such a parameter can then be applied after the model (the
+    /// renderer's packets run one model for the lanes of a textured material and scale each lane's values
+    /// by its texels). The conductors' `specular_reflectance` and the dielectrics' `specular_reflectance`
+    /// and `specular_transmittance` (Mitsuba's meaning: "a factor that modulates the component"; both
+    /// renderers choose the dielectric's lobe by the Fresnel term alone), where [`Self::reflectance_slot`]
+    /// holds them; `None` for every other parameter (test `tints_only_scale_their_lobe`).
+    #[must_use]
+    pub fn tint(&mut self, name: &str) -> Option<Tint> {
+        self.reflectance_slot(name)?;
+        match (self, name) {
+            (Bsdf::Conductor(_) | Bsdf::RoughConductor(_), "specular_reflectance") => Some(Tint::Reflection),
+            (Bsdf::Dielectric(_) | Bsdf::ThinDielectric(_) | Bsdf::RoughDielectric(_), "specular_reflectance") => Some(Tint::Reflection),
+            (Bsdf::Dielectric(_) | Bsdf::ThinDielectric(_) | Bsdf::RoughDielectric(_), "specular_transmittance") => {
+                Some(Tint::Transmission)
+            }
+            _ => None,
+        }
+    }
+
+    /// The model a `twosided` with one nested model runs on both sides (`None` for other models).
+    #[must_use]
+    pub fn both_sides(&mut self) -> Option<&mut Bsdf> {
+        match self {
+            Bsdf::TwoSided(t) => t.both_sides(),
+            _ => None,
         }
     }
 
@@ -1038,6 +1078,79 @@ mod tests {
                     "{spec}: sample at {k}"
                 );
             }
+        }
+    }
+
+    /// Each parameter [`Bsdf::tint`] names scales its lobe and nothing else: with it at c, `f` and a
+    /// sample's `f` and weight are c times theirs at 1 in the tinted lobe (to rounding) and the same in the
+    /// other; `pdf`, the sampled direction and its pdf are unchanged, bit for bit. Parameters that are not
+    /// pure tints (a plastic's, a principled's colour, a compensated conductor's reflectance) have none.
+    #[test]
+    fn tints_only_scale_their_lobe() {
+        let c = Rgb::new(0.7, 0.2, 0.45);
+        let cases = [
+            (r#"{"type": "conductor", "material": "Au"}"#, "specular_reflectance", Tint::Reflection),
+            (r#"{"type": "roughconductor", "alpha_u": 0.1, "alpha_v": 0.3}"#, "specular_reflectance", Tint::Reflection),
+            (r#"{"type": "roughconductor", "distribution": "ggx", "alpha": 0.3}"#, "specular_reflectance", Tint::Reflection),
+            (r#"{"type": "dielectric"}"#, "specular_reflectance", Tint::Reflection),
+            (r#"{"type": "dielectric", "int_ior": 1.33}"#, "specular_transmittance", Tint::Transmission),
+            (r#"{"type": "thindielectric"}"#, "specular_reflectance", Tint::Reflection),
+            (r#"{"type": "thindielectric"}"#, "specular_transmittance", Tint::Transmission),
+            (r#"{"type": "roughdielectric", "alpha": 0.2}"#, "specular_reflectance", Tint::Reflection),
+            (r#"{"type": "roughdielectric", "distribution": "ggx", "alpha": 0.4}"#, "specular_transmittance", Tint::Transmission),
+        ];
+        let mut rng = Pcg32::new(11, 0);
+        let dir = |rng: &mut Pcg32| {
+            let v = Vec3::new(2.0 * rng.next_f32() - 1.0, 2.0 * rng.next_f32() - 1.0, 2.0 * rng.next_f32() - 1.0);
+            v.try_normalize().unwrap_or(Vec3::Z)
+        };
+        let close = |a: Rgb, b: Rgb, what: &str| {
+            for k in 0..3 {
+                assert!((a.0[k] - b.0[k]).abs() <= 1e-6 * b.0[k].abs().max(1e-30) + 1e-30, "{what}: {a:?} against {b:?}");
+            }
+        };
+        for (json, name, lobe) in cases {
+            let mut at_one = Bsdf::from_json(json).unwrap();
+            assert_eq!(at_one.tint(name), Some(lobe), "{json} {name}");
+            let mut tinted = at_one.clone();
+            *tinted.reflectance_slot(name).unwrap() = c;
+            let (mut reflected, mut transmitted) = (0, 0);
+            for _ in 0..2000 {
+                let (wo, wi) = (dir(&mut rng), dir(&mut rng));
+                let through = wo.z * wi.z < 0.0;
+                let scale = if through == (lobe == Tint::Transmission) { c } else { Rgb::ONE };
+                close(tinted.f(wo, wi), at_one.f(wo, wi) * scale, &format!("{json} {name}: f({wo}, {wi})"));
+                assert_eq!(tinted.pdf(wo, wi).to_bits(), at_one.pdf(wo, wi).to_bits(), "{json} {name}: pdf");
+                let (uc, u) = (rng.next_f32(), Vec2::new(rng.next_f32(), rng.next_f32()));
+                match (tinted.sample(wo, uc, u), at_one.sample(wo, uc, u)) {
+                    (Some(a), Some(b)) => {
+                        assert_eq!((a.wi, a.pdf.to_bits(), a.flags), (b.wi, b.pdf.to_bits(), b.flags), "{json} {name}: sample");
+                        let through = wo.z * a.wi.z < 0.0;
+                        let scale = if through == (lobe == Tint::Transmission) { c } else { Rgb::ONE };
+                        close(a.weight, b.weight * scale, &format!("{json} {name}: weight at {wo}"));
+                        close(a.f, b.f * scale, &format!("{json} {name}: sampled f at {wo}"));
+                        if through {
+                            transmitted += 1;
+                        } else {
+                            reflected += 1;
+                        }
+                    }
+                    (None, None) => {}
+                    (a, b) => panic!("{json} {name}: a sample in one model only: {a:?} {b:?}"),
+                }
+            }
+            // Both lobes of the dielectrics were sampled (so both scales were compared).
+            assert!(reflected > 100 && (transmitted > 100 || !json.contains("dielectric")), "{json}: {reflected} / {transmitted}");
+        }
+        for (json, name) in [
+            (r#"{"type": "plastic"}"#, "diffuse_reflectance"),
+            (r#"{"type": "roughplastic"}"#, "specular_reflectance"),
+            (r#"{"type": "principled"}"#, "base_color"),
+            (r#"{"type": "diffuse"}"#, "reflectance"),
+            (r#"{"type": "roughconductor", "energy_compensation": true}"#, "specular_reflectance"),
+            (r#"{"type": "conductor"}"#, "eta"),
+        ] {
+            assert_eq!(Bsdf::from_json(json).unwrap().tint(name), None, "{json} {name}");
         }
     }
 }

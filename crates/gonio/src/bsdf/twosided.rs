@@ -39,6 +39,11 @@ impl TwoSided {
         TwoSided { front: Box::new(front), back: Box::new(back), mirrored }
     }
 
+    /// The model of both sides, where one nested model is both (the front and the back are equal).
+    pub(crate) fn both_sides(&mut self) -> Option<&mut Bsdf> {
+        self.mirrored.then_some(&mut *self.front)
+    }
+
     /// The models built from the k-th of `count` nested descriptions, to change parameters they read as
     /// they are: one nested model is both sides; of two, the front (k = 0) or the back (k = 1), after
     /// which the sides are run as one only if they are still equal (as [`Self::new`] decides).

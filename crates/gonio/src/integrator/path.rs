@@ -348,6 +348,11 @@ struct Shading<'a> {
     /// The shading frames (s, t, n).
     frame: (V3<Float8>, V3<Float8>, V3<Float8>),
     wo: V3<Float8>,
+    /// The lanes of tinted materials ([`Material::tinted_lanes`](crate::scene::Material::tinted_lanes)),
+    /// whose model's values are scaled by their tints of reflection (`tint[0]`) and transmission (`tint[1]`);
+    /// 1 in the other lanes.
+    tinted: u32,
+    tint: [[Float8; 3]; 2],
 }
 
 impl Shading<'_> {
@@ -366,6 +371,17 @@ impl Shading<'_> {
     fn to_world(&self, v: V3<Float8>) -> V3<Float8> {
         to_world(self.frame.0, self.frame.1, self.frame.2, v)
     }
+
+    /// `values` of the models towards `wi` (local: `f`, or a sample's weight) scaled in tinted lanes by the
+    /// tint of the lobe `wi` lies in (transmission where ωo and ωi are on opposite sides).
+    #[inline(always)]
+    fn tinted(&self, wi: V3<Float8>, values: [Float8; 3]) -> [Float8; 3] {
+        if self.tinted == 0 {
+            return values;
+        }
+        let through = (self.wo.z * wi.z).lt(Float8::splat(0.0));
+        std::array::from_fn(|c| values[c] * Float8::select(through, self.tint[1][c], self.tint[0][c]))
+    }
 }
 
 /// The live lanes' materials at their surfaces in `hit`: diffuse ones are evaluated in lanes, the others by
@@ -376,6 +392,7 @@ fn shading<'a>(scene: &'a Scene, p: &Packet, hit: &Surfaces8) -> Shading<'a> {
     // their material: a constant, checkerboard or bitmap reflectance is found for them together, other
     // materials lane by lane.
     let (mut rho, mut rho_rows, mut diffuse, mut diffuse_rows) = ([Float8::splat(0.0); 3], Rows3::default(), 0u32, 0u32);
+    let (mut tint, mut tinted) = ([[Float8::splat(1.0); 3]; 2], 0u32);
     let mut models: [Option<Cow<'_, Bsdf>>; W] = Default::default();
     let (u, v) = (Float8::load(&hit.uv[0]), Float8::load(&hit.uv[1]));
     // Without a branch per lane (a lane without a hit holds shape 0 or the shape of an earlier hit in it
@@ -394,6 +411,19 @@ fn shading<'a>(scene: &'a Scene, p: &Packet, hit: &Surfaces8) -> Shading<'a> {
             let m = Mask8::from_bitmask(same);
             rho = std::array::from_fn(|c| Float8::select(m, r[c], rho[c]));
             diffuse |= same;
+            continue;
+        }
+        // A textured material whose textures only tint its model: that one model for all its lanes, each
+        // lane's values scaled by its tints (`Shading::tinted`).
+        if let Some((model, tints)) = material.tinted_lanes(u, v, same) {
+            let m = Mask8::from_bitmask(same);
+            for (lobe, t) in tint.iter_mut().zip(tints) {
+                *lobe = std::array::from_fn(|c| Float8::select(m, t[c], lobe[c]));
+            }
+            for lane in bits(same) {
+                models[lane] = Some(Cow::Borrowed(model));
+            }
+            tinted |= same;
             continue;
         }
         for lane in bits(same) {
@@ -437,7 +467,7 @@ fn shading<'a>(scene: &'a Scene, p: &Packet, hit: &Surfaces8) -> Shading<'a> {
     // The lanes whose model has a smooth component: next-event estimation serves them.
     let smooth = diffuse
         | bits(p.live & !diffuse).fold(0, |m, lane| m | (u32::from(models[lane].as_ref().is_some_and(|b| b.flags().has_smooth())) << lane));
-    Shading { rho, diffuse, smooth, models, groups: groups_of, n_groups, frame, wo }
+    Shading { rho, diffuse, smooth, models, groups: groups_of, n_groups, frame, wo, tinted, tint }
 }
 
 /// Next-event estimation on the lanes whose model has a smooth component: `light_samples` times, a light
@@ -677,6 +707,7 @@ fn light_sample(scene: &Scene, p: &mut Packet, hit: &Surfaces8, sh: &Shading<'_>
         let pdf = Float8::select(Mask8::from_bitmask(delta), Float8::splat(0.0), pdf_where(model, wo, wi_local, m));
         bsdf_pdf = Float8::select(m, pdf, bsdf_pdf);
     }
+    let f = sh.tinted(wi_local, f);
     // Shadow rays where the sample carries light.
     let nonzero = (f[0].ne(Float8::splat(0.0)) | f[1].ne(Float8::splat(0.0)) | f[2].ne(Float8::splat(0.0))).bitmask();
     let tested = sampled & nonzero;
@@ -725,6 +756,7 @@ fn sample_bsdf(p: &mut Packet, hit: &Surfaces8, sh: &Shading<'_>) -> (u32, [Floa
         valid |= (s.valid & m).bitmask();
         s_delta |= (s.is_delta() & m).bitmask();
     }
+    let s_weight = sh.tinted(s_wi, s_weight);
     let eta = Float8::load(&p.eta) * s_eta;
     let wi = sh.to_world(s_wi);
     let sp = hit.p.lanes();

@@ -1,7 +1,7 @@
 //! Materials: a BSDF whose parameters may be textures. Evaluated at a hit into a plain [`Bsdf`]; an
 //! untextured material is that `Bsdf` already.
 
-use crate::bsdf::{Bsdf, Diffuse};
+use crate::bsdf::{Bsdf, Diffuse, Tint};
 use crate::error::{Error, Result};
 use crate::geometry::Mesh;
 use crate::math::lanes::Real;
@@ -54,6 +54,9 @@ pub enum Material {
     Slotted {
         model: Bsdf,
         textures: Vec<(Slot, SurfaceTexture, Lookup)>,
+        /// Where every texture is a tint ([`Bsdf::tint`]): the model with the tinted parameters at 1 and
+        /// each texture's lobe, in `textures`' order ([`Material::tinted_lanes`]).
+        tinted: Option<(Bsdf, Vec<Tint>)>,
     },
     /// Any other BSDF with texture parameters: the description without them, and the textures with their
     /// parameter paths. Rebuilt at every hit from a copy of the template (`Props` tracks which parameters
@@ -190,10 +193,38 @@ impl Material {
             })
             .collect();
         if let Some(slots) = slots {
-            let textures = slots.into_iter().zip(textures).map(|(slot, (_, t, lookup))| (slot, t.clone(), *lookup)).collect();
-            return Ok(Material::Slotted { model, textures });
+            let textures: Vec<_> = slots.into_iter().zip(textures).map(|(slot, (_, t, lookup))| (slot, t.clone(), *lookup)).collect();
+            let tinted = Self::tints(&model, &textures);
+            return Ok(Material::Slotted { model, textures, tinted });
         }
         Ok(material)
+    }
+
+    /// The tinted form of a slotted material (see `Material::Slotted`): every texture read as a colour at
+    /// texture coordinates, on a parameter that tints its model ([`Bsdf::tint`]), reached through nothing
+    /// but `twosided`s of one nested model (a blend's component, or one side of two, is not a tint of the
+    /// whole).
+    fn tints(model: &Bsdf, textures: &[(Slot, SurfaceTexture, Lookup)]) -> Option<(Bsdf, Vec<Tint>)> {
+        let mut base = model.clone();
+        let mut lobes = Vec::with_capacity(textures.len());
+        for (slot, texture, lookup) in textures {
+            if *lookup != Lookup::Colour || !matches!(texture, SurfaceTexture::Uv(_)) {
+                return None;
+            }
+            let mut probe = base.clone();
+            let mut leaf = &mut probe;
+            for &step in &slot.route {
+                if step != (0, 1) {
+                    return None;
+                }
+                leaf = leaf.both_sides()?;
+            }
+            lobes.push(leaf.tint(&slot.name)?);
+            if !slot.write(&mut base, &TextureValue::Colour(Rgb::ONE)) {
+                return None;
+            }
+        }
+        Some((base, lobes))
     }
 
     /// The material without slots: `Fixed`, `TexturedDiffuse`, or `Textured` (built again at each hit).
@@ -237,7 +268,7 @@ impl Material {
         Ok(match self {
             Material::Fixed(b) => Cow::Borrowed(b),
             Material::TexturedDiffuse(t) => Cow::Owned(Bsdf::Diffuse(Diffuse::new(Self::texel(t, uv)))),
-            Material::Slotted { model, textures } => {
+            Material::Slotted { model, textures, .. } => {
                 let mut model = model.clone();
                 for (slot, t, lookup) in textures {
                     let value = TextureValue::of(t, *lookup, uv, surface);
@@ -311,13 +342,44 @@ impl Material {
     pub fn diffuse_reflectance_lanes(&self, u: Float8, v: Float8, lanes: u32) -> Option<[Float8; 3]> {
         match self {
             Material::Fixed(Bsdf::Diffuse(d)) => Some(d.reflectance.0.map(Float8::splat)),
-            Material::TexturedDiffuse(Texture::Bitmap(b)) => Some(b.eval_lanes(u, v, lanes).map(|c| Real::clamp(c, 0.0, 1.0))),
-            Material::TexturedDiffuse(Texture::Checkerboard(c)) => {
+            Material::TexturedDiffuse(t) => Some(Self::texels(t, u, v, lanes)),
+            _ => None,
+        }
+    }
+
+    /// For a material whose every texture is a tint (see `Material::Slotted`): the one model its lanes run,
+    /// and each lane's tints at texture coordinates (`u`, `v`) of the lanes set in `lanes` (the others
+    /// unspecified) — of reflection and of transmission, 1 where no texture tints the lobe — which scale
+    /// that model's values per lane to the values of [`Self::at`]'s model (to rounding: the model multiplies
+    /// its tint in its own order). `None` for other materials.
+    #[inline]
+    #[must_use]
+    pub fn tinted_lanes(&self, u: Float8, v: Float8, lanes: u32) -> Option<(&Bsdf, [[Float8; 3]; 2])> {
+        let Material::Slotted { textures, tinted: Some((model, lobes)), .. } = self else { return None };
+        let mut tints = [[Float8::splat(1.0); 3]; 2];
+        for ((_, texture, _), lobe) in textures.iter().zip(lobes) {
+            let SurfaceTexture::Uv(t) = texture else { return None };
+            let tint = &mut tints[match lobe {
+                Tint::Reflection => 0,
+                Tint::Transmission => 1,
+            }];
+            let c = Self::texels(t, u, v, lanes);
+            *tint = std::array::from_fn(|i| tint[i] * c[i]);
+        }
+        Some((model, tints))
+    }
+
+    /// A texture's colours at (`u`, `v`) in lanes as reflectances (clamped to [0, 1]; [`Self::texel`] in
+    /// each lane).
+    #[inline]
+    fn texels(t: &Texture, u: Float8, v: Float8, lanes: u32) -> [Float8; 3] {
+        match t {
+            Texture::Bitmap(b) => b.eval_lanes(u, v, lanes).map(|c| Real::clamp(c, 0.0, 1.0)),
+            Texture::Checkerboard(c) => {
                 let first = c.same_side_lanes(u, v);
                 let (c0, c1) = (Self::clamped(c.color0), Self::clamped(c.color1));
-                Some(std::array::from_fn(|i| Float8::select(first, Float8::splat(c0.0[i]), Float8::splat(c1.0[i]))))
+                std::array::from_fn(|i| Float8::select(first, Float8::splat(c0.0[i]), Float8::splat(c1.0[i])))
             }
-            _ => None,
         }
     }
 
