@@ -23,7 +23,7 @@ use super::{Bounds3, PrimHit, Ray};
 use crate::math::frame::{tangents, tangents_along};
 use crate::math::lanes::{Real, V3};
 use crate::math::simd::Float8;
-use crate::math::trig::sin_cos_turn;
+use crate::math::trig::{atan2, sin_cos_turn};
 use crate::math::{Frame, Transform};
 use crate::sampling::warp::{sample_uniform_sphere, uniform_sphere};
 use glam::{Vec2, Vec3};
@@ -83,15 +83,16 @@ impl Sphere {
     }
 
     /// The texture coordinates at the point with outward normal `outward`: Mitsuba's parametrisation,
-    /// u = φ / 2π, v = θ / π in object space.
+    /// u = φ / 2π, v = θ / π in object space, the angles by [`atan2`] (θ = atan2(√(x² + y²), z), which
+    /// keeps its precision at the poles, where acos z of an `f32` does not).
     #[must_use]
     pub fn uv_at(&self, outward: Vec3) -> Vec2 {
         let local = self.to_object.vector(outward).normalize();
-        let mut phi = local.y.atan2(local.x);
+        let mut phi = atan2(local.y, local.x);
         if phi < 0.0 {
             phi += 2.0 * PI;
         }
-        Vec2::new(phi / (2.0 * PI), local.z.clamp(-1.0, 1.0).acos() / PI)
+        Vec2::new(phi / (2.0 * PI), atan2((local.x * local.x + local.y * local.y).sqrt(), local.z) / PI)
     }
 
     /// ∂p/∂u and ∂p/∂v at the surface point `p` for u = φ/2π, v = θ/π in object space: 2π (−y, x, 0) and

@@ -31,8 +31,8 @@
 //!
 //! ## Lanes
 //! [`EnvMap::sample_lanes`] and [`EnvMap::eval_lanes`] are the light, written once over a
-//! [`Real`] type: the table reads (the alias table, the texels, and `atan2`/`acos` of a direction)
-//! loop over the lanes, everything else runs in lanes. The scalar [`EnvMap::sample_li`],
+//! [`Real`] type: the table reads (the alias table, the texels) loop over the lanes, everything else
+//! (a direction's angles too, by [`trig::atan2`]) runs in lanes. The scalar [`EnvMap::sample_li`],
 //! [`EnvMap::radiance`] and [`EnvMap::pdf_li`] are those functions at `f32`; the path tracer runs them on
 //! eight lanes.
 
@@ -42,7 +42,7 @@ use crate::geometry::ray::spawn_ray;
 use crate::geometry::Ray;
 use crate::image::{read_image, Image};
 use crate::math::lanes::{Real, V3};
-use crate::math::trig::sin_cos_turn;
+use crate::math::trig::{self, sin_cos_turn};
 use crate::math::Transform;
 use crate::props::Props;
 use crate::sampling::alias::AliasTable;
@@ -151,11 +151,20 @@ impl EnvMap {
     /// Map-space direction → (u, v) ∈ [0, 1)² × [0, 1] (module docs). θ is atan2(sin θ, cos θ), which keeps
     /// its precision near the poles, where acos(d_y) of an `f32` resolves θ only to √(2 · 2⁻²⁴) ≈ 3.5e-4 rad
     /// (2026-12: a sample a thousandth of a row from the pole came back in the next cell).
+    /// In lanes by [`trig::atan2`] (within 3·10⁻⁷ rad of the exact angle).
     #[inline]
     fn direction_to_uv(d: Vec3) -> Vec2 {
-        let u = d.x.atan2(-d.z) * (0.5 / PI);
-        let v = (d.x * d.x + d.z * d.z).sqrt().atan2(d.y) / PI;
-        Vec2::new(u - u.floor(), v)
+        let (u, v) = EnvMap::direction_to_uv_lanes(V3::<f32>::from(d));
+        Vec2::new(u, v)
+    }
+
+    /// [`Self::direction_to_uv`] in lanes.
+    #[inline(always)]
+    fn direction_to_uv_lanes<R: Real>(d: V3<R>) -> (R, R) {
+        let u = trig::atan2(d.x, -d.z) * (0.5 / PI);
+        let v = trig::atan2((d.x * d.x + d.z * d.z).sqrt(), d.y) * (1.0 / PI);
+        // u − ⌊u⌋ for u ∈ [−½, ½]: the negative half turned up by one.
+        (R::select(u.lt(R::splat(0.0)), u + R::splat(1.0), u), v)
     }
 
     /// (u, v) → map-space unit direction, and sin θ: θ = π v and φ = 2π u, by [`sin_cos_turn`] (in turns,
@@ -256,12 +265,13 @@ impl EnvMap {
         let zero = R::splat(0.0);
         let d = V3::select(length.gt(zero), d.div(length), V3::new(zero, zero, zero));
         let sin_theta = (d.x * d.x + d.z * d.z).sqrt();
-        // (u, v) by atan2 lane by lane, with the grid cell and its density.
-        let (dx, dy, dz) = (numbers(d.x), numbers(d.y), numbers(d.z));
+        // (u, v) in lanes, then the grid cell and its density lane by lane.
+        let (u, v) = EnvMap::direction_to_uv_lanes(d);
+        let (u, v) = (numbers(u), numbers(v));
         let (mut cells, mut fx, mut fy, mut density) =
             (([0u32; MAX_LANES], [0u32; MAX_LANES]), [0.0; MAX_LANES], [0.0; MAX_LANES], [0.0; MAX_LANES]);
         for i in (0..R::LANES).filter(|i| lanes >> i & 1 != 0) {
-            let (x, y, fxi, fyi) = self.grid_point(EnvMap::direction_to_uv(Vec3::new(dx[i], dy[i], dz[i])));
+            let (x, y, fxi, fyi) = self.grid_point(Vec2::new(u[i], v[i]));
             (cells.0[i], cells.1[i], fx[i], fy[i]) = (x, y, fxi, fyi);
             density[i] = self.cell_density(x, y);
         }

@@ -1,6 +1,7 @@
 //! Short polynomial sine and cosine for arguments in [−π/4, π/4], for inner loops (the concentric disk
 //! map, visible-normal sampling) where a general `sin_cos` call with its range reduction dominates, and
-//! which must run in SIMD lanes ([`Real`]).
+//! which must run in SIMD lanes ([`Real`]); and `atan2` in lanes (direction → texture coordinates of
+//! environment maps and spheres), where libm's runs one lane at a time.
 
 use crate::math::lanes::Real;
 
@@ -47,6 +48,33 @@ pub fn sin_cos_turn<R: Real>(t: R) -> (R, R) {
     (R::select(flip, -s, s), R::select(flip, -c, c))
 }
 
+/// atan2(y, x) ∈ [−π, π] for finite `y`, `x`, branch-free so that it runs in lanes. The octant is
+/// reduced to a = min(|x|, |y|) / max(|x|, |y|) ∈ [0, 1] (0 where both are 0), then to
+/// |a′| ≤ tan(π/8) by atan a = π/4 + atan a′, a′ = (a − 1)/(a + 1), for a > tan(π/8); there
+/// atan a′ ≈ a′ + a′³ P(a′²) with the cubic P of Cephes' `atanf` (S. L. Moshier, Cephes Math Library
+/// 2.2, atanf.c: relative error 1.9·10⁻⁷ peak on that interval). The octant is then undone: π/2 − r where
+/// |y| > |x|, π − r where x < 0, and y's sign. Within 3·10⁻⁷ of the exact value (test `atan2_matches_f64`:
+/// 2.7·10⁻⁷ at worst, 1.2 ulp of π), against libm's correctly rounded `atan2f` one lane at a time.
+/// Unlike libm, atan2(±0, −0) is ±0 (the zero vector's angle is undefined either way).
+#[inline(always)]
+#[must_use]
+pub fn atan2<R: Real>(y: R, x: R) -> R {
+    use std::f32::consts::{FRAC_PI_2, FRAC_PI_4, PI};
+    const P: [f32; 4] = [-3.333_294_9e-1, 1.997_771_1e-1, -1.387_768_6e-1, 8.053_744_5e-2];
+    let (zero, one) = (R::splat(0.0), R::splat(1.0));
+    let (ax, ay) = (x.abs(), y.abs());
+    let (lo, hi) = (ax.min(ay), ax.max(ay));
+    let a = R::select(hi.gt(zero), lo / hi, zero);
+    let reduced = a.gt(R::splat(0.414_213_57));
+    let a = R::select(reduced, (a - one) / (a + one), a);
+    let z = a * a;
+    let poly = P.iter().rev().skip(1).fold(R::splat(P[3]), |p, &k| z.mad(p, R::splat(k)));
+    let r = (a * z).mad(poly, a) + R::select(reduced, R::splat(FRAC_PI_4), zero);
+    let r = R::select(ay.gt(ax), R::splat(FRAC_PI_2) - r, r);
+    let r = R::select(x.lt(zero), R::splat(PI) - r, r);
+    r.xor_sign(y)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -81,5 +109,36 @@ mod tests {
             assert!((f64::from(s) - ws).abs() <= 2.0 * ulp(ws), "sin({x}) = {s}, want {ws}");
             assert!((f64::from(c) - wc).abs() <= 2.0 * ulp(wc), "cos({x}) = {c}, want {wc}");
         }
+    }
+
+    /// Over directions all round the circle (and near the axes and diagonals, where the octant reduction
+    /// switches), at radii from 10⁻³⁰ to 10³⁰: within 3·10⁻⁷ of the f64 atan2, the same in eight lanes bit
+    /// for bit, and the axes exact.
+    #[test]
+    fn atan2_matches_f64() {
+        let n = 100_000;
+        let mut worst = 0.0f64;
+        for i in 0..=n {
+            let t = f64::from(i) / f64::from(n) * std::f64::consts::TAU - std::f64::consts::PI;
+            for (k, radius) in [1e-30f64, 1e-3, 1.0, 7.5, 1e30].into_iter().enumerate() {
+                let t = t + 1e-7 * k as f64;
+                let (y, x) = ((t.sin() * radius) as f32, (t.cos() * radius) as f32);
+                let got = atan2(y, x);
+                let lanes = atan2(crate::math::lanes::F32x8::splat(y), crate::math::lanes::F32x8::splat(x));
+                assert!(lanes.0.iter().all(|v| v.to_bits() == got.to_bits()), "lanes at ({y}, {x})");
+                let want = f64::from(y).atan2(f64::from(x));
+                let err = (f64::from(got) - want).abs();
+                // ±π are the same angle.
+                let err = err.min((err - std::f64::consts::TAU).abs());
+                worst = worst.max(err);
+                assert!(err <= 3e-7, "atan2({y}, {x}) = {got}, want {want}");
+            }
+        }
+        for (y, x, want) in [(0.0f32, 1.0f32, 0.0f32), (1.0, 0.0, std::f32::consts::FRAC_PI_2), (-1.0, 0.0, -std::f32::consts::FRAC_PI_2)] {
+            assert_eq!(atan2(y, x), want);
+        }
+        assert_eq!(atan2(0.0f32, -1.0).abs(), std::f32::consts::PI);
+        assert_eq!(atan2(0.0f32, 0.0), 0.0);
+        assert!(worst > 1e-8, "the test compares something: worst {worst}");
     }
 }
