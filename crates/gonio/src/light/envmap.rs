@@ -148,17 +148,17 @@ impl EnvMap {
         EnvMap::new(&image, scale, to_world, p.at())
     }
 
-    /// Map-space direction → (u, v) ∈ [0, 1)² × [0, 1] (module docs). θ is atan2(sin θ, cos θ), which keeps
-    /// its precision near the poles, where acos(d_y) of an `f32` resolves θ only to √(2 · 2⁻²⁴) ≈ 3.5e-4 rad
-    /// (2026-12: a sample a thousandth of a row from the pole came back in the next cell).
-    /// In lanes by [`trig::atan2`] (within 3·10⁻⁷ rad of the exact angle).
-    #[inline]
+    /// [`Self::direction_to_uv_lanes`] of one direction, for the tests.
+    #[cfg(test)]
     fn direction_to_uv(d: Vec3) -> Vec2 {
         let (u, v) = EnvMap::direction_to_uv_lanes(V3::<f32>::from(d));
         Vec2::new(u, v)
     }
 
-    /// [`Self::direction_to_uv`] in lanes.
+    /// Map-space directions → (u, v) ∈ [0, 1)² × [0, 1] (module docs), in lanes by [`trig::atan2`] (within
+    /// 3·10⁻⁷ rad of the exact angles). θ is atan2(sin θ, cos θ), which keeps its precision near the
+    /// poles, where acos(d_y) of an `f32` resolves θ only to √(2 · 2⁻²⁴) ≈ 3.5e-4 rad (2026-12: a sample a
+    /// thousandth of a row from the pole came back in the next cell).
     #[inline(always)]
     fn direction_to_uv_lanes<R: Real>(d: V3<R>) -> (R, R) {
         let u = trig::atan2(d.x, -d.z) * (0.5 / PI);
