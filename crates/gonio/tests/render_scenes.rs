@@ -514,6 +514,23 @@ fn filters_blur_an_edge_by_their_weights() {
     }
 }
 
+/// Spheres of radius 0.5 with the models `bsdfs` (`<bsdf>` elements), `per_row` to a row 1.1 apart, the
+/// rows 1.1 apart, centred on x = 0 and y = 0 for two rows, at z = 0.
+fn spheres_in_rows(bsdfs: &[impl AsRef<str>], per_row: usize) -> String {
+    let left = (per_row - 1) as f32 * 0.55;
+    bsdfs
+        .iter()
+        .enumerate()
+        .map(|(i, bsdf)| {
+            let (x, y) = ((i % per_row) as f32 * 1.1 - left, (i / per_row) as f32 * 1.1 - 0.55);
+            format!(
+                r#"<shape type="sphere"><point name="center" x="{x}" y="{y}" z="0"/><float name="radius" value="0.5"/>{}</shape>"#,
+                bsdf.as_ref()
+            )
+        })
+        .collect()
+}
+
 /// `direct` renders through the path tracer's packets at max_depth 2 (`integrator::radiance`), with any
 /// numbers of light and BSDF samples; the scalar `direct` integrator (`integrator::direct_each`) is its
 /// reference: every camera sample's radiance the same bit for bit, over every light type, smooth, glossy,
@@ -535,14 +552,7 @@ fn direct_is_the_path_tracer_at_depth_two() {
         r#"<bsdf type="twosided"><bsdf type="blendbsdf"><float name="weight" value="0.3"/><bsdf type="diffuse"/><bsdf type="roughconductor"/></bsdf></bsdf>"#,
         r#"<bsdf type="mask"><float name="opacity" value="0.5"/><bsdf type="oren_nayar"/></bsdf>"#,
     ];
-    let shapes: String = spheres
-        .iter()
-        .enumerate()
-        .map(|(i, bsdf)| {
-            let (x, y) = ((i % 5) as f32 * 1.1 - 2.2, (i / 5) as f32 * 1.1 - 0.55);
-            format!(r#"<shape type="sphere"><point name="center" x="{x}" y="{y}" z="0"/><float name="radius" value="0.5"/>{bsdf}</shape>"#)
-        })
-        .collect();
+    let shapes = spheres_in_rows(&spheres, 5);
     // A mesh light from a file whose flat vertex normals oppose its winding: it emits on their side, in
     // lanes as for one ray.
     let obj = std::env::temp_dir().join(format!("gonio-test-direct-{}.obj", std::process::id()));
@@ -624,14 +634,7 @@ fn tinted_textures_in_packets_are_the_textured_models() {
             checker("specular_reflectance", "0.9, 0.9, 0.2", "0.2, 0.5, 0.9")
         ),
     ];
-    let shapes: String = spheres
-        .iter()
-        .enumerate()
-        .map(|(i, bsdf)| {
-            let (x, y) = ((i % 3) as f32 * 1.1 - 1.1, (i / 3) as f32 * 1.1 - 0.55);
-            format!(r#"<shape type="sphere"><point name="center" x="{x}" y="{y}" z="0"/><float name="radius" value="0.5"/>{bsdf}</shape>"#)
-        })
-        .collect();
+    let shapes = spheres_in_rows(&spheres, 3);
     let xml = format!(
         r#"<scene version="3.0.0"><integrator type="direct"><integer name="emitter_samples" value="2"/><integer name="bsdf_samples" value="2"/></integrator>{sensor}
         {shapes}

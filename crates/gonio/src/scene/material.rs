@@ -272,7 +272,7 @@ impl Material {
                 let mut model = model.clone();
                 for (slot, t, lookup) in textures {
                     let value = TextureValue::of(t, *lookup, uv, surface);
-                    // A value in range is clamped into it (`Slot::write`); one that is not a number fails
+                    // A value out of range is clamped into it (`Slot::write`); one that is not a number fails
                     // as it would in the rebuilt model.
                     if !value.is_finite() {
                         return Err(Error::spec("", format!("texture value of `{}` is not a finite number", slot.name)));
