@@ -60,7 +60,9 @@ pub fn sin_cos_turn<R: Real>(t: R) -> (R, R) {
 #[must_use]
 pub fn atan2<R: Real>(y: R, x: R) -> R {
     use std::f32::consts::{FRAC_PI_2, FRAC_PI_4, PI};
-    const P: [f32; 4] = [-3.333_294_9e-1, 1.997_771_1e-1, -1.387_768_6e-1, 8.053_744_5e-2];
+    // Cephes' coefficients (−3.33329491539e−1, 1.99777106478e−1, −1.38776856032e−1, 8.05374449538e−2) as
+    // `f32`s.
+    const P: [f32; 4] = [-0.333_329_5, 0.199_777_11, -0.138_776_85, 0.080_537_446];
     let (zero, one) = (R::splat(0.0), R::splat(1.0));
     let (ax, ay) = (x.abs(), y.abs());
     let (lo, hi) = (ax.min(ay), ax.max(ay));
