@@ -211,8 +211,7 @@ impl Material {
             if *lookup != Lookup::Colour || !matches!(texture, SurfaceTexture::Uv(_)) {
                 return None;
             }
-            let mut probe = base.clone();
-            let mut leaf = &mut probe;
+            let mut leaf = &mut base;
             for &step in &slot.route {
                 if step != (0, 1) {
                     return None;
