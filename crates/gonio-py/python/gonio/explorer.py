@@ -12,6 +12,7 @@ the same numbers. No server, no port.
 
 from __future__ import annotations
 
+import functools
 import json
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
@@ -20,16 +21,6 @@ from urllib.parse import urlencode
 
 from . import _gonio
 
-try:
-    import anywidget
-    import traitlets
-except ImportError as _e:  # pragma: no cover - anywidget is an optional dependency
-    anywidget = None
-    _IMPORT_ERROR: Optional[ImportError] = _e
-else:
-    _IMPORT_ERROR = None
-
-_JS, _CSS = _gonio._explorer_page()
 _COLOURS = ["#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf"]
 
 
@@ -45,14 +36,23 @@ def _spec_text(model: Any) -> str:
     return model
 
 
-if anywidget is not None:
+@functools.lru_cache(maxsize=None)
+def _widget_class() -> type:
+    """The widget's class, defined on first use: anywidget brings in ipywidgets and IPython (~0.15 s), which
+    ``import gonio`` should not pay for. Raises ImportError naming the package when anywidget is missing."""
+    try:
+        import anywidget
+        import traitlets
+    except ImportError as e:
+        raise ImportError("gonio.explore needs anywidget: pip install anywidget") from e
+    js, css = _gonio._explorer_page()
 
     class ExplorerWidget(anywidget.AnyWidget):
         """The explorer in a notebook. ``state`` is the page's state (JSON: the models, their colours, the
         view), ``spec`` the selected model's JSON; ``bsdf`` builds it. ``request`` asks what the page asks."""
 
-        _esm = _JS
-        _css = _CSS
+        _esm = js
+        _css = css
         state = traitlets.Unicode("").tag(sync=True)
         spec = traitlets.Unicode("").tag(sync=True)
 
@@ -94,9 +94,11 @@ if anywidget is not None:
             else:
                 self._pool.submit(self._answer, content)
 
+    return ExplorerWidget
+
 
 def explore(*models: Any, data: Optional[Union[str, Path]] = None, environment: Optional[Union[str, Path]] = None,
-            threads: int = 2) -> "ExplorerWidget":
+            threads: int = 2) -> Any:
     """Look at models in a notebook: polar and 3-D lobes, the θh × θd slice, the albedo and white furnace,
     a path-traced lit sphere and the verification verdict, updating as the sliders move.
 
@@ -105,6 +107,4 @@ def explore(*models: Any, data: Optional[Union[str, Path]] = None, environment: 
     map for the lit sphere (else the built-in sky). Returns the widget; ``widget.bsdf`` is the selected
     model as edited. Needs ``anywidget`` (``pip install anywidget``).
     """
-    if anywidget is None:
-        raise ImportError("gonio.explore needs anywidget: pip install anywidget") from _IMPORT_ERROR
-    return ExplorerWidget(models, data=data, environment=environment, threads=threads)
+    return _widget_class()(models, data=data, environment=environment, threads=threads)
