@@ -598,14 +598,16 @@ fn direct_is_the_path_tracer_at_depth_two() {
 }
 
 /// A textured material whose textures only tint its model (a conductor's `specular_reflectance`, a
-/// dielectric's `specular_reflectance` and `specular_transmittance`, also inside a `twosided`) runs one
-/// model for all its lanes in the packets and scales each lane's values by its texels
-/// (`Material::tinted_lanes`). The scalar `direct` integrator, which builds each hit's model with the texel
-/// written into it, is its reference: every camera sample's radiance the same to rounding (the model
-/// multiplies its tint in its own order, so not bit for bit), with paths through both lobes of the
-/// dielectrics and through a tinted material seen through another.
+/// dielectric's `specular_reflectance` and `specular_transmittance`, also inside a `twosided`) or set its
+/// roughness (`alpha`, `alpha_u`, `alpha_v` of the rough conductors and dielectric, GGX and Beckmann)
+/// runs one model — or one kernel with each lane's roughness — for all its lanes in the packets and scales
+/// each lane's values by its texels (`Material::lanes_at`). The scalar `direct` integrator, which builds
+/// each hit's model with the texel written into it, is its reference: every camera sample's radiance the
+/// same to rounding (the model multiplies its tint in its own order, so not bit for bit), with paths
+/// through both lobes of the dielectrics, through a tinted material seen through another, and roughness
+/// texels of 0 (clamped to 10⁻⁴ in both).
 #[test]
-fn tinted_textures_in_packets_are_the_textured_models() {
+fn tinted_and_rough_textures_in_packets_are_the_textured_models() {
     use gonio::integrator::{direct_each, radiance, CameraSample};
     let checker = |name: &str, c0: &str, c1: &str| {
         format!(
@@ -633,8 +635,20 @@ fn tinted_textures_in_packets_are_the_textured_models() {
             r#"<bsdf type="twosided"><bsdf type="roughconductor"><float name="alpha" value="0.3"/>{}</bsdf></bsdf>"#,
             checker("specular_reflectance", "0.9, 0.9, 0.2", "0.2, 0.5, 0.9")
         ),
+        format!(r#"<bsdf type="roughconductor"><string name="distribution" value="ggx"/>{}</bsdf>"#, checker("alpha", "0.05", "0.5")),
+        format!(
+            r#"<bsdf type="roughconductor"><float name="alpha_v" value="0.3"/>{}{}</bsdf>"#,
+            checker("alpha_u", "0.02", "0.6"),
+            checker("specular_reflectance", "1, 0.5, 0.2", "0.3, 0.3, 0.9")
+        ),
+        format!(r#"<bsdf type="roughdielectric">{}</bsdf>"#, checker("alpha", "0", "0.3")),
+        format!(
+            r#"<bsdf type="roughdielectric"><string name="distribution" value="ggx"/>{}{}</bsdf>"#,
+            checker("alpha_u", "0.1", "0.5"),
+            checker("alpha_v", "0.4", "0.05")
+        ),
     ];
-    let shapes = spheres_in_rows(&spheres, 3);
+    let shapes = spheres_in_rows(&spheres, 4);
     let xml = format!(
         r#"<scene version="3.0.0"><integrator type="direct"><integer name="emitter_samples" value="2"/><integer name="bsdf_samples" value="2"/></integrator>{sensor}
         {shapes}
@@ -648,12 +662,10 @@ fn tinted_textures_in_packets_are_the_textured_models() {
         floor = checker("reflectance", "0.8, 0.8, 0.8", "0.2, 0.2, 0.2"),
     );
     let s = scene(&xml);
-    let tinted = s
-        .materials
-        .iter()
-        .filter(|m| m.tinted_lanes(gonio::math::simd::Float8::splat(0.5), gonio::math::simd::Float8::splat(0.5), 1).is_some())
-        .count();
-    assert_eq!(tinted, spheres.len(), "every sphere's material is in the tinted form");
+    let half = gonio::math::simd::Float8::splat(0.5);
+    let in_lanes: Vec<_> = s.materials.iter().filter_map(|m| m.lanes_at(half, half, 1)).collect();
+    assert_eq!(in_lanes.len(), spheres.len(), "every sphere's material is in the lane form");
+    assert_eq!(in_lanes.iter().filter(|m| m.kernel.is_some()).count(), 4, "the rough ones with a roughness per lane");
     let samples: Vec<CameraSample> =
         (0..32).flat_map(|y| (0..32).flat_map(move |x| (0..4).map(move |k| CameraSample { x, y, k }))).collect();
     let (mut packets, mut each) = (vec![gonio::spectrum::Rgb::ZERO; samples.len()], vec![gonio::spectrum::Rgb::ZERO; samples.len()]);

@@ -23,13 +23,14 @@ use super::dielectric::Dielectric;
 use super::plastic::Plastic;
 use super::polarizer::Polarizer;
 use super::principled::PrincipledLobes;
-use super::rough_conductor::ConductorKernel;
-use super::rough_dielectric::DielectricKernel;
+use super::rough_conductor::{ConductorKernel, ConductorLobe};
+use super::rough_dielectric::{DielectricKernel, DielectricLobe};
 use super::rough_plastic::PlasticKernel;
 use super::thin_dielectric::ThinDielectric;
 use super::{Bsdf, BsdfFlags, BsdfSample, SampleColumns};
 use crate::math::lanes::{channels, F32x8, Real, Rows, V3};
 use crate::math::{Vec2, Vec3};
+use crate::microfacet::{Beckmann, Ggx, PerLane};
 use crate::spectrum::Rgb;
 
 /// One sampled row per lane: the fields of [`BsdfSample`] as lanes, and which lanes hold a sample.
@@ -160,6 +161,51 @@ pub enum LaneKernel<'a> {
     Plastic(&'a Plastic),
     Polarizer(&'a Polarizer),
     Principled(PrincipledLobes),
+}
+
+/// The kernel of a microfacet model whose roughness is given per lane ([`Bsdf::per_lane_kernel`]): a
+/// textured roughness in the path tracer's packets runs one kernel call for all its lanes, each lane with
+/// its own α, instead of a model and a call per lane. The same lobes as the models' own kernels, over a
+/// distribution holding a [`PerLane`] roughness. Read in at most [`crate::microfacet::PER_LANE`] lanes.
+#[derive(Clone, Copy, Debug)]
+pub enum PerLaneKernel {
+    ConductorGgx(ConductorLobe<Ggx<PerLane>>),
+    ConductorBeckmann(ConductorLobe<Beckmann<PerLane>>),
+    DielectricGgx(DielectricLobe<Ggx<PerLane>>),
+    DielectricBeckmann(DielectricLobe<Beckmann<PerLane>>),
+}
+
+/// Not inlined, as [`LaneKernel`]'s (one copy for the packets' lane type).
+impl LaneModel for PerLaneKernel {
+    #[inline(never)]
+    fn f_lanes<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> [R; 3] {
+        match self {
+            PerLaneKernel::ConductorGgx(k) => k.f_lanes(wo, wi),
+            PerLaneKernel::ConductorBeckmann(k) => k.f_lanes(wo, wi),
+            PerLaneKernel::DielectricGgx(k) => k.f_lanes(wo, wi),
+            PerLaneKernel::DielectricBeckmann(k) => k.f_lanes(wo, wi),
+        }
+    }
+
+    #[inline(never)]
+    fn pdf_lanes<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> R {
+        match self {
+            PerLaneKernel::ConductorGgx(k) => k.pdf_lanes(wo, wi),
+            PerLaneKernel::ConductorBeckmann(k) => k.pdf_lanes(wo, wi),
+            PerLaneKernel::DielectricGgx(k) => k.pdf_lanes(wo, wi),
+            PerLaneKernel::DielectricBeckmann(k) => k.pdf_lanes(wo, wi),
+        }
+    }
+
+    #[inline(never)]
+    fn sample_lanes<R: Real>(&self, wo: V3<R>, uc: R, ux: R, uy: R) -> LaneSample<R> {
+        match self {
+            PerLaneKernel::ConductorGgx(k) => k.sample_lanes(wo, uc, ux, uy),
+            PerLaneKernel::ConductorBeckmann(k) => k.sample_lanes(wo, uc, ux, uy),
+            PerLaneKernel::DielectricGgx(k) => k.sample_lanes(wo, uc, ux, uy),
+            PerLaneKernel::DielectricBeckmann(k) => k.sample_lanes(wo, uc, ux, uy),
+        }
+    }
 }
 
 impl Bsdf {

@@ -308,8 +308,10 @@ pub mod twosided;
 
 use crate::error::{Error, Result};
 use crate::math::{Vec2, Vec3};
+use crate::microfacet::{PerLane, PER_LANE};
 use crate::props::Props;
 use crate::spectrum::Rgb;
+use rough_conductor::textured_roughness;
 
 pub use ashikhmin_shirley::AshikhminShirley;
 pub use blend::BlendBsdf;
@@ -317,7 +319,7 @@ pub use blinn_phong::BlinnPhong;
 pub use conductor::Conductor;
 pub use dielectric::Dielectric;
 pub use diffuse::Diffuse;
-pub use lanes::RowCheck;
+pub use lanes::{PerLaneKernel, RowCheck};
 pub use layered::Layered;
 pub use mask::Mask;
 pub use measured::Measured;
@@ -822,7 +824,6 @@ impl Bsdf {
     /// (`Props::set_texture_value`). `false` (the model unchanged) otherwise. The float counterpart of
     /// [`Self::reflectance_slot`].
     pub fn set_float(&mut self, name: &str, value: f32) -> bool {
-        use rough_conductor::{ALPHA_MAX, ALPHA_MIN};
         match (self, name) {
             (Bsdf::Blend(b), "weight") => {
                 b.set_weight(value.clamp(0.0, 1.0));
@@ -830,12 +831,39 @@ impl Bsdf {
             }
             (Bsdf::Principled(p), name) => p.set_unit_float(name, value.clamp(0.0, 1.0)),
             (Bsdf::RoughConductor(RoughConductor(c)) | Bsdf::TorranceSparrow(TorranceSparrow(c)), name) if c.compensation.is_none() => {
-                c.distribution.set_roughness(name, value.clamp(ALPHA_MIN, ALPHA_MAX))
+                c.distribution.set_roughness(name, textured_roughness(value))
             }
-            (Bsdf::RoughDielectric(d), name) if d.compensation.is_none() => {
-                d.distribution.set_roughness(name, value.clamp(ALPHA_MIN, ALPHA_MAX))
-            }
+            (Bsdf::RoughDielectric(d), name) if d.compensation.is_none() => d.distribution.set_roughness(name, textured_roughness(value)),
             _ => false,
+        }
+    }
+
+    /// This model's kernel with its roughness parameters in `values` given per lane of a packet (name and
+    /// each lane's value, as [`Self::set_float`] takes them and clamped as it clamps them; the others the
+    /// model's own): what each lane's model with those values written by [`Self::set_float`] computes, in
+    /// one kernel call for all lanes. For the models whose roughness [`Self::set_float`] sets — except
+    /// Blinn's, whose exponent is one number — and for no other parameter; `None` otherwise.
+    pub fn per_lane_kernel<'a>(&self, values: impl IntoIterator<Item = (&'a str, [f32; PER_LANE])>) -> Option<PerLaneKernel> {
+        let distribution = match self {
+            Bsdf::RoughConductor(RoughConductor(c)) | Bsdf::TorranceSparrow(TorranceSparrow(c)) => &c.distribution,
+            Bsdf::RoughDielectric(d) => &d.distribution,
+            _ => return None,
+        };
+        let (mut ax, mut ay) = ([distribution.alpha_x; PER_LANE], [distribution.alpha_y; PER_LANE]);
+        for (name, v) in values {
+            let (x, y) = distribution.roughness_axes(name)?;
+            let v = v.map(textured_roughness);
+            if x {
+                ax = v;
+            }
+            if y {
+                ay = v;
+            }
+        }
+        match self {
+            Bsdf::RoughConductor(RoughConductor(c)) | Bsdf::TorranceSparrow(TorranceSparrow(c)) => c.per_lane(PerLane(ax), PerLane(ay)),
+            Bsdf::RoughDielectric(d) => d.per_lane(PerLane(ax), PerLane(ay)),
+            _ => None,
         }
     }
 
@@ -1078,6 +1106,89 @@ mod tests {
                     "{spec}: sample at {k}"
                 );
             }
+        }
+    }
+
+    /// A kernel with a roughness per lane ([`Bsdf::per_lane_kernel`]) gives in each lane what that lane's
+    /// model — the roughness written into it with [`Bsdf::set_float`], clamped alike — gives in its single
+    /// calls, bit for bit: `f`, `pdf` and `sample` in the path tracer's lanes, for GGX and Beckmann,
+    /// conductors and the dielectric, each roughness parameter, over roughnesses from 0 (clamped to 10⁻⁴)
+    /// to beyond 10, every lane a different one. Models and parameters it does not cover have none.
+    #[test]
+    fn per_lane_roughness_is_each_lanes_model() {
+        use crate::math::lanes::{Real, V3};
+        use crate::math::simd::Float8;
+        use lanes::LaneModel;
+        let cases = [
+            (r#"{"type": "roughconductor"}"#, "alpha"),
+            (r#"{"type": "roughconductor", "distribution": "ggx", "material": "Cu"}"#, "alpha"),
+            (r#"{"type": "roughconductor", "alpha_v": 0.3}"#, "alpha_u"),
+            (r#"{"type": "roughconductor", "distribution": "ggx", "alpha_u": 0.05}"#, "alpha_v"),
+            (r#"{"type": "roughconductor", "sample_visible": false}"#, "alpha"),
+            (r#"{"type": "torrance_sparrow", "distribution": "beckmann"}"#, "alpha"),
+            (r#"{"type": "roughdielectric"}"#, "alpha"),
+            (r#"{"type": "roughdielectric", "distribution": "ggx", "int_ior": 1.33}"#, "alpha"),
+            (r#"{"type": "roughdielectric", "distribution": "ggx", "alpha_v": 0.2}"#, "alpha_u"),
+        ];
+        let mut rng = Pcg32::new(17, 0);
+        let dir = |rng: &mut Pcg32| {
+            let v = Vec3::new(2.0 * rng.next_f32() - 1.0, 2.0 * rng.next_f32() - 1.0, 2.0 * rng.next_f32() - 1.0);
+            v.try_normalize().unwrap_or(Vec3::Z)
+        };
+        for (json, name) in cases {
+            let model = Bsdf::from_json(json).unwrap();
+            let mut sampled = 0;
+            for _ in 0..400 {
+                // Roughness from 0 to 10^1.2 (log-uniform), and the ends beyond the range.
+                let alphas: [f32; PER_LANE] = std::array::from_fn(|_| match rng.next_f32() {
+                    u if u < 0.1 => 0.0,
+                    u if u > 0.95 => 20.0,
+                    u => 10f32.powf(-4.5 + 5.7 * u),
+                });
+                let kernel = model.per_lane_kernel([(name, alphas)]).unwrap_or_else(|| panic!("{json} {name}: a kernel"));
+                let (wo, wi): (Vec<Vec3>, Vec<Vec3>) = (0..PER_LANE).map(|_| (dir(&mut rng), dir(&mut rng))).unzip();
+                let lanes = |v: &[Vec3]| V3::new(Float8::from_fn(|i| v[i].x), Float8::from_fn(|i| v[i].y), Float8::from_fn(|i| v[i].z));
+                let (uc, ux, uy) =
+                    (Float8::from_fn(|_| rng.next_f32()), Float8::from_fn(|_| rng.next_f32()), Float8::from_fn(|_| rng.next_f32()));
+                let f = kernel.f_lanes(lanes(&wo), lanes(&wi));
+                let pdf = kernel.pdf_lanes(lanes(&wo), lanes(&wi));
+                let s = kernel.sample_lanes(lanes(&wo), uc, ux, uy);
+                let valid = Float8::bitmask(s.valid);
+                for l in 0..PER_LANE {
+                    let mut own = model.clone();
+                    assert!(own.set_float(name, alphas[l]));
+                    let at = format!("{json} {name} = {}, lane {l}, {} → {}", alphas[l], wo[l], wi[l]);
+                    let want = own.f(wo[l], wi[l]);
+                    for (got, want) in f.iter().map(|c| c.lane(l)).zip(want.0) {
+                        assert_eq!(got.to_bits(), want.to_bits(), "{at}: f {got} against {want}");
+                    }
+                    assert_eq!(pdf.lane(l).to_bits(), own.pdf(wo[l], wi[l]).to_bits(), "{at}: pdf");
+                    match own.sample(wo[l], uc.lane(l), Vec2::new(ux.lane(l), uy.lane(l))) {
+                        Some(b) => {
+                            assert!(valid & (1 << l) != 0, "{at}: a sample in the model only");
+                            let a_wi = Vec3::new(s.wi.x.lane(l), s.wi.y.lane(l), s.wi.z.lane(l));
+                            assert_eq!((a_wi, s.pdf.lane(l).to_bits()), (b.wi, b.pdf.to_bits()), "{at}: sample");
+                            for (got, want) in s.weight.iter().map(|c| c.lane(l)).zip(b.weight.0) {
+                                assert_eq!(got.to_bits(), want.to_bits(), "{at}: weight");
+                            }
+                            sampled += 1;
+                        }
+                        None => assert!(valid & (1 << l) == 0, "{at}: a sample in the kernel only"),
+                    }
+                }
+            }
+            assert!(sampled > 1000, "{json}: {sampled} samples compared");
+        }
+        let none = [
+            (r#"{"type": "roughconductor", "energy_compensation": true}"#, "alpha"),
+            (r#"{"type": "roughdielectric", "energy_compensation": true}"#, "alpha"),
+            (r#"{"type": "torrance_sparrow"}"#, "alpha"),
+            (r#"{"type": "roughplastic"}"#, "alpha"),
+            (r#"{"type": "roughconductor"}"#, "specular_reflectance"),
+            (r#"{"type": "diffuse"}"#, "alpha"),
+        ];
+        for (json, name) in none {
+            assert!(Bsdf::from_json(json).unwrap().per_lane_kernel([(name, [0.3; PER_LANE])]).is_none(), "{json} {name}");
         }
     }
 

@@ -46,20 +46,30 @@
 //! ```
 
 use super::energy_compensation::ConductorCompensation;
-use super::lanes::{f_one, flag_lanes, pdf_one, sample_one, LaneModel, LaneSample};
+use super::lanes::{f_one, flag_lanes, pdf_one, sample_one, LaneModel, LaneSample, PerLaneKernel};
 use super::{BsdfFlags, BsdfModel, BsdfSample, Conductor};
 use crate::error::{Error, Result};
 use crate::fresnel::fresnel_conductor_rgb_lanes;
 use crate::math::lanes::{channels, Real, V3};
 use crate::math::{Vec2, Vec3};
 use crate::microfacet::reflection::ReflectionLobe;
-use crate::microfacet::{alpha_from_blinn_exponent, on_distribution, Distribution, MicrofacetDistribution, MicrofacetKind, Shadowing};
+use crate::microfacet::{
+    alpha_from_blinn_exponent, on_distribution, Beckmann, Distribution, Ggx, MicrofacetDistribution, MicrofacetKind, PerLane, Shadowing,
+};
 use crate::props::Props;
 use crate::spectrum::Rgb;
 
 /// Roughness limits of every microfacet conductor (see the module doc for the reasons).
 pub const ALPHA_MIN: f32 = 1e-4;
 pub const ALPHA_MAX: f32 = 10.0;
+
+/// A texture's value on a roughness parameter as the microfacet models take it: clamped to
+/// [[`ALPHA_MIN`], [`ALPHA_MAX`]] (Mitsuba's distributions clamp α to 10⁻⁴ the same way).
+#[inline]
+#[must_use]
+pub fn textured_roughness(value: f32) -> f32 {
+    value.clamp(ALPHA_MIN, ALPHA_MAX)
+}
 
 /// The shared core of `roughconductor` and `torrance_sparrow`: a microfacet distribution, a
 /// masking–shadowing form, a sampling strategy and a conductor's Fresnel term.
@@ -158,12 +168,28 @@ impl MicrofacetConductor {
     /// The glossy lobe of this model as a lane kernel, for its distribution (matched here, once per call).
     #[inline(always)]
     pub(crate) fn kernel(&self) -> ConductorKernel {
+        on_distribution!(self.distribution, |d| ConductorKernel::from(self.lobe(d)))
+    }
+
+    /// The glossy lobe with the distribution `d`: this model's own, or its kind with a roughness per lane.
+    #[inline(always)]
+    fn lobe<D>(&self, d: D) -> ConductorLobe<D> {
         let fresnel = ConductorFresnel { eta_k: self.fresnel.eta_k, specular_reflectance: self.fresnel.specular_reflectance };
-        let (shadowing, visible) = (self.shadowing, self.sample_visible);
-        on_distribution!(self.distribution, |d| ConductorKernel::from(ConductorLobe {
-            lobe: ReflectionLobe { distribution: d, shadowing, visible },
-            fresnel
-        }))
+        ConductorLobe { lobe: ReflectionLobe { distribution: d, shadowing: self.shadowing, visible: self.sample_visible }, fresnel }
+    }
+
+    /// The kernel of this model with the roughness (`ax`, `ay`) of each lane instead of its own (GGX and
+    /// Beckmann without energy compensation; `None` otherwise): [`Bsdf::per_lane_kernel`](super::Bsdf::per_lane_kernel).
+    pub(crate) fn per_lane(&self, ax: PerLane, ay: PerLane) -> Option<PerLaneKernel> {
+        if self.compensation.is_some() {
+            return None;
+        }
+        let (alpha_x, alpha_y) = (ax, ay);
+        match self.distribution.kind {
+            MicrofacetKind::Ggx => Some(PerLaneKernel::ConductorGgx(self.lobe(Ggx { alpha_x, alpha_y }))),
+            MicrofacetKind::Beckmann => Some(PerLaneKernel::ConductorBeckmann(self.lobe(Beckmann { alpha_x, alpha_y }))),
+            MicrofacetKind::Blinn => None,
+        }
     }
 
     /// The kernel of this model when the glossy lobe is all of it (no energy compensation, whose lobe

@@ -63,7 +63,7 @@
 
 use super::dielectric::relative_ior;
 use super::energy_compensation::DielectricCompensation;
-use super::lanes::{f_one, flag_lanes, pdf_one, sample_one, LaneModel, LaneSample};
+use super::lanes::{f_one, flag_lanes, pdf_one, sample_one, LaneModel, LaneSample, PerLaneKernel};
 use super::rough_conductor::{read_distribution, MicrofacetParams};
 use super::{BsdfFlags, BsdfModel, BsdfSample};
 use crate::error::{Error, Result};
@@ -71,7 +71,7 @@ use crate::fresnel::{fresnel_dielectric, fresnel_dielectric_lanes, reflect, refl
 use crate::math::lanes::{channels, Real, V3};
 use crate::math::{Vec2, Vec3};
 use crate::microfacet::reflection::ReflectionLobe;
-use crate::microfacet::{on_distribution, Distribution, MicrofacetDistribution, MicrofacetKind, Shadowing};
+use crate::microfacet::{on_distribution, Beckmann, Distribution, Ggx, MicrofacetDistribution, MicrofacetKind, PerLane, Shadowing};
 use crate::props::Props;
 use crate::spectrum::Rgb;
 
@@ -159,14 +159,32 @@ impl RoughDielectric {
     /// per call).
     #[inline(always)]
     pub(crate) fn kernel(&self) -> DielectricKernel {
-        let (eta, reflectance, transmittance, visible) =
-            (self.eta, self.specular_reflectance, self.specular_transmittance, self.sample_visible);
-        on_distribution!(self.distribution, |d| DielectricKernel::from(DielectricLobe {
-            lobe: ReflectionLobe { distribution: d, shadowing: Shadowing::Smith, visible },
-            eta,
-            specular_reflectance: reflectance,
-            specular_transmittance: transmittance,
-        }))
+        on_distribution!(self.distribution, |d| DielectricKernel::from(self.lobe(d)))
+    }
+
+    /// The lobes with the distribution `d`: this model's own, or its kind with a roughness per lane.
+    #[inline(always)]
+    fn lobe<D>(&self, d: D) -> DielectricLobe<D> {
+        DielectricLobe {
+            lobe: ReflectionLobe { distribution: d, shadowing: Shadowing::Smith, visible: self.sample_visible },
+            eta: self.eta,
+            specular_reflectance: self.specular_reflectance,
+            specular_transmittance: self.specular_transmittance,
+        }
+    }
+
+    /// The kernel of this model with the roughness (`ax`, `ay`) of each lane instead of its own (GGX and
+    /// Beckmann without energy compensation; `None` otherwise): [`Bsdf::per_lane_kernel`](super::Bsdf::per_lane_kernel).
+    pub(crate) fn per_lane(&self, ax: PerLane, ay: PerLane) -> Option<PerLaneKernel> {
+        if self.compensation.is_some() {
+            return None;
+        }
+        let (alpha_x, alpha_y) = (ax, ay);
+        match self.distribution.kind {
+            MicrofacetKind::Ggx => Some(PerLaneKernel::DielectricGgx(self.lobe(Ggx { alpha_x, alpha_y }))),
+            MicrofacetKind::Beckmann => Some(PerLaneKernel::DielectricBeckmann(self.lobe(Beckmann { alpha_x, alpha_y }))),
+            MicrofacetKind::Blinn => None,
+        }
     }
 
     /// The kernel of this model when the single-scattering lobes are all of it (no energy compensation,

@@ -23,8 +23,8 @@
 
 use super::{emitter_hit, mix, start_lanes, BsdfSampled, CameraSample};
 use crate::bsdf::diffuse::{diffuse_f, diffuse_pdf, diffuse_sample};
-use crate::bsdf::lanes::LaneSample;
-use crate::bsdf::{Bsdf, BsdfModel};
+use crate::bsdf::lanes::{LaneModel, LaneSample};
+use crate::bsdf::{Bsdf, BsdfModel, PerLaneKernel};
 use crate::geometry::bvh::{bits, groups};
 use crate::geometry::mesh::uniform_triangle_point;
 use crate::geometry::ray::{offset_origin_lanes, spawn_ray_to_lanes, RayLanes};
@@ -345,6 +345,8 @@ struct Shading<'a> {
     /// The groups of lanes of one model instance (lanes, first lane), `n_groups` of them.
     groups: [(u32, usize); W],
     n_groups: usize,
+    /// Each group's kernel with a roughness per lane, if it has one (it runs instead of the model).
+    kernels: [Option<PerLaneKernel>; W],
     /// The shading frames (s, t, n).
     frame: (V3<Float8>, V3<Float8>, V3<Float8>),
     wo: V3<Float8>,
@@ -358,6 +360,33 @@ struct Shading<'a> {
 impl Shading<'_> {
     fn groups(&self) -> &[(u32, usize)] {
         &self.groups[..self.n_groups]
+    }
+
+    /// f of group `g`'s model (or its kernel) in lanes `m`.
+    fn f(&self, g: usize, wo: V3<Float8>, wi: V3<Float8>, m: Mask8) -> [Float8; 3] {
+        match &self.kernels[g] {
+            Some(k) => k.f_lanes(wo, wi),
+            None => f_where(self.model(self.groups[g].1), wo, wi, m),
+        }
+    }
+
+    /// pdf of group `g`'s model (or its kernel) in lanes `m`.
+    fn pdf(&self, g: usize, wo: V3<Float8>, wi: V3<Float8>, m: Mask8) -> Float8 {
+        match &self.kernels[g] {
+            Some(k) => k.pdf_lanes(wo, wi),
+            None => pdf_where(self.model(self.groups[g].1), wo, wi, m),
+        }
+    }
+
+    /// A sample of group `g`'s model (or its kernel) in lanes `m`.
+    fn sample(&self, g: usize, wo: V3<Float8>, uc: Float8, ux: Float8, uy: Float8, m: Mask8) -> LaneSample<Float8> {
+        match &self.kernels[g] {
+            Some(k) => {
+                let s = k.sample_lanes(wo, uc, ux, uy);
+                LaneSample { valid: s.valid & m, ..s }
+            }
+            None => sample_where(self.model(self.groups[g].1), wo, uc, ux, uy, m),
+        }
     }
 
     fn model(&self, lane: usize) -> &Bsdf {
@@ -394,6 +423,8 @@ fn shading<'a>(scene: &'a Scene, p: &Packet, hit: &Surfaces8) -> Shading<'a> {
     let (mut rho, mut rho_rows, mut diffuse, mut diffuse_rows) = ([Float8::splat(0.0); 3], Rows3::default(), 0u32, 0u32);
     let (mut tint, mut tinted) = ([[Float8::splat(1.0); 3]; 2], 0u32);
     let mut models: [Option<Cow<'_, Bsdf>>; W] = Default::default();
+    // Groups of lanes running a kernel with a roughness per lane: one per material, found here.
+    let (mut groups_of, mut n_groups, mut kernels, mut grouped) = ([(0u32, 0usize); W], 0usize, [None; W], 0u32);
     let (u, v) = (Float8::load(&hit.uv[0]), Float8::load(&hit.uv[1]));
     // Without a branch per lane (a lane without a hit holds shape 0 or the shape of an earlier hit in it
     // (`Scene::surfaces_into`): a valid index either way, and an out-of-range one would read as no class).
@@ -413,17 +444,25 @@ fn shading<'a>(scene: &'a Scene, p: &Packet, hit: &Surfaces8) -> Shading<'a> {
             diffuse |= same;
             continue;
         }
-        // A textured material whose textures only tint its model: that one model for all its lanes, each
-        // lane's values scaled by its tints (`Shading::tinted`).
-        if let Some((model, tints)) = material.tinted_lanes(u, v, same) {
-            let m = Mask8::from_bitmask(same);
-            for (lobe, t) in tint.iter_mut().zip(tints) {
-                *lobe = std::array::from_fn(|c| Float8::select(m, t[c], lobe[c]));
+        // A textured material whose textures only tint its model or set its roughness: that one model (or
+        // its kernel with each lane's roughness) for all its lanes, each lane's values scaled by its tints
+        // (`Shading::tinted`).
+        if let Some(lm) = material.lanes_at(u, v, same) {
+            if lm.tinted {
+                let m = Mask8::from_bitmask(same);
+                for (lobe, t) in tint.iter_mut().zip(lm.tints) {
+                    *lobe = std::array::from_fn(|c| Float8::select(m, t[c], lobe[c]));
+                }
+                tinted |= same;
             }
             for lane in bits(same) {
-                models[lane] = Some(Cow::Borrowed(model));
+                models[lane] = Some(Cow::Borrowed(lm.model));
             }
-            tinted |= same;
+            if lm.kernel.is_some() {
+                (groups_of[n_groups], kernels[n_groups]) = ((same, first), lm.kernel);
+                n_groups += 1;
+                grouped |= same;
+            }
             continue;
         }
         for lane in bits(same) {
@@ -446,8 +485,6 @@ fn shading<'a>(scene: &'a Scene, p: &Packet, hit: &Surfaces8) -> Shading<'a> {
     // The other lanes grouped by model instance (lanes on one shape share their material's model; a
     // textured material's model is its own lane's): each group calls its model once, in lanes
     // (`Bsdf::f_lanes_where` and friends: the model's kernel, or its single calls lane by lane).
-    let (mut groups_of, mut n_groups) = ([(0u32, 0usize); W], 0usize);
-    let mut grouped = 0u32;
     for lane in bits(p.live & !diffuse) {
         if grouped & (1 << lane) != 0 {
             continue;
@@ -467,7 +504,7 @@ fn shading<'a>(scene: &'a Scene, p: &Packet, hit: &Surfaces8) -> Shading<'a> {
     // The lanes whose model has a smooth component: next-event estimation serves them.
     let smooth = diffuse
         | bits(p.live & !diffuse).fold(0, |m, lane| m | (u32::from(models[lane].as_ref().is_some_and(|b| b.flags().has_smooth())) << lane));
-    Shading { rho, diffuse, smooth, models, groups: groups_of, n_groups, frame, wo, tinted, tint }
+    Shading { rho, diffuse, smooth, models, groups: groups_of, n_groups, kernels, frame, wo, tinted, tint }
 }
 
 /// Next-event estimation on the lanes whose model has a smooth component: `light_samples` times, a light
@@ -693,18 +730,17 @@ fn light_sample(scene: &Scene, p: &mut Packet, hit: &Surfaces8, sh: &Shading<'_>
     let (rho, wo) = (sh.rho, sh.wo);
     let mut f = diffuse_f(rho, wo, wi_local);
     let mut bsdf_pdf = diffuse_pdf(wo, wi_local);
-    for &(lanes, first) in sh.groups() {
+    for (g, &(lanes, _)) in sh.groups().iter().enumerate() {
         let lanes = lanes & sampled;
         if lanes == 0 {
             continue;
         }
         let m = Mask8::from_bitmask(lanes);
-        let model = sh.model(first);
-        let fk = f_where(model, wo, wi_local, m);
+        let fk = sh.f(g, wo, wi_local, m);
         for c in 0..3 {
             f[c] = Float8::select(m, fk[c], f[c]);
         }
-        let pdf = Float8::select(Mask8::from_bitmask(delta), Float8::splat(0.0), pdf_where(model, wo, wi_local, m));
+        let pdf = Float8::select(Mask8::from_bitmask(delta), Float8::splat(0.0), sh.pdf(g, wo, wi_local, m));
         bsdf_pdf = Float8::select(m, pdf, bsdf_pdf);
     }
     let f = sh.tinted(wi_local, f);
@@ -745,9 +781,9 @@ fn sample_bsdf(p: &mut Packet, hit: &Surfaces8, sh: &Shading<'_>) -> (u32, [Floa
     let mut valid = ds.valid.bitmask() & diffuse;
     let (mut s_wi, mut s_pdf, mut s_eta, mut s_weight) = (ds.wi, ds.pdf, ds.eta, ds.weight);
     let mut s_delta = 0u32;
-    for &(lanes, first) in sh.groups() {
+    for (g, &(lanes, _)) in sh.groups().iter().enumerate() {
         let m = Mask8::from_bitmask(lanes);
-        let s = sample_where(sh.model(first), wo, uc, ux, uy, m);
+        let s = sh.sample(g, wo, uc, ux, uy, m);
         s_wi = V3::select(m, s.wi, s_wi);
         for (w, k) in s_weight.iter_mut().zip(s.weight) {
             *w = Float8::select(m, k, *w);

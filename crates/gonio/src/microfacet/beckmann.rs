@@ -5,6 +5,7 @@
 //! number of steps (Jakob 2014). The exact `f64` Λ, [`beckmann_lambda`], is kept for tables and tests.
 
 use super::distribution::Distribution;
+use super::roughness::Roughness;
 use crate::math::lanes::{Real, V3};
 use crate::numerics::erf::{erf_inv_lanes, erfc, erfc_lanes, erfcx_cf};
 use crate::numerics::exp_log::{exp_neg, exp_split, ln_unit, square_split};
@@ -18,9 +19,9 @@ const FRAC_1_SQRT_PI: f32 = 0.564_189_583_547_756_3;
 
 /// The Beckmann distribution with roughness (RMS slope) `alpha_x`, `alpha_y`.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Beckmann {
-    pub alpha_x: f32,
-    pub alpha_y: f32,
+pub struct Beckmann<A = f32> {
+    pub alpha_x: A,
+    pub alpha_y: A,
 }
 
 /// The exact Beckmann Λ for a ≥ 0, a = cot θ / α (Heitz 2014 §5; Walter 2007 eq. 27 approximates its G1):
@@ -203,14 +204,10 @@ pub fn visible_slope_x<R: Real>(sin_theta: R, cos_theta: R, u: R) -> R {
     R::select(below_surface, R::splat(0.0), erf_inv_lanes(b))
 }
 
-impl Distribution for Beckmann {
+impl<A: Roughness> Distribution for Beckmann<A> {
     #[inline(always)]
-    fn alpha_x(&self) -> f32 {
-        self.alpha_x
-    }
-    #[inline(always)]
-    fn alpha_y(&self) -> f32 {
-        self.alpha_y
+    fn alphas<R: Real>(&self) -> (R, R) {
+        (self.alpha_x.lanes(), self.alpha_y.lanes())
     }
 
     /// D = exp(−s²/z²) / (π αx αy z⁴), 0 below the surface and where z⁴ underflows (exp(−s²/z²) is 0 there
@@ -220,8 +217,8 @@ impl Distribution for Beckmann {
         let zero = R::splat(0.0);
         let z2 = wm.z * wm.z;
         let cos4 = z2 * z2;
-        let (x, y) = (wm.x * (1.0 / self.alpha_x), wm.y * (1.0 / self.alpha_y));
-        let d = exp_neg(-(x * x + y * y) / z2) / (cos4 * (PI * self.alpha_x * self.alpha_y));
+        let (x, y) = (wm.x * self.alpha_x.recip::<R>(), wm.y * self.alpha_y.recip::<R>());
+        let d = exp_neg(-(x * x + y * y) / z2) / (cos4 * (self.alpha_x.lanes::<R>() * PI * self.alpha_y.lanes::<R>()));
         R::select(wm.z.le(zero) | cos4.eq(zero), zero, d)
     }
 
@@ -230,7 +227,7 @@ impl Distribution for Beckmann {
     fn lambda_upper<R: Real>(&self, x: R, y: R, z: R) -> R {
         let zero = R::splat(0.0);
         // α(φ)² sin²θ = αx² x² + αy² y² (the projected roughness of the anisotropic case, times sin²θ).
-        let (ax, ay) = (x * self.alpha_x, y * self.alpha_y);
+        let (ax, ay) = (x * self.alpha_x.lanes::<R>(), y * self.alpha_y.lanes::<R>());
         let s2 = ax * ax + ay * ay;
         let lambda = beckmann_lambda_lanes(z / s2.sqrt());
         R::select(s2.eq(zero), zero, R::select(z.eq(zero), R::splat(f32::INFINITY), lambda))
@@ -250,7 +247,7 @@ impl Distribution for Beckmann {
         let zero = R::splat(0.0);
         let one = R::splat(1.0);
         // 1. Stretch.
-        let v = V3::new(wo.x * self.alpha_x, wo.y * self.alpha_y, wo.z).normalize();
+        let v = V3::new(wo.x * self.alpha_x.lanes::<R>(), wo.y * self.alpha_y.lanes::<R>(), wo.z).normalize();
         let sin2 = v.x * v.x + v.y * v.y;
         let sin_theta = sin2.sqrt();
         let tilted = sin2.gt(zero);
@@ -259,8 +256,8 @@ impl Distribution for Beckmann {
         let slope_x = visible_slope_x(sin_theta, v.z, ux);
         let slope_y = erf_inv_lanes(uy * 2.0 - 1.0);
         // 3. Rotate to ωo's azimuth, 4. unstretch, 5. the normal of that slope.
-        let px = (cos_phi * slope_x - sin_phi * slope_y) * self.alpha_x;
-        let py = (sin_phi * slope_x + cos_phi * slope_y) * self.alpha_y;
+        let px = (cos_phi * slope_x - sin_phi * slope_y) * self.alpha_x.lanes::<R>();
+        let py = (sin_phi * slope_x + cos_phi * slope_y) * self.alpha_y.lanes::<R>();
         V3::new(-px, -py, one).normalize()
     }
 }

@@ -51,12 +51,8 @@ impl Distribution for Blinn {
     const HAS_VISIBLE: bool = false;
 
     #[inline(always)]
-    fn alpha_x(&self) -> f32 {
-        self.alpha
-    }
-    #[inline(always)]
-    fn alpha_y(&self) -> f32 {
-        self.alpha
+    fn alphas<R: Real>(&self) -> (R, R) {
+        (R::splat(self.alpha), R::splat(self.alpha))
     }
 
     /// cos^e θm = (1 − sin²θm)^{e/2} from sin²θm = (x² + y²)/|ωm|², not z^e: an f32 z near 1 carries 6·10⁻⁸

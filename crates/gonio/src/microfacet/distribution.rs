@@ -14,10 +14,8 @@ pub trait Distribution: Copy + std::fmt::Debug {
     /// asking for visible normals samples D·cos.
     const HAS_VISIBLE: bool = true;
 
-    /// The roughness along the frame's x axis.
-    fn alpha_x(&self) -> f32;
-    /// The roughness along the frame's y axis.
-    fn alpha_y(&self) -> f32;
+    /// The roughness along the frame's x and y axes, in lanes.
+    fn alphas<R: Real>(&self) -> (R, R);
 
     /// The normal distribution D(ωm) in sr⁻¹, 0 below the surface; ∫ D(ωm) cos θm dωm = 1.
     fn d<R: Real>(&self, wm: V3<R>) -> R;
@@ -86,7 +84,7 @@ pub trait Distribution: Copy + std::fmt::Debug {
     /// azimuth φ = atan2(αy sin 2πuy, αx cos 2πuy), whose density is D·cos.
     #[inline(always)]
     fn sample_d_cos<R: Real>(&self, ux: R, uy: R) -> V3<R> {
-        let (alpha_x, alpha_y) = (self.alpha_x(), self.alpha_y());
+        let (alpha_x, alpha_y): (R, R) = self.alphas();
         let zero = R::splat(0.0);
         let one = R::splat(1.0);
         // (cos φ, sin φ) ∝ (αx cos 2πuy, αy sin 2πuy): no arc tangent.
@@ -94,7 +92,7 @@ pub trait Distribution: Copy + std::fmt::Debug {
         let (px, py) = (c * alpha_x, s * alpha_y);
         let r = (px * px + py * py).sqrt();
         let (cos_phi, sin_phi) = (px / r, py / r);
-        let a = cos_phi * cos_phi * (1.0 / (alpha_x * alpha_x)) + sin_phi * sin_phi * (1.0 / (alpha_y * alpha_y));
+        let a = cos_phi * cos_phi * (R::splat(1.0) / (alpha_x * alpha_x)) + sin_phi * sin_phi * (R::splat(1.0) / (alpha_y * alpha_y));
         let tan2 = self.tan2_d_cos(ux, a);
         // tan² = ∞ is the horizon. sin θ from tan²θ directly: √(1 − cos²θ) loses it to f32 rounding for
         // narrow lobes (2026-11: chi-square failed at α = 0.01).

@@ -3,6 +3,7 @@
 //! (Walter 2007 eq. 35) and Heitz 2018's visible-normal sampler.
 
 use super::distribution::Distribution;
+use super::roughness::Roughness;
 use crate::math::lanes::{Real, V3};
 use crate::math::trig::sin_cos_turn;
 use std::f32::consts::PI;
@@ -11,20 +12,20 @@ use std::f32::consts::PI;
 /// reflection terms from the unnormalised half vector that the GGX kernels use (fewer divisions); the
 /// [`Distribution`] implementation forwards to them.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Ggx {
-    pub alpha_x: f32,
-    pub alpha_y: f32,
+pub struct Ggx<A = f32> {
+    pub alpha_x: A,
+    pub alpha_y: A,
 }
 
-impl Ggx {
+impl<A: Roughness> Ggx<A> {
     /// D(ωm) = 1 / (π αx αy (s² + z²)²), zero below the surface (Walter 2007 eq. 33; Heitz 2014 §5).
     #[inline(always)]
     #[must_use]
     pub fn d<R: Real>(&self, wm: V3<R>) -> R {
         // Times 1/α (computed once per batch, outside the loop): no divisions per row but the one below.
-        let (x, y) = (wm.x * (1.0 / self.alpha_x), wm.y * (1.0 / self.alpha_y));
+        let (x, y) = (wm.x * self.alpha_x.recip::<R>(), wm.y * self.alpha_y.recip::<R>());
         let t = x * x + y * y + wm.z * wm.z;
-        let d = R::splat(1.0) / (t * (PI * self.alpha_x * self.alpha_y) * t);
+        let d = R::splat(1.0) / (t * (self.alpha_x.lanes::<R>() * PI * self.alpha_y.lanes::<R>()) * t);
         R::select(wm.z.le(R::splat(0.0)), R::splat(0.0), d)
     }
 
@@ -33,7 +34,7 @@ impl Ggx {
     #[must_use]
     pub fn lambda_upper<R: Real>(&self, x: R, y: R, z: R) -> R {
         // α(φ)² sin²θ = αx² x² + αy² y² (the projected roughness of the anisotropic case, times sin²θ).
-        let (ax, ay) = (x * self.alpha_x, y * self.alpha_y);
+        let (ax, ay) = (x * self.alpha_x.lanes::<R>(), y * self.alpha_y.lanes::<R>());
         let s2 = ax * ax + ay * ay;
         // Λ = (−1 + √(1 + α² tan²θ))/2, written as t / (2 (1 + √(1 + t))) to avoid cancellation at small t.
         let t = s2 / (z * z);
@@ -51,7 +52,7 @@ impl Ggx {
         // and one square root instead of three and one (2026-12: the GGX kernels are bound by them); no
         // difference of nearly equal terms. 0 on the horizon (z = 0), 1 at the pole (s² = 0).
         let z = w.z.abs();
-        let (ax, ay) = (w.x * self.alpha_x, w.y * self.alpha_y);
+        let (ax, ay) = (w.x * self.alpha_x.lanes::<R>(), w.y * self.alpha_y.lanes::<R>());
         let s2 = ax * ax + ay * ay;
         let zq2 = z * (z + (z * z + s2).sqrt()) * 2.0;
         let zero = R::splat(0.0);
@@ -65,7 +66,7 @@ impl Ggx {
     #[inline(always)]
     fn masking_sum<R: Real>(&self, w: V3<R>) -> R {
         let z = w.z.abs();
-        let (ax, ay) = (w.x * self.alpha_x, w.y * self.alpha_y);
+        let (ax, ay) = (w.x * self.alpha_x.lanes::<R>(), w.y * self.alpha_y.lanes::<R>());
         z + (z * z + ax * ax + ay * ay).sqrt()
     }
 
@@ -73,9 +74,9 @@ impl Ggx {
     /// t = (hx/αx)² + (hy/αy)² + hz² ([`d`](Self::d) multiplied through by |h|⁴; no normalisation).
     #[inline(always)]
     fn d_unnormalised<R: Real>(&self, h: V3<R>, l: R) -> (R, R) {
-        let (x, y) = (h.x * (1.0 / self.alpha_x), h.y * (1.0 / self.alpha_y));
+        let (x, y) = (h.x * self.alpha_x.recip::<R>(), h.y * self.alpha_y.recip::<R>());
         let t = x * x + y * y + h.z * h.z;
-        (l * l, t * (PI * self.alpha_x * self.alpha_y) * t)
+        (l * l, t * (self.alpha_x.lanes::<R>() * PI * self.alpha_y.lanes::<R>()) * t)
     }
 
     /// The microfacet reflection term D(ωh) G1(ωo, ωh) G1(ωi, ωh) / (4 cos θo cos θi) (Walter 2007 eq. 20
@@ -112,7 +113,7 @@ impl Ggx {
     #[must_use]
     pub fn sample_visible<R: Real>(&self, wo: V3<R>, ux: R, uy: R) -> V3<R> {
         let zero = R::splat(0.0);
-        let vh = V3::new(wo.x * self.alpha_x, wo.y * self.alpha_y, wo.z).normalize();
+        let vh = V3::new(wo.x * self.alpha_x.lanes::<R>(), wo.y * self.alpha_y.lanes::<R>(), wo.z).normalize();
         // Orthonormal basis around vh (T1 is horizontal; degenerate at normal incidence).
         let len2 = vh.x * vh.x + vh.y * vh.y;
         // (Its z, 0 / √len2, is 0 wherever len2 > 0 selects it: not divided.)
@@ -131,11 +132,11 @@ impl Ggx {
         // Project onto the hemisphere around vh.
         let nh = t1.scale(p1).add(t2.scale(p2)).add(vh.scale((one - p1 * p1 - p2 * p2).max(zero).sqrt()));
         // Unstretch (the normal transforms with the inverse transpose).
-        V3::new(nh.x * self.alpha_x, nh.y * self.alpha_y, nh.z.max(zero)).normalize()
+        V3::new(nh.x * self.alpha_x.lanes::<R>(), nh.y * self.alpha_y.lanes::<R>(), nh.z.max(zero)).normalize()
     }
 }
 
-impl Ggx {
+impl<A: Roughness> Ggx<A> {
     /// tan²θm = u / ((1 − u) A(φ)) (Walter 2007 eq. 35 with the anisotropic A(φ)); ∞ at u = 1.
     #[inline(always)]
     fn tan2_of_sample<R: Real>(ux: R, a: R) -> R {
@@ -143,14 +144,10 @@ impl Ggx {
     }
 }
 
-impl Distribution for Ggx {
+impl<A: Roughness> Distribution for Ggx<A> {
     #[inline(always)]
-    fn alpha_x(&self) -> f32 {
-        self.alpha_x
-    }
-    #[inline(always)]
-    fn alpha_y(&self) -> f32 {
-        self.alpha_y
+    fn alphas<R: Real>(&self) -> (R, R) {
+        (self.alpha_x.lanes(), self.alpha_y.lanes())
     }
     #[inline(always)]
     fn d<R: Real>(&self, wm: V3<R>) -> R {
@@ -162,7 +159,7 @@ impl Distribution for Ggx {
     }
     #[inline(always)]
     fn tan2_d_cos<R: Real>(&self, ux: R, a: R) -> R {
-        Ggx::tan2_of_sample(ux, a)
+        Self::tan2_of_sample(ux, a)
     }
     #[inline(always)]
     fn sample_visible<R: Real>(&self, wo: V3<R>, ux: R, uy: R) -> V3<R> {

@@ -68,6 +68,7 @@ pub mod distribution;
 pub mod ggx;
 pub mod gtr1;
 pub mod reflection;
+pub mod roughness;
 #[cfg(test)]
 mod tests;
 
@@ -77,6 +78,7 @@ pub use blinn::{alpha_from_blinn_exponent, blinn_exponent_from_alpha, Blinn};
 pub use distribution::Distribution;
 pub use ggx::Ggx;
 pub use gtr1::Gtr1;
+pub use roughness::{PerLane, Roughness, PER_LANE};
 
 use crate::math::lanes::V3;
 use crate::math::{Vec2, Vec3};
@@ -193,13 +195,26 @@ impl MicrofacetDistribution {
     /// `alpha_v` along y (for Beckmann and GGX: Blinn is isotropic). Whether the distribution has `name`.
     pub fn set_roughness(&mut self, name: &str, alpha: f32) -> bool {
         debug_assert!(alpha > 0.0, "roughness must be positive");
-        match (name, self.kind) {
-            ("alpha", _) => (self.alpha_x, self.alpha_y) = (alpha, alpha),
-            ("alpha_u", MicrofacetKind::Beckmann | MicrofacetKind::Ggx) => self.alpha_x = alpha,
-            ("alpha_v", MicrofacetKind::Beckmann | MicrofacetKind::Ggx) => self.alpha_y = alpha,
-            _ => return false,
+        let Some((x, y)) = self.roughness_axes(name) else { return false };
+        if x {
+            self.alpha_x = alpha;
+        }
+        if y {
+            self.alpha_y = alpha;
         }
         true
+    }
+
+    /// Which roughnesses parameter `name` sets: (along x, along y) — `alpha` both, `alpha_u` x, `alpha_v`
+    /// y (the last two for Beckmann and GGX: Blinn is isotropic); `None` for other names.
+    #[must_use]
+    pub fn roughness_axes(&self, name: &str) -> Option<(bool, bool)> {
+        match (name, self.kind) {
+            ("alpha", _) => Some((true, true)),
+            ("alpha_u", MicrofacetKind::Beckmann | MicrofacetKind::Ggx) => Some((true, false)),
+            ("alpha_v", MicrofacetKind::Beckmann | MicrofacetKind::Ggx) => Some((false, true)),
+            _ => None,
+        }
     }
 
     /// The normalised Blinn distribution with exponent `exponent` ≥ 0.

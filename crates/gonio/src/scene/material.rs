@@ -1,12 +1,13 @@
 //! Materials: a BSDF whose parameters may be textures. Evaluated at a hit into a plain [`Bsdf`]; an
 //! untextured material is that `Bsdf` already.
 
-use crate::bsdf::{Bsdf, Diffuse, Tint};
+use crate::bsdf::{Bsdf, Diffuse, PerLaneKernel, Tint};
 use crate::error::{Error, Result};
 use crate::geometry::Mesh;
 use crate::math::lanes::Real;
-use crate::math::simd::Float8;
+use crate::math::simd::{Float8, Mask8};
 use crate::math::Frame;
+use crate::microfacet::PER_LANE;
 use crate::props::{Props, Value};
 use crate::spectrum::Rgb;
 use crate::texture::{MeshAttribute, SurfaceTexture, Texture};
@@ -54,9 +55,10 @@ pub enum Material {
     Slotted {
         model: Bsdf,
         textures: Vec<(Slot, SurfaceTexture, Lookup)>,
-        /// Where every texture is a tint ([`Bsdf::tint`]): the model with the tinted parameters at 1 and
-        /// each texture's lobe, in `textures`' order ([`Material::tinted_lanes`]).
-        tinted: Option<(Bsdf, Vec<Tint>)>,
+        /// Where every texture is a tint ([`Bsdf::tint`]) or a roughness the model takes per lane
+        /// ([`Bsdf::per_lane_kernel`]): the model with the tinted parameters at 1, and how each texture
+        /// applies, in `textures`' order ([`Material::lanes_at`]).
+        in_lanes: Option<(Bsdf, Vec<InLanes>)>,
     },
     /// Any other BSDF with texture parameters: the description without them, and the textures with their
     /// parameter paths. Rebuilt at every hit from a copy of the template (`Props` tracks which parameters
@@ -70,6 +72,26 @@ pub enum Material {
         textures: Vec<(Vec<String>, SurfaceTexture, Lookup)>,
         cache: RwLock<HashMap<Vec<u32>, Bsdf>>,
     },
+}
+
+/// How the packets apply a texture of a slotted material in lanes (`Material::Slotted`'s `in_lanes`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum InLanes {
+    /// It scales the model's values in this lobe.
+    Tint(Tint),
+    /// It is a roughness of the model: a kernel with each lane's roughness ([`Bsdf::per_lane_kernel`]).
+    Roughness,
+}
+
+/// What the lanes of a packet on one slotted material run ([`Material::lanes_at`]): `kernel` (a
+/// roughness per lane) or else `model`, for all of them, each lane's values then scaled by its tint of
+/// reflection (`tints[0]`) or transmission (`tints[1]`) where `tinted`.
+#[derive(Clone, Copy, Debug)]
+pub struct LaneMaterial<'a> {
+    pub model: &'a Bsdf,
+    pub kernel: Option<PerLaneKernel>,
+    pub tinted: bool,
+    pub tints: [[Float8; 3]; 2],
 }
 
 /// Where a slotted texture's value is written: the nested models on the way from the material's model
@@ -194,36 +216,46 @@ impl Material {
             .collect();
         if let Some(slots) = slots {
             let textures: Vec<_> = slots.into_iter().zip(textures).map(|(slot, (_, t, lookup))| (slot, t.clone(), *lookup)).collect();
-            let tinted = Self::tints(&model, &textures);
-            return Ok(Material::Slotted { model, textures, tinted });
+            let in_lanes = Self::in_lanes(&model, &textures);
+            return Ok(Material::Slotted { model, textures, in_lanes });
         }
         Ok(material)
     }
 
-    /// The tinted form of a slotted material (see `Material::Slotted`): every texture read as a colour at
-    /// texture coordinates, on a parameter that tints its model ([`Bsdf::tint`]), reached through nothing
-    /// but `twosided`s of one nested model (a blend's component, or one side of two, is not a tint of the
-    /// whole).
-    fn tints(model: &Bsdf, textures: &[(Slot, SurfaceTexture, Lookup)]) -> Option<(Bsdf, Vec<Tint>)> {
+    /// The lane form of a slotted material (see `Material::Slotted`): every texture read at texture
+    /// coordinates, either as a colour on a parameter that tints its model ([`Bsdf::tint`]), reached through
+    /// nothing but `twosided`s of one nested model (a blend's component, or one side of two, is not a tint
+    /// of the whole), or as a float on a roughness of the model itself that it takes per lane
+    /// ([`Bsdf::per_lane_kernel`]).
+    fn in_lanes(model: &Bsdf, textures: &[(Slot, SurfaceTexture, Lookup)]) -> Option<(Bsdf, Vec<InLanes>)> {
         let mut base = model.clone();
-        let mut lobes = Vec::with_capacity(textures.len());
+        let mut how = Vec::with_capacity(textures.len());
         for (slot, texture, lookup) in textures {
-            if *lookup != Lookup::Colour || !matches!(texture, SurfaceTexture::Uv(_)) {
+            if !matches!(texture, SurfaceTexture::Uv(_)) {
                 return None;
             }
-            let mut leaf = &mut base;
-            for &step in &slot.route {
-                if step != (0, 1) {
-                    return None;
+            match lookup {
+                Lookup::Float if slot.route.is_empty() => {
+                    model.per_lane_kernel([(slot.name.as_str(), [0.5; PER_LANE])])?;
+                    how.push(InLanes::Roughness);
                 }
-                leaf = leaf.both_sides()?;
-            }
-            lobes.push(leaf.tint(&slot.name)?);
-            if !slot.write(&mut base, &TextureValue::Colour(Rgb::ONE)) {
-                return None;
+                Lookup::Colour => {
+                    let mut leaf = &mut base;
+                    for &step in &slot.route {
+                        if step != (0, 1) {
+                            return None;
+                        }
+                        leaf = leaf.both_sides()?;
+                    }
+                    how.push(InLanes::Tint(leaf.tint(&slot.name)?));
+                    if !slot.write(&mut base, &TextureValue::Colour(Rgb::ONE)) {
+                        return None;
+                    }
+                }
+                _ => return None,
             }
         }
-        Some((base, lobes))
+        Some((base, how))
     }
 
     /// The material without slots: `Fixed`, `TexturedDiffuse`, or `Textured` (built again at each hit).
@@ -346,26 +378,49 @@ impl Material {
         }
     }
 
-    /// For a material whose every texture is a tint (see `Material::Slotted`): the one model its lanes run,
-    /// and each lane's tints at texture coordinates (`u`, `v`) of the lanes set in `lanes` (the others
-    /// unspecified) — of reflection and of transmission, 1 where no texture tints the lobe — which scale
-    /// that model's values per lane to the values of [`Self::at`]'s model (to rounding: the model multiplies
-    /// its tint in its own order). `None` for other materials.
+    /// For a material whose every texture is a tint or a roughness taken per lane (see
+    /// `Material::Slotted`): what its lanes run at texture coordinates (`u`, `v`) of the lanes set in
+    /// `lanes` (the others' tints are left unspecified) — the values of [`Self::at`]'s model in each lane,
+    /// to rounding (the model multiplies in its tints in its own order). `None` for other materials, and
+    /// where a roughness texture is not a finite number in one of the lanes (each lane's own model then
+    /// reports it, as [`Self::at`] does).
     #[inline]
     #[must_use]
-    pub fn tinted_lanes(&self, u: Float8, v: Float8, lanes: u32) -> Option<(&Bsdf, [[Float8; 3]; 2])> {
-        let Material::Slotted { textures, tinted: Some((model, lobes)), .. } = self else { return None };
+    pub fn lanes_at(&self, u: Float8, v: Float8, lanes: u32) -> Option<LaneMaterial<'_>> {
+        let Material::Slotted { textures, in_lanes: Some((model, how)), .. } = self else { return None };
         let mut tints = [[Float8::splat(1.0); 3]; 2];
-        for ((_, texture, _), lobe) in textures.iter().zip(lobes) {
+        let (mut tinted, mut rough) = (false, false);
+        for ((_, texture, _), how) in textures.iter().zip(how) {
             let SurfaceTexture::Uv(t) = texture else { return None };
-            let tint = &mut tints[match lobe {
-                Tint::Reflection => 0,
-                Tint::Transmission => 1,
-            }];
-            let c = Self::texels(t, u, v, lanes);
-            *tint = std::array::from_fn(|i| tint[i] * c[i]);
+            match how {
+                InLanes::Tint(lobe) => {
+                    let tint = &mut tints[match lobe {
+                        Tint::Reflection => 0,
+                        Tint::Transmission => 1,
+                    }];
+                    let c = Self::texels(t, u, v, lanes);
+                    *tint = std::array::from_fn(|i| tint[i] * c[i]);
+                    tinted = true;
+                }
+                InLanes::Roughness => rough = true,
+            }
         }
-        Some((model, tints))
+        let mut kernel = None;
+        if rough {
+            // The other lanes hold a valid roughness, so that the kernel's numbers stay tame there.
+            let (m, mut finite) = (Mask8::from_bitmask(lanes), true);
+            let values = textures.iter().zip(how).filter(|(_, how)| **how == InLanes::Roughness).filter_map(|((slot, texture, _), _)| {
+                let SurfaceTexture::Uv(t) = texture else { return None };
+                let value = t.eval_1_lanes(u, v, lanes);
+                finite &= !Float8::any(m & !value.is_finite());
+                Some((slot.name.as_str(), Float8::select(m, value, Float8::splat(1.0)).to_array()))
+            });
+            kernel = model.per_lane_kernel(values);
+            if !finite || kernel.is_none() {
+                return None;
+            }
+        }
+        Some(LaneMaterial { model, kernel, tinted, tints })
     }
 
     /// A texture's colours at (`u`, `v`) in lanes as reflectances (clamped to [0, 1]; [`Self::texel`] in

@@ -10,7 +10,7 @@ pub mod mitsuba_dict;
 pub mod mitsuba_xml;
 pub mod surfaces;
 
-pub use material::Material;
+pub use material::{LaneMaterial, Material};
 
 use crate::bsdf::Bsdf;
 use crate::camera::Camera;

@@ -60,7 +60,14 @@ impl Rgb {
     #[inline]
     #[must_use]
     pub fn luminance(self) -> f32 {
-        0.212_671 * self.0[0] + 0.715_160 * self.0[1] + 0.072_169 * self.0[2]
+        Self::luminance_lanes(self.0)
+    }
+
+    /// [`Self::luminance`] of colours in lanes (the same operations in each lane).
+    #[inline(always)]
+    #[must_use]
+    pub fn luminance_lanes<R: crate::math::lanes::Real>(c: [R; 3]) -> R {
+        c[0] * 0.212_671 + c[1] * 0.715_160 + c[2] * 0.072_169
     }
 
     #[inline]

@@ -13,6 +13,7 @@ pub use checkerboard::Checkerboard;
 pub use mesh_attribute::MeshAttribute;
 
 use crate::error::{Error, Result};
+use crate::math::simd::Float8;
 use crate::props::Props;
 use crate::spectrum::Rgb;
 use glam::Vec2;
@@ -69,6 +70,20 @@ impl Texture {
         match self {
             Texture::Checkerboard(c) => c.eval_1(uv),
             Texture::Bitmap(b) => b.eval(uv).luminance(),
+        }
+    }
+
+    /// [`Self::eval_1`] in lanes, at texture coordinates (`u`, `v`) of the lanes set in `lanes` (the others
+    /// unspecified): the same values as one lane at a time.
+    #[inline]
+    #[must_use]
+    pub fn eval_1_lanes(&self, u: Float8, v: Float8, lanes: u32) -> Float8 {
+        match self {
+            Texture::Checkerboard(c) => {
+                let (l0, l1) = (Float8::splat(c.color0.luminance()), Float8::splat(c.color1.luminance()));
+                Float8::select(c.same_side_lanes(u, v), l1, l0)
+            }
+            Texture::Bitmap(b) => Rgb::luminance_lanes(b.eval_lanes(u, v, lanes)),
         }
     }
 
