@@ -25,12 +25,13 @@ use super::polarizer::Polarizer;
 use super::principled::PrincipledLobes;
 use super::rough_conductor::{ConductorKernel, ConductorLobe};
 use super::rough_dielectric::{DielectricKernel, DielectricLobe};
-use super::rough_plastic::PlasticKernel;
+use super::rough_plastic::{PlasticKernel, PlasticLobe};
 use super::thin_dielectric::ThinDielectric;
 use super::{Bsdf, BsdfFlags, BsdfSample, SampleColumns};
 use crate::math::lanes::{channels, F32x8, Real, Rows, V3};
+use crate::math::param::PerLane;
 use crate::math::{Vec2, Vec3};
-use crate::microfacet::{Beckmann, Ggx, PerLane};
+use crate::microfacet::{Beckmann, Ggx};
 use crate::spectrum::Rgb;
 
 /// One sampled row per lane: the fields of [`BsdfSample`] as lanes, and which lanes hold a sample.
@@ -163,48 +164,50 @@ pub enum LaneKernel<'a> {
     Principled(PrincipledLobes),
 }
 
-/// The kernel of a microfacet model whose roughness is given per lane ([`Bsdf::per_lane_kernel`]): a
-/// textured roughness in the path tracer's packets runs one kernel call for all its lanes, each lane with
-/// its own α, instead of a model and a call per lane. The same lobes as the models' own kernels, over a
-/// distribution holding a [`PerLane`] roughness. Read in at most [`crate::microfacet::PER_LANE`] lanes.
+/// The kernel of a model with a parameter given per lane ([`Bsdf::per_lane_kernel`]): a textured roughness
+/// (of the rough conductors and dielectric) or base reflectance (of the rough plastic) in the path tracer's
+/// packets runs one kernel call for all the lanes on it, each lane with its own value, instead of a model
+/// and a call per lane. The same lobes as the models' own kernels, over a [`PerLane`] parameter. Read in at
+/// most [`crate::math::param::PER_LANE`] lanes.
 #[derive(Clone, Copy, Debug)]
-pub enum PerLaneKernel {
+pub enum PerLaneKernel<'a> {
     ConductorGgx(ConductorLobe<Ggx<PerLane>>),
     ConductorBeckmann(ConductorLobe<Beckmann<PerLane>>),
     DielectricGgx(DielectricLobe<Ggx<PerLane>>),
     DielectricBeckmann(DielectricLobe<Beckmann<PerLane>>),
+    PlasticGgx(PlasticLobe<'a, Ggx, PerLane>),
+    PlasticBeckmann(PlasticLobe<'a, Beckmann, PerLane>),
+}
+
+/// Each kernel of [`PerLaneKernel`], bound to `$k` in `$body`.
+macro_rules! on_per_lane {
+    ($kernel:expr, |$k:ident| $body:expr) => {
+        match $kernel {
+            PerLaneKernel::ConductorGgx($k) => $body,
+            PerLaneKernel::ConductorBeckmann($k) => $body,
+            PerLaneKernel::DielectricGgx($k) => $body,
+            PerLaneKernel::DielectricBeckmann($k) => $body,
+            PerLaneKernel::PlasticGgx($k) => $body,
+            PerLaneKernel::PlasticBeckmann($k) => $body,
+        }
+    };
 }
 
 /// Not inlined, as [`LaneKernel`]'s (one copy for the packets' lane type).
-impl LaneModel for PerLaneKernel {
+impl LaneModel for PerLaneKernel<'_> {
     #[inline(never)]
     fn f_lanes<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> [R; 3] {
-        match self {
-            PerLaneKernel::ConductorGgx(k) => k.f_lanes(wo, wi),
-            PerLaneKernel::ConductorBeckmann(k) => k.f_lanes(wo, wi),
-            PerLaneKernel::DielectricGgx(k) => k.f_lanes(wo, wi),
-            PerLaneKernel::DielectricBeckmann(k) => k.f_lanes(wo, wi),
-        }
+        on_per_lane!(self, |k| k.f_lanes(wo, wi))
     }
 
     #[inline(never)]
     fn pdf_lanes<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> R {
-        match self {
-            PerLaneKernel::ConductorGgx(k) => k.pdf_lanes(wo, wi),
-            PerLaneKernel::ConductorBeckmann(k) => k.pdf_lanes(wo, wi),
-            PerLaneKernel::DielectricGgx(k) => k.pdf_lanes(wo, wi),
-            PerLaneKernel::DielectricBeckmann(k) => k.pdf_lanes(wo, wi),
-        }
+        on_per_lane!(self, |k| k.pdf_lanes(wo, wi))
     }
 
     #[inline(never)]
     fn sample_lanes<R: Real>(&self, wo: V3<R>, uc: R, ux: R, uy: R) -> LaneSample<R> {
-        match self {
-            PerLaneKernel::ConductorGgx(k) => k.sample_lanes(wo, uc, ux, uy),
-            PerLaneKernel::ConductorBeckmann(k) => k.sample_lanes(wo, uc, ux, uy),
-            PerLaneKernel::DielectricGgx(k) => k.sample_lanes(wo, uc, ux, uy),
-            PerLaneKernel::DielectricBeckmann(k) => k.sample_lanes(wo, uc, ux, uy),
-        }
+        on_per_lane!(self, |k| k.sample_lanes(wo, uc, ux, uy))
     }
 }
 

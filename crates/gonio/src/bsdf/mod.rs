@@ -307,8 +307,9 @@ pub mod torrance_sparrow;
 pub mod twosided;
 
 use crate::error::{Error, Result};
+use crate::math::param::{PerLane, PER_LANE};
 use crate::math::{Vec2, Vec3};
-use crate::microfacet::{PerLane, PER_LANE};
+use crate::microfacet::MicrofacetDistribution;
 use crate::props::Props;
 use crate::spectrum::Rgb;
 use rough_conductor::textured_roughness;
@@ -838,31 +839,30 @@ impl Bsdf {
         }
     }
 
-    /// This model's kernel with its roughness parameters in `values` given per lane of a packet (name and
-    /// each lane's value, as [`Self::set_float`] takes them and clamped as it clamps them; the others the
-    /// model's own): what each lane's model with those values written by [`Self::set_float`] computes, in
-    /// one kernel call for all lanes. For the models whose roughness [`Self::set_float`] sets — except
-    /// Blinn's, whose exponent is one number — and for no other parameter; `None` otherwise.
-    pub fn per_lane_kernel<'a>(&self, values: impl IntoIterator<Item = (&'a str, [f32; PER_LANE])>) -> Option<PerLaneKernel> {
-        let distribution = match self {
-            Bsdf::RoughConductor(RoughConductor(c)) | Bsdf::TorranceSparrow(TorranceSparrow(c)) => &c.distribution,
-            Bsdf::RoughDielectric(d) => &d.distribution,
-            _ => return None,
-        };
-        let (mut ax, mut ay) = ([distribution.alpha_x; PER_LANE], [distribution.alpha_y; PER_LANE]);
-        for (name, v) in values {
-            let (x, y) = distribution.roughness_axes(name)?;
-            let v = v.map(textured_roughness);
-            if x {
-                ax = v;
-            }
-            if y {
-                ay = v;
-            }
-        }
+    /// This model's kernel with the parameters in `values` given per lane of a packet (name and each
+    /// lane's value, as [`Self::set_float`] and [`Self::reflectance_slot`] take them and clamped as they
+    /// are clamped; the others the model's own): what each lane's model with those values written into it
+    /// computes, in one kernel call for all lanes. The parameters: the roughness of the models whose
+    /// roughness [`Self::set_float`] sets (except Blinn's, whose exponent is one number), and the base
+    /// reflectance of `roughplastic` without energy compensation; `None` for other models and parameters.
+    pub fn per_lane_kernel<'n>(&self, values: impl IntoIterator<Item = (&'n str, LaneValue)>) -> Option<PerLaneKernel<'_>> {
         match self {
-            Bsdf::RoughConductor(RoughConductor(c)) | Bsdf::TorranceSparrow(TorranceSparrow(c)) => c.per_lane(PerLane(ax), PerLane(ay)),
-            Bsdf::RoughDielectric(d) => d.per_lane(PerLane(ax), PerLane(ay)),
+            Bsdf::RoughConductor(RoughConductor(c)) | Bsdf::TorranceSparrow(TorranceSparrow(c)) => {
+                let (ax, ay) = roughness_lanes(&c.distribution, values)?;
+                c.per_lane(ax, ay)
+            }
+            Bsdf::RoughDielectric(d) => {
+                let (ax, ay) = roughness_lanes(&d.distribution, values)?;
+                d.per_lane(ax, ay)
+            }
+            Bsdf::RoughPlastic(p) => {
+                let mut rho = p.diffuse_reflectance.0.map(|c| [c; PER_LANE]);
+                for value in values {
+                    let ("diffuse_reflectance", LaneValue::Colour(c)) = value else { return None };
+                    rho = c.map(|channel| channel.map(textured_reflectance));
+                }
+                p.per_lane(rho)
+            }
             _ => None,
         }
     }
@@ -946,6 +946,42 @@ impl Bsdf {
             _ => None,
         }
     }
+}
+
+/// A parameter's values per lane of a packet ([`Bsdf::per_lane_kernel`]).
+#[derive(Clone, Copy, Debug)]
+pub enum LaneValue {
+    Float([f32; PER_LANE]),
+    /// Per channel.
+    Colour([[f32; PER_LANE]; 3]),
+}
+
+/// A texture's value on a reflectance (a colour parameter of a model) as the models take it: clamped to
+/// [0, 1].
+#[inline]
+#[must_use]
+pub fn textured_reflectance(value: f32) -> f32 {
+    value.clamp(0.0, 1.0)
+}
+
+/// The roughness per lane of `distribution` with the roughness parameters in `values` (clamped as a
+/// texture's, [`textured_roughness`]) and its own elsewhere; `None` for any other parameter.
+fn roughness_lanes<'n>(
+    distribution: &MicrofacetDistribution,
+    values: impl IntoIterator<Item = (&'n str, LaneValue)>,
+) -> Option<(PerLane, PerLane)> {
+    let (mut ax, mut ay) = ([distribution.alpha_x; PER_LANE], [distribution.alpha_y; PER_LANE]);
+    for (name, value) in values {
+        let ((x, y), LaneValue::Float(v)) = (distribution.roughness_axes(name)?, value) else { return None };
+        let v = v.map(textured_roughness);
+        if x {
+            ax = v;
+        }
+        if y {
+            ay = v;
+        }
+    }
+    Some((PerLane(ax), PerLane(ay)))
 }
 
 #[cfg(test)]
@@ -1109,13 +1145,15 @@ mod tests {
         }
     }
 
-    /// A kernel with a roughness per lane ([`Bsdf::per_lane_kernel`]) gives in each lane what that lane's
-    /// model — the roughness written into it with [`Bsdf::set_float`], clamped alike — gives in its single
-    /// calls, bit for bit: `f`, `pdf` and `sample` in the path tracer's lanes, for GGX and Beckmann,
-    /// conductors and the dielectric, each roughness parameter, over roughnesses from 0 (clamped to 10⁻⁴)
-    /// to beyond 10, every lane a different one. Models and parameters it does not cover have none.
+    /// A kernel with a parameter per lane ([`Bsdf::per_lane_kernel`]) gives in each lane what that lane's
+    /// model — the value written into it with [`Bsdf::set_float`] or [`Bsdf::reflectance_slot`], clamped
+    /// as a texture's — gives in its single calls, bit for bit: `f`, `pdf` and `sample` in the path
+    /// tracer's lanes, for GGX and Beckmann, conductors, the dielectric and the rough plastic, each
+    /// roughness parameter and the plastic's base reflectance, over roughnesses from 0 (clamped to 10⁻⁴)
+    /// to beyond 10 and reflectances beyond [0, 1], every lane a different one. Models and parameters it
+    /// does not cover have none.
     #[test]
-    fn per_lane_roughness_is_each_lanes_model() {
+    fn per_lane_parameters_are_each_lanes_model() {
         use crate::math::lanes::{Real, V3};
         use crate::math::simd::Float8;
         use lanes::LaneModel;
@@ -1129,6 +1167,9 @@ mod tests {
             (r#"{"type": "roughdielectric"}"#, "alpha"),
             (r#"{"type": "roughdielectric", "distribution": "ggx", "int_ior": 1.33}"#, "alpha"),
             (r#"{"type": "roughdielectric", "distribution": "ggx", "alpha_v": 0.2}"#, "alpha_u"),
+            (r#"{"type": "roughplastic"}"#, "diffuse_reflectance"),
+            (r#"{"type": "roughplastic", "distribution": "ggx", "alpha": 0.3, "nonlinear": true}"#, "diffuse_reflectance"),
+            (r#"{"type": "roughplastic", "distribution": "ggx", "int_ior": 1.0, "ext_ior": 1.5}"#, "diffuse_reflectance"),
         ];
         let mut rng = Pcg32::new(17, 0);
         let dir = |rng: &mut Pcg32| {
@@ -1137,15 +1178,20 @@ mod tests {
         };
         for (json, name) in cases {
             let model = Bsdf::from_json(json).unwrap();
+            let colour = name == "diffuse_reflectance";
             let mut sampled = 0;
             for _ in 0..400 {
-                // Roughness from 0 to 10^1.2 (log-uniform), and the ends beyond the range.
-                let alphas: [f32; PER_LANE] = std::array::from_fn(|_| match rng.next_f32() {
+                // Roughness from 0 to 10^1.2 (log-uniform), and the ends beyond the range; reflectances in
+                // [−0.2, 1.2].
+                let value = |rng: &mut Pcg32| match rng.next_f32() {
+                    u if colour => 1.4 * u - 0.2,
                     u if u < 0.1 => 0.0,
                     u if u > 0.95 => 20.0,
                     u => 10f32.powf(-4.5 + 5.7 * u),
-                });
-                let kernel = model.per_lane_kernel([(name, alphas)]).unwrap_or_else(|| panic!("{json} {name}: a kernel"));
+                };
+                let values: [[f32; PER_LANE]; 3] = std::array::from_fn(|_| std::array::from_fn(|_| value(&mut rng)));
+                let lane_value = if colour { LaneValue::Colour(values) } else { LaneValue::Float(values[0]) };
+                let kernel = model.per_lane_kernel([(name, lane_value)]).unwrap_or_else(|| panic!("{json} {name}: a kernel"));
                 let (wo, wi): (Vec<Vec3>, Vec<Vec3>) = (0..PER_LANE).map(|_| (dir(&mut rng), dir(&mut rng))).unzip();
                 let lanes = |v: &[Vec3]| V3::new(Float8::from_fn(|i| v[i].x), Float8::from_fn(|i| v[i].y), Float8::from_fn(|i| v[i].z));
                 let (uc, ux, uy) =
@@ -1156,8 +1202,12 @@ mod tests {
                 let valid = Float8::bitmask(s.valid);
                 for l in 0..PER_LANE {
                     let mut own = model.clone();
-                    assert!(own.set_float(name, alphas[l]));
-                    let at = format!("{json} {name} = {}, lane {l}, {} → {}", alphas[l], wo[l], wi[l]);
+                    if colour {
+                        *own.reflectance_slot(name).unwrap() = Rgb::new(values[0][l], values[1][l], values[2][l]).map(textured_reflectance);
+                    } else {
+                        assert!(own.set_float(name, values[0][l]));
+                    }
+                    let at = format!("{json} {name} = {}, lane {l}, {} → {}", values[0][l], wo[l], wi[l]);
                     let want = own.f(wo[l], wi[l]);
                     for (got, want) in f.iter().map(|c| c.lane(l)).zip(want.0) {
                         assert_eq!(got.to_bits(), want.to_bits(), "{at}: f {got} against {want}");
@@ -1179,16 +1229,20 @@ mod tests {
             }
             assert!(sampled > 1000, "{json}: {sampled} samples compared");
         }
+        let float = LaneValue::Float([0.3; PER_LANE]);
         let none = [
-            (r#"{"type": "roughconductor", "energy_compensation": true}"#, "alpha"),
-            (r#"{"type": "roughdielectric", "energy_compensation": true}"#, "alpha"),
-            (r#"{"type": "torrance_sparrow"}"#, "alpha"),
-            (r#"{"type": "roughplastic"}"#, "alpha"),
-            (r#"{"type": "roughconductor"}"#, "specular_reflectance"),
-            (r#"{"type": "diffuse"}"#, "alpha"),
+            (r#"{"type": "roughconductor", "energy_compensation": true}"#, "alpha", float),
+            (r#"{"type": "roughdielectric", "energy_compensation": true}"#, "alpha", float),
+            (r#"{"type": "torrance_sparrow"}"#, "alpha", float),
+            (r#"{"type": "roughplastic"}"#, "alpha", float),
+            (r#"{"type": "roughplastic", "energy_compensation": true}"#, "diffuse_reflectance", LaneValue::Colour([[0.3; PER_LANE]; 3])),
+            (r#"{"type": "roughplastic"}"#, "specular_reflectance", LaneValue::Colour([[0.3; PER_LANE]; 3])),
+            (r#"{"type": "roughconductor"}"#, "specular_reflectance", LaneValue::Colour([[0.3; PER_LANE]; 3])),
+            (r#"{"type": "roughconductor"}"#, "alpha", LaneValue::Colour([[0.3; PER_LANE]; 3])),
+            (r#"{"type": "diffuse"}"#, "alpha", float),
         ];
-        for (json, name) in none {
-            assert!(Bsdf::from_json(json).unwrap().per_lane_kernel([(name, [0.3; PER_LANE])]).is_none(), "{json} {name}");
+        for (json, name, value) in none {
+            assert!(Bsdf::from_json(json).unwrap().per_lane_kernel([(name, value)]).is_none(), "{json} {name}");
         }
     }
 

@@ -52,6 +52,7 @@ use super::{BsdfFlags, BsdfModel, BsdfSample};
 use crate::error::Result;
 use crate::fresnel::{fresnel_dielectric_lanes, fresnel_diffuse_reflectance, reflect_lanes};
 use crate::math::lanes::{channels, Real, V3};
+use crate::math::param::Param;
 use crate::math::{Vec2, Vec3};
 use crate::props::Props;
 use crate::sampling::warp::{cosine_hemisphere, cosine_hemisphere_density};
@@ -79,11 +80,18 @@ pub(crate) const POLYPROPYLENE: f32 = 1.49;
 /// `plastic` and `roughplastic`.
 #[must_use]
 #[inline(always)]
-pub(crate) fn coated_diffuse<R: Real>(rho: Rgb, t_o: R, t_i: R, eta: f32, internal_reflectance: f32, nonlinear: bool) -> [R; 3] {
+pub(crate) fn coated_diffuse<R: Real, P: Param>(
+    rho: [P; 3],
+    t_o: R,
+    t_i: R,
+    eta: f32,
+    internal_reflectance: f32,
+    nonlinear: bool,
+) -> [R; 3] {
     let scale = t_o * t_i * (FRAC_1_PI / (eta * eta));
     channels!(|c| {
-        let r = rho.0[c];
-        let denom = 1.0 - if nonlinear { r * internal_reflectance } else { internal_reflectance };
+        let r: R = rho[c].lanes();
+        let denom = R::splat(1.0) - if nonlinear { r * internal_reflectance } else { R::splat(internal_reflectance) };
         scale * (r / denom)
     })
 }
@@ -104,8 +112,9 @@ pub(crate) fn specular_sampling_weight(diffuse: Rgb, specular: Rgb) -> f32 {
 /// coating and the steering weight is `w`: r w / (r w + (1 − r)(1 − w)).
 #[must_use]
 #[inline(always)]
-pub(crate) fn specular_probability<R: Real>(r: R, w: f32) -> R {
-    let (s, d) = (r * w, (R::splat(1.0) - r) * (1.0 - w));
+pub(crate) fn specular_probability<R: Real, P: Param>(r: R, w: P) -> R {
+    let w: R = w.lanes();
+    let (s, d) = (r * w, (R::splat(1.0) - r) * (R::splat(1.0) - w));
     // Both lobes carry nothing (e.g. a black specular multiplier and total reflection): pick either.
     R::select((s + d).gt(R::splat(0.0)), s / (s + d), R::splat(0.0))
 }
@@ -194,7 +203,7 @@ impl LaneModel for Plastic {
         let above = wo.z.gt(zero) & wi.z.gt(zero);
         let one = R::splat(1.0);
         let (t_o, t_i) = (one - fresnel_dielectric_lanes(wo.z, self.eta), one - fresnel_dielectric_lanes(wi.z, self.eta));
-        let diffuse = coated_diffuse(self.diffuse_reflectance, t_o, t_i, self.eta, self.internal_reflectance, self.nonlinear);
+        let diffuse = coated_diffuse(self.diffuse_reflectance.0, t_o, t_i, self.eta, self.internal_reflectance, self.nonlinear);
         channels!(|c| R::select(above, diffuse[c], zero))
     }
 

@@ -51,10 +51,11 @@ use super::{BsdfFlags, BsdfModel, BsdfSample, Conductor};
 use crate::error::{Error, Result};
 use crate::fresnel::fresnel_conductor_rgb_lanes;
 use crate::math::lanes::{channels, Real, V3};
+use crate::math::param::PerLane;
 use crate::math::{Vec2, Vec3};
 use crate::microfacet::reflection::ReflectionLobe;
 use crate::microfacet::{
-    alpha_from_blinn_exponent, on_distribution, Beckmann, Distribution, Ggx, MicrofacetDistribution, MicrofacetKind, PerLane, Shadowing,
+    alpha_from_blinn_exponent, on_distribution, Beckmann, Distribution, Ggx, MicrofacetDistribution, MicrofacetKind, Shadowing,
 };
 use crate::props::Props;
 use crate::spectrum::Rgb;
@@ -180,7 +181,7 @@ impl MicrofacetConductor {
 
     /// The kernel of this model with the roughness (`ax`, `ay`) of each lane instead of its own (GGX and
     /// Beckmann without energy compensation; `None` otherwise): [`Bsdf::per_lane_kernel`](super::Bsdf::per_lane_kernel).
-    pub(crate) fn per_lane(&self, ax: PerLane, ay: PerLane) -> Option<PerLaneKernel> {
+    pub(crate) fn per_lane(&self, ax: PerLane, ay: PerLane) -> Option<PerLaneKernel<'static>> {
         if self.compensation.is_some() {
             return None;
         }

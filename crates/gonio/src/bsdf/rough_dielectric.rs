@@ -69,9 +69,10 @@ use super::{BsdfFlags, BsdfModel, BsdfSample};
 use crate::error::{Error, Result};
 use crate::fresnel::{fresnel_dielectric, fresnel_dielectric_lanes, reflect, reflect_lanes, refract_about, refract_lanes};
 use crate::math::lanes::{channels, Real, V3};
+use crate::math::param::PerLane;
 use crate::math::{Vec2, Vec3};
 use crate::microfacet::reflection::ReflectionLobe;
-use crate::microfacet::{on_distribution, Beckmann, Distribution, Ggx, MicrofacetDistribution, MicrofacetKind, PerLane, Shadowing};
+use crate::microfacet::{on_distribution, Beckmann, Distribution, Ggx, MicrofacetDistribution, MicrofacetKind, Shadowing};
 use crate::props::Props;
 use crate::spectrum::Rgb;
 
@@ -175,7 +176,7 @@ impl RoughDielectric {
 
     /// The kernel of this model with the roughness (`ax`, `ay`) of each lane instead of its own (GGX and
     /// Beckmann without energy compensation; `None` otherwise): [`Bsdf::per_lane_kernel`](super::Bsdf::per_lane_kernel).
-    pub(crate) fn per_lane(&self, ax: PerLane, ay: PerLane) -> Option<PerLaneKernel> {
+    pub(crate) fn per_lane(&self, ax: PerLane, ay: PerLane) -> Option<PerLaneKernel<'static>> {
         if self.compensation.is_some() {
             return None;
         }

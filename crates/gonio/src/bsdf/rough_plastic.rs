@@ -65,7 +65,7 @@
 //! assert!(s.wi.z > 0.0 && (s.pdf - b.pdf(wo, s.wi)).abs() <= 1e-5 * s.pdf);
 //! ```
 
-use super::lanes::{f_one, flag_lanes, pdf_one, sample_one, LaneModel, LaneSample};
+use super::lanes::{f_one, flag_lanes, pdf_one, sample_one, LaneModel, LaneSample, PerLaneKernel};
 use super::plastic::{coated_diffuse, specular_probability, specular_sampling_weight, CoatingParams};
 use super::rough_conductor::{read_distribution, MicrofacetParams};
 use super::rough_dielectric::SplitLobes;
@@ -73,9 +73,10 @@ use super::{BsdfFlags, BsdfModel, BsdfSample, RoughDielectric};
 use crate::error::{Error, Result};
 use crate::fresnel::fresnel_dielectric_lanes;
 use crate::math::lanes::{channels, Real, V3};
+use crate::math::param::{Param, PerLane, PER_LANE};
 use crate::math::{Vec2, Vec3};
 use crate::microfacet::reflection::ReflectionLobe;
-use crate::microfacet::{on_distribution, Distribution, MicrofacetDistribution, MicrofacetKind, Shadowing};
+use crate::microfacet::{on_distribution, Beckmann, Distribution, Ggx, MicrofacetDistribution, MicrofacetKind, Shadowing};
 use crate::props::Props;
 use crate::sampling::warp::{cosine_hemisphere, cosine_hemisphere_density, cosine_hemisphere_pdf, sample_cosine_hemisphere};
 use crate::spectrum::Rgb;
@@ -472,7 +473,7 @@ impl BsdfModel for RoughPlastic {
             return Rgb::ZERO;
         }
         let diffuse = Rgb(coated_diffuse(
-            self.diffuse_reflectance,
+            self.diffuse_reflectance.0,
             self.transmittance(wo.z),
             self.transmittance(wi.z),
             self.coating.eta,
@@ -536,15 +537,16 @@ impl BsdfModel for RoughPlastic {
 /// coating's [`ReflectionLobe`] times F (what [`RoughDielectric::reflection`] is above the surface), the base
 /// [`coated_diffuse`]; each step is the one of [`RoughPlastic`]'s methods with selects for the early returns.
 #[derive(Clone, Copy, Debug)]
-pub struct PlasticLobe<'a, D> {
+pub struct PlasticLobe<'a, D, P = f32> {
     lobe: ReflectionLobe<D>,
     eta: f32,
     specular_reflectance: Rgb,
-    diffuse_reflectance: Rgb,
+    /// The base's reflectance per channel: the model's, or one per lane ([`RoughPlastic::per_lane`]).
+    diffuse_reflectance: [P; 3],
     internal_reflectance: f32,
     nonlinear: bool,
     /// The steering weight of the glossy lobe ([`specular_sampling_weight`]).
-    weight: f32,
+    weight: P,
     tables: &'a CoatingTables,
     /// The even table of T when the lookups use it (no graded nodes), chosen once per kernel.
     even: Option<&'a [f32; TABLE_SIZE]>,
@@ -560,26 +562,50 @@ impl RoughPlastic {
     /// up per lane and stay on the single calls).
     #[inline(always)]
     pub(crate) fn lanes(&self) -> Option<PlasticKernel<'_>> {
-        let c = &self.coating;
-        if c.compensation.is_some() {
+        if self.coating.compensation.is_some() {
             return None;
         }
-        let visible = c.sample_visible;
-        Some(on_distribution!(c.distribution, |d| PlasticKernel::from(PlasticLobe {
-            lobe: ReflectionLobe { distribution: d, shadowing: Shadowing::Smith, visible },
+        let weight = specular_sampling_weight(self.diffuse_reflectance, self.coating.specular_reflectance);
+        Some(on_distribution!(self.coating.distribution, |d| PlasticKernel::from(self.lobe(d, self.diffuse_reflectance.0, weight))))
+    }
+
+    /// The kernel with the base reflectance `rho` (per channel, one per lane: clamped to [0, 1] as a
+    /// texture's) instead of its own, each lane's steering weight from its reflectance (without energy
+    /// compensation; `None` otherwise): [`Bsdf::per_lane_kernel`](super::Bsdf::per_lane_kernel).
+    pub(crate) fn per_lane(&self, rho: [[f32; PER_LANE]; 3]) -> Option<PerLaneKernel<'_>> {
+        if self.coating.compensation.is_some() {
+            return None;
+        }
+        let spec = self.coating.specular_reflectance;
+        let weight = PerLane(std::array::from_fn(|l| specular_sampling_weight(Rgb::new(rho[0][l], rho[1][l], rho[2][l]), spec)));
+        let rho = rho.map(PerLane);
+        let (alpha_x, alpha_y) = (self.coating.distribution.alpha_x, self.coating.distribution.alpha_y);
+        match self.coating.distribution.kind {
+            MicrofacetKind::Ggx => Some(PerLaneKernel::PlasticGgx(self.lobe(Ggx { alpha_x, alpha_y }, rho, weight))),
+            MicrofacetKind::Beckmann => Some(PerLaneKernel::PlasticBeckmann(self.lobe(Beckmann { alpha_x, alpha_y }, rho, weight))),
+            MicrofacetKind::Blinn => None,
+        }
+    }
+
+    /// The lobes with the distribution `d`, the base reflectance `rho` and steering weight `weight`.
+    #[inline(always)]
+    fn lobe<D, P>(&self, d: D, rho: [P; 3], weight: P) -> PlasticLobe<'_, D, P> {
+        let c = &self.coating;
+        PlasticLobe {
+            lobe: ReflectionLobe { distribution: d, shadowing: Shadowing::Smith, visible: c.sample_visible },
             eta: c.eta,
             specular_reflectance: c.specular_reflectance,
-            diffuse_reflectance: self.diffuse_reflectance,
+            diffuse_reflectance: rho,
             internal_reflectance: self.tables.internal_reflectance,
             nonlinear: self.nonlinear,
-            weight: specular_sampling_weight(self.diffuse_reflectance, c.specular_reflectance),
+            weight,
             tables: &self.tables,
             even: self.tables.graded.is_none().then_some(&self.tables.transmittance),
-        })))
+        }
     }
 }
 
-impl<D: Distribution> PlasticLobe<'_, D> {
+impl<D: Distribution, P: Param> PlasticLobe<'_, D, P> {
     /// T(μ) per lane ([`CoatingTables::transmittance`]): the even table by [`Real::lerp_table`] (gathers in
     /// the AVX lanes), graded nodes (η < 1) by a search per lane.
     #[inline(always)]
@@ -607,7 +633,7 @@ impl<D: Distribution> PlasticLobe<'_, D> {
     }
 }
 
-impl<D: Distribution> LaneModel for PlasticLobe<'_, D> {
+impl<D: Distribution, P: Param> LaneModel for PlasticLobe<'_, D, P> {
     #[inline(always)]
     fn f_lanes<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> [R; 3] {
         let zero = R::splat(0.0);

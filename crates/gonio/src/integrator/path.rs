@@ -346,7 +346,7 @@ struct Shading<'a> {
     groups: [(u32, usize); W],
     n_groups: usize,
     /// Each group's kernel with a roughness per lane, if it has one (it runs instead of the model).
-    kernels: [Option<PerLaneKernel>; W],
+    kernels: [Option<PerLaneKernel<'a>>; W],
     /// The shading frames (s, t, n).
     frame: (V3<Float8>, V3<Float8>, V3<Float8>),
     wo: V3<Float8>,

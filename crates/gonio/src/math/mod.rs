@@ -6,6 +6,7 @@ pub mod avx2;
 pub mod avx512;
 pub mod frame;
 pub mod lanes;
+pub mod param;
 pub mod perspective;
 pub mod simd;
 pub mod spherical;

@@ -5,8 +5,8 @@
 //! number of steps (Jakob 2014). The exact `f64` Λ, [`beckmann_lambda`], is kept for tables and tests.
 
 use super::distribution::Distribution;
-use super::roughness::Roughness;
 use crate::math::lanes::{Real, V3};
+use crate::math::param::Param;
 use crate::numerics::erf::{erf_inv_lanes, erfc, erfc_lanes, erfcx_cf};
 use crate::numerics::exp_log::{exp_neg, exp_split, ln_unit, square_split};
 use crate::numerics::horner;
@@ -204,7 +204,7 @@ pub fn visible_slope_x<R: Real>(sin_theta: R, cos_theta: R, u: R) -> R {
     R::select(below_surface, R::splat(0.0), erf_inv_lanes(b))
 }
 
-impl<A: Roughness> Distribution for Beckmann<A> {
+impl<A: Param> Distribution for Beckmann<A> {
     #[inline(always)]
     fn alphas<R: Real>(&self) -> (R, R) {
         (self.alpha_x.lanes(), self.alpha_y.lanes())

@@ -3,8 +3,8 @@
 //! (Walter 2007 eq. 35) and Heitz 2018's visible-normal sampler.
 
 use super::distribution::Distribution;
-use super::roughness::Roughness;
 use crate::math::lanes::{Real, V3};
+use crate::math::param::Param;
 use crate::math::trig::sin_cos_turn;
 use std::f32::consts::PI;
 
@@ -17,7 +17,7 @@ pub struct Ggx<A = f32> {
     pub alpha_y: A,
 }
 
-impl<A: Roughness> Ggx<A> {
+impl<A: Param> Ggx<A> {
     /// D(ωm) = 1 / (π αx αy (s² + z²)²), zero below the surface (Walter 2007 eq. 33; Heitz 2014 §5).
     #[inline(always)]
     #[must_use]
@@ -136,7 +136,7 @@ impl<A: Roughness> Ggx<A> {
     }
 }
 
-impl<A: Roughness> Ggx<A> {
+impl<A: Param> Ggx<A> {
     /// tan²θm = u / ((1 − u) A(φ)) (Walter 2007 eq. 35 with the anisotropic A(φ)); ∞ at u = 1.
     #[inline(always)]
     fn tan2_of_sample<R: Real>(ux: R, a: R) -> R {
@@ -144,7 +144,7 @@ impl<A: Roughness> Ggx<A> {
     }
 }
 
-impl<A: Roughness> Distribution for Ggx<A> {
+impl<A: Param> Distribution for Ggx<A> {
     #[inline(always)]
     fn alphas<R: Real>(&self) -> (R, R) {
         (self.alpha_x.lanes(), self.alpha_y.lanes())

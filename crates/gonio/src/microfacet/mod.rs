@@ -68,7 +68,7 @@ pub mod distribution;
 pub mod ggx;
 pub mod gtr1;
 pub mod reflection;
-pub mod roughness;
+
 #[cfg(test)]
 mod tests;
 
@@ -78,7 +78,6 @@ pub use blinn::{alpha_from_blinn_exponent, blinn_exponent_from_alpha, Blinn};
 pub use distribution::Distribution;
 pub use ggx::Ggx;
 pub use gtr1::Gtr1;
-pub use roughness::{PerLane, Roughness, PER_LANE};
 
 use crate::math::lanes::V3;
 use crate::math::{Vec2, Vec3};

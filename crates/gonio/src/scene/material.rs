@@ -1,13 +1,13 @@
 //! Materials: a BSDF whose parameters may be textures. Evaluated at a hit into a plain [`Bsdf`]; an
 //! untextured material is that `Bsdf` already.
 
-use crate::bsdf::{Bsdf, Diffuse, PerLaneKernel, Tint};
+use crate::bsdf::{textured_reflectance, Bsdf, Diffuse, LaneValue, PerLaneKernel, Tint};
 use crate::error::{Error, Result};
 use crate::geometry::Mesh;
 use crate::math::lanes::Real;
+use crate::math::param::PER_LANE;
 use crate::math::simd::{Float8, Mask8};
 use crate::math::Frame;
-use crate::microfacet::PER_LANE;
 use crate::props::{Props, Value};
 use crate::spectrum::Rgb;
 use crate::texture::{MeshAttribute, SurfaceTexture, Texture};
@@ -79,8 +79,8 @@ pub enum Material {
 pub enum InLanes {
     /// It scales the model's values in this lobe.
     Tint(Tint),
-    /// It is a roughness of the model: a kernel with each lane's roughness ([`Bsdf::per_lane_kernel`]).
-    Roughness,
+    /// The model takes it per lane: a kernel with each lane's value ([`Bsdf::per_lane_kernel`]).
+    Value,
 }
 
 /// What the lanes of a packet on one slotted material run ([`Material::lanes_at`]): `kernel` (a
@@ -89,7 +89,7 @@ pub enum InLanes {
 #[derive(Clone, Copy, Debug)]
 pub struct LaneMaterial<'a> {
     pub model: &'a Bsdf,
-    pub kernel: Option<PerLaneKernel>,
+    pub kernel: Option<PerLaneKernel<'a>>,
     pub tinted: bool,
     pub tints: [[Float8; 3]; 2],
 }
@@ -125,7 +125,7 @@ impl Slot {
         fn visit(model: &mut Bsdf, route: &[(usize, usize)], name: &str, value: &TextureValue) -> bool {
             match (route, value) {
                 ([], TextureValue::Scalar(v)) => model.set_float(name, *v),
-                ([], TextureValue::Colour(c)) => model.reflectance_slot(name).map(|r| *r = c.map(|v| v.clamp(0.0, 1.0))).is_some(),
+                ([], TextureValue::Colour(c)) => model.reflectance_slot(name).map(|r| *r = c.map(textured_reflectance)).is_some(),
                 ([(k, count), rest @ ..], _) => {
                     let mut ok = true;
                     let reached = model.for_nested_models(*k, *count, &mut |m| ok &= visit(m, rest, name, value));
@@ -234,10 +234,15 @@ impl Material {
             if !matches!(texture, SurfaceTexture::Uv(_)) {
                 return None;
             }
+            let probe = match lookup {
+                Lookup::Float => LaneValue::Float([0.5; PER_LANE]),
+                _ => LaneValue::Colour([[0.5; PER_LANE]; 3]),
+            };
             match lookup {
-                Lookup::Float if slot.route.is_empty() => {
-                    model.per_lane_kernel([(slot.name.as_str(), [0.5; PER_LANE])])?;
-                    how.push(InLanes::Roughness);
+                Lookup::Float | Lookup::Colour
+                    if slot.route.is_empty() && model.per_lane_kernel([(slot.name.as_str(), probe)]).is_some() =>
+                {
+                    how.push(InLanes::Value);
                 }
                 Lookup::Colour => {
                     let mut leaf = &mut base;
@@ -350,7 +355,7 @@ impl Material {
     /// A texture value as a reflectance: clamped to [0, 1].
     #[inline]
     fn clamped(c: crate::spectrum::Rgb) -> crate::spectrum::Rgb {
-        c.map(|v| v.clamp(0.0, 1.0))
+        c.map(textured_reflectance)
     }
 
     /// For a `diffuse` material (textured or not), its reflectance at `uv` — what [`Self::at`] would build a
@@ -389,7 +394,7 @@ impl Material {
     pub fn lanes_at(&self, u: Float8, v: Float8, lanes: u32) -> Option<LaneMaterial<'_>> {
         let Material::Slotted { textures, in_lanes: Some((model, how)), .. } = self else { return None };
         let mut tints = [[Float8::splat(1.0); 3]; 2];
-        let (mut tinted, mut rough) = (false, false);
+        let (mut tinted, mut per_lane) = (false, false);
         for ((_, texture, _), how) in textures.iter().zip(how) {
             let SurfaceTexture::Uv(t) = texture else { return None };
             match how {
@@ -402,19 +407,30 @@ impl Material {
                     *tint = std::array::from_fn(|i| tint[i] * c[i]);
                     tinted = true;
                 }
-                InLanes::Roughness => rough = true,
+                InLanes::Value => per_lane = true,
             }
         }
         let mut kernel = None;
-        if rough {
-            // The other lanes hold a valid roughness, so that the kernel's numbers stay tame there.
+        if per_lane {
+            // The other lanes hold a valid value, so that the kernel's numbers stay tame there.
             let (m, mut finite) = (Mask8::from_bitmask(lanes), true);
-            let values = textures.iter().zip(how).filter(|(_, how)| **how == InLanes::Roughness).filter_map(|((slot, texture, _), _)| {
-                let SurfaceTexture::Uv(t) = texture else { return None };
-                let value = t.eval_1_lanes(u, v, lanes);
-                finite &= !Float8::any(m & !value.is_finite());
-                Some((slot.name.as_str(), Float8::select(m, value, Float8::splat(1.0)).to_array()))
-            });
+            let mut lane_value = |v: Float8, other: f32| {
+                finite &= !Float8::any(m & !v.is_finite());
+                Float8::select(m, v, Float8::splat(other)).to_array()
+            };
+            let values: Vec<(&str, LaneValue)> = textures
+                .iter()
+                .zip(how)
+                .filter(|(_, how)| **how == InLanes::Value)
+                .filter_map(|((slot, texture, lookup), _)| {
+                    let SurfaceTexture::Uv(t) = texture else { return None };
+                    let value = match lookup {
+                        Lookup::Float => LaneValue::Float(lane_value(t.eval_1_lanes(u, v, lanes), 1.0)),
+                        _ => LaneValue::Colour(t.eval_lanes(u, v, lanes).map(|c| lane_value(c, 0.5))),
+                    };
+                    Some((slot.name.as_str(), value))
+                })
+                .collect();
             kernel = model.per_lane_kernel(values);
             if !finite || kernel.is_none() {
                 return None;
@@ -427,14 +443,7 @@ impl Material {
     /// each lane).
     #[inline]
     fn texels(t: &Texture, u: Float8, v: Float8, lanes: u32) -> [Float8; 3] {
-        match t {
-            Texture::Bitmap(b) => b.eval_lanes(u, v, lanes).map(|c| Real::clamp(c, 0.0, 1.0)),
-            Texture::Checkerboard(c) => {
-                let first = c.same_side_lanes(u, v);
-                let (c0, c1) = (Self::clamped(c.color0), Self::clamped(c.color1));
-                std::array::from_fn(|i| Float8::select(first, Float8::splat(c0.0[i]), Float8::splat(c1.0[i])))
-            }
-        }
+        t.eval_lanes(u, v, lanes).map(|c| Real::clamp(c, 0.0, 1.0)) // textured_reflectance in lanes
     }
 
     /// The BSDF at texture coordinates `uv`. A texture's value outside its parameter's range is clamped

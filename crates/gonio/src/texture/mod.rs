@@ -73,6 +73,20 @@ impl Texture {
         }
     }
 
+    /// [`Self::eval`] in lanes, at texture coordinates (`u`, `v`) of the lanes set in `lanes` (the others
+    /// unspecified): the same values as one lane at a time.
+    #[inline]
+    #[must_use]
+    pub fn eval_lanes(&self, u: Float8, v: Float8, lanes: u32) -> [Float8; 3] {
+        match self {
+            Texture::Bitmap(b) => b.eval_lanes(u, v, lanes),
+            Texture::Checkerboard(c) => {
+                let first = c.same_side_lanes(u, v);
+                std::array::from_fn(|i| Float8::select(first, Float8::splat(c.color0.0[i]), Float8::splat(c.color1.0[i])))
+            }
+        }
+    }
+
     /// [`Self::eval_1`] in lanes, at texture coordinates (`u`, `v`) of the lanes set in `lanes` (the others
     /// unspecified): the same values as one lane at a time.
     #[inline]
