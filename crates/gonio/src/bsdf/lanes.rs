@@ -20,7 +20,7 @@
 
 use super::conductor::Conductor;
 use super::dielectric::Dielectric;
-use super::plastic::Plastic;
+use super::plastic::CoatedMirror;
 use super::polarizer::Polarizer;
 use super::principled::PrincipledLobes;
 use super::rough_conductor::{ConductorKernel, ConductorLobe};
@@ -159,13 +159,13 @@ pub enum LaneKernel<'a> {
     SmoothConductor(&'a Conductor),
     Dielectric(&'a Dielectric),
     ThinDielectric(&'a ThinDielectric),
-    Plastic(&'a Plastic),
+    Plastic(CoatedMirror<f32>),
     Polarizer(&'a Polarizer),
     Principled(PrincipledLobes),
 }
 
 /// The kernel of a model with a parameter given per lane ([`Bsdf::per_lane_kernel`]): a textured roughness
-/// (of the rough conductors and dielectric) or base reflectance (of the rough plastic) in the path tracer's
+/// (of the rough conductors and dielectric) or base reflectance (of the plastics) in the path tracer's
 /// packets runs one kernel call for all the lanes on it, each lane with its own value, instead of a model
 /// and a call per lane. The same lobes as the models' own kernels, over a [`PerLane`] parameter. Read in at
 /// most [`crate::math::param::PER_LANE`] lanes.
@@ -175,8 +175,9 @@ pub enum PerLaneKernel<'a> {
     ConductorBeckmann(ConductorLobe<Beckmann<PerLane>>),
     DielectricGgx(DielectricLobe<Ggx<PerLane>>),
     DielectricBeckmann(DielectricLobe<Beckmann<PerLane>>),
-    PlasticGgx(PlasticLobe<'a, Ggx, PerLane>),
-    PlasticBeckmann(PlasticLobe<'a, Beckmann, PerLane>),
+    RoughPlasticGgx(PlasticLobe<'a, Ggx, PerLane>),
+    RoughPlasticBeckmann(PlasticLobe<'a, Beckmann, PerLane>),
+    Plastic(CoatedMirror<PerLane>),
 }
 
 /// Each kernel of [`PerLaneKernel`], bound to `$k` in `$body`.
@@ -187,8 +188,9 @@ macro_rules! on_per_lane {
             PerLaneKernel::ConductorBeckmann($k) => $body,
             PerLaneKernel::DielectricGgx($k) => $body,
             PerLaneKernel::DielectricBeckmann($k) => $body,
-            PerLaneKernel::PlasticGgx($k) => $body,
-            PerLaneKernel::PlasticBeckmann($k) => $body,
+            PerLaneKernel::RoughPlasticGgx($k) => $body,
+            PerLaneKernel::RoughPlasticBeckmann($k) => $body,
+            PerLaneKernel::Plastic($k) => $body,
         }
     };
 }
@@ -225,7 +227,7 @@ impl Bsdf {
             Bsdf::Conductor(m) => Some(LaneKernel::SmoothConductor(m)),
             Bsdf::Dielectric(m) => Some(LaneKernel::Dielectric(m)),
             Bsdf::ThinDielectric(m) => Some(LaneKernel::ThinDielectric(m)),
-            Bsdf::Plastic(m) => Some(LaneKernel::Plastic(m)),
+            Bsdf::Plastic(m) => m.lanes().map(LaneKernel::Plastic),
             Bsdf::Polarizer(m) => Some(LaneKernel::Polarizer(m)),
             Bsdf::Principled(m) => m.lanes().map(LaneKernel::Principled),
             _ => None,

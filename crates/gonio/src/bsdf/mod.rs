@@ -844,7 +844,8 @@ impl Bsdf {
     /// are clamped; the others the model's own): what each lane's model with those values written into it
     /// computes, in one kernel call for all lanes. The parameters: the roughness of the models whose
     /// roughness [`Self::set_float`] sets (except Blinn's, whose exponent is one number), and the base
-    /// reflectance of `roughplastic` without energy compensation; `None` for other models and parameters.
+    /// reflectance of `plastic` and of `roughplastic` without energy compensation; `None` for other models and
+    /// parameters.
     pub fn per_lane_kernel<'n>(&self, values: impl IntoIterator<Item = (&'n str, LaneValue)>) -> Option<PerLaneKernel<'_>> {
         match self {
             Bsdf::RoughConductor(RoughConductor(c)) | Bsdf::TorranceSparrow(TorranceSparrow(c)) => {
@@ -855,14 +856,8 @@ impl Bsdf {
                 let (ax, ay) = roughness_lanes(&d.distribution, values)?;
                 d.per_lane(ax, ay)
             }
-            Bsdf::RoughPlastic(p) => {
-                let mut rho = p.diffuse_reflectance.0.map(|c| [c; PER_LANE]);
-                for value in values {
-                    let ("diffuse_reflectance", LaneValue::Colour(c)) = value else { return None };
-                    rho = c.map(|channel| channel.map(textured_reflectance));
-                }
-                p.per_lane(rho)
-            }
+            Bsdf::RoughPlastic(p) => p.per_lane(base_reflectance_lanes(p.diffuse_reflectance, values)?),
+            Bsdf::Plastic(p) => Some(PerLaneKernel::Plastic(p.per_lane(base_reflectance_lanes(p.diffuse_reflectance, values)?))),
             _ => None,
         }
     }
@@ -962,6 +957,17 @@ pub enum LaneValue {
 #[must_use]
 pub fn textured_reflectance(value: f32) -> f32 {
     value.clamp(0.0, 1.0)
+}
+
+/// A plastic's base reflectance per lane: `diffuse_reflectance` in `values` (clamped as a texture's,
+/// [`textured_reflectance`]), else `own`; `None` for any other parameter.
+fn base_reflectance_lanes<'n>(own: Rgb, values: impl IntoIterator<Item = (&'n str, LaneValue)>) -> Option<[[f32; PER_LANE]; 3]> {
+    let mut rho = own.0.map(|c| [c; PER_LANE]);
+    for value in values {
+        let ("diffuse_reflectance", LaneValue::Colour(c)) = value else { return None };
+        rho = c.map(|channel| channel.map(textured_reflectance));
+    }
+    Some(rho)
 }
 
 /// The roughness per lane of `distribution` with the roughness parameters in `values` (clamped as a
@@ -1148,7 +1154,7 @@ mod tests {
     /// A kernel with a parameter per lane ([`Bsdf::per_lane_kernel`]) gives in each lane what that lane's
     /// model — the value written into it with [`Bsdf::set_float`] or [`Bsdf::reflectance_slot`], clamped
     /// as a texture's — gives in its single calls, bit for bit: `f`, `pdf` and `sample` in the path
-    /// tracer's lanes, for GGX and Beckmann, conductors, the dielectric and the rough plastic, each
+    /// tracer's lanes, for GGX and Beckmann, conductors, the dielectric and the plastics, each
     /// roughness parameter and the plastic's base reflectance, over roughnesses from 0 (clamped to 10⁻⁴)
     /// to beyond 10 and reflectances beyond [0, 1], every lane a different one. Models and parameters it
     /// does not cover have none.
@@ -1170,6 +1176,8 @@ mod tests {
             (r#"{"type": "roughplastic"}"#, "diffuse_reflectance"),
             (r#"{"type": "roughplastic", "distribution": "ggx", "alpha": 0.3, "nonlinear": true}"#, "diffuse_reflectance"),
             (r#"{"type": "roughplastic", "distribution": "ggx", "int_ior": 1.0, "ext_ior": 1.5}"#, "diffuse_reflectance"),
+            (r#"{"type": "plastic"}"#, "diffuse_reflectance"),
+            (r#"{"type": "plastic", "nonlinear": true, "specular_reflectance": 0.4}"#, "diffuse_reflectance"),
         ];
         let mut rng = Pcg32::new(17, 0);
         let dir = |rng: &mut Pcg32| {

@@ -52,7 +52,7 @@ use super::{BsdfFlags, BsdfModel, BsdfSample};
 use crate::error::Result;
 use crate::fresnel::{fresnel_dielectric_lanes, fresnel_diffuse_reflectance, reflect_lanes};
 use crate::math::lanes::{channels, Real, V3};
-use crate::math::param::Param;
+use crate::math::param::{Param, PerLane, PER_LANE};
 use crate::math::{Vec2, Vec3};
 use crate::props::Props;
 use crate::sampling::warp::{cosine_hemisphere, cosine_hemisphere_density};
@@ -159,17 +159,53 @@ impl Plastic {
         Ok(Plastic { specular_reflectance: c.specular_reflectance, ..Plastic::new(c.eta, c.diffuse_reflectance, c.nonlinear) })
     }
 
+    /// Its lane code ([`CoatedMirror`]) with its own parameters: runs every configuration (the batch
+    /// methods' `lane_batch_methods!`).
+    #[inline(always)]
+    pub(crate) fn lanes(&self) -> Option<CoatedMirror<f32>> {
+        Some(self.with_base(self.diffuse_reflectance.0, specular_sampling_weight(self.diffuse_reflectance, self.specular_reflectance)))
+    }
+
+    /// Its lane code with the base reflectance `rho` (per channel, one per lane, clamped to [0, 1] as a
+    /// texture's) instead of its own, each lane's steering weight from its reflectance:
+    /// [`Bsdf::per_lane_kernel`](super::Bsdf::per_lane_kernel).
+    pub(crate) fn per_lane(&self, rho: [[f32; PER_LANE]; 3]) -> CoatedMirror<PerLane> {
+        let spec = self.specular_reflectance;
+        let weight = PerLane(std::array::from_fn(|l| specular_sampling_weight(Rgb::new(rho[0][l], rho[1][l], rho[2][l]), spec)));
+        self.with_base(rho.map(PerLane), weight)
+    }
+
+    #[inline(always)]
+    fn with_base<P>(&self, rho: [P; 3], weight: P) -> CoatedMirror<P> {
+        CoatedMirror {
+            eta: self.eta,
+            diffuse_reflectance: rho,
+            specular_reflectance: self.specular_reflectance,
+            nonlinear: self.nonlinear,
+            internal_reflectance: self.internal_reflectance,
+            weight,
+        }
+    }
+}
+
+/// [`Plastic`] in lanes ([`LaneModel`]): its single calls run it for one pair, the batches and the path
+/// tracer's packets for a register of them — with the model's base reflectance, or one per lane.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CoatedMirror<P> {
+    eta: f32,
+    diffuse_reflectance: [P; 3],
+    specular_reflectance: Rgb,
+    nonlinear: bool,
+    internal_reflectance: f32,
+    /// The steering weight of the mirror ([`specular_sampling_weight`]).
+    weight: P,
+}
+
+impl<P: Param> CoatedMirror<P> {
     /// The probability of sampling the mirror at cos θo.
     #[inline(always)]
     fn specular_probability<R: Real>(&self, cos_theta_o: R) -> R {
-        let w = specular_sampling_weight(self.diffuse_reflectance, self.specular_reflectance);
-        specular_probability(fresnel_dielectric_lanes(cos_theta_o, self.eta), w)
-    }
-
-    /// Itself: its lane code runs every configuration (the batch methods' `lane_batch_methods!`).
-    #[inline(always)]
-    fn lanes(&self) -> Option<&Self> {
-        Some(self)
+        specular_probability(fresnel_dielectric_lanes(cos_theta_o, self.eta), self.weight)
     }
 }
 
@@ -179,23 +215,21 @@ impl BsdfModel for Plastic {
     }
 
     fn f(&self, wo: Vec3, wi: Vec3) -> Rgb {
-        f_one(self, wo, wi)
+        f_one(&self.lanes().expect("every plastic has lane code"), wo, wi)
     }
 
     fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
-        sample_one(self, wo, uc, u)
+        sample_one(&self.lanes().expect("every plastic has lane code"), wo, uc, u)
     }
 
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        pdf_one(self, wo, wi)
+        pdf_one(&self.lanes().expect("every plastic has lane code"), wo, wi)
     }
 
     lane_batch_methods!(lanes);
 }
 
-/// The model in lanes ([`LaneModel`]): its single calls run it for one pair, the batches and the path
-/// tracer's packets for a register of them.
-impl LaneModel for Plastic {
+impl<P: Param> LaneModel for CoatedMirror<P> {
     /// The diffuse lobe (the mirror is a delta: 0 here).
     #[inline(always)]
     fn f_lanes<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> [R; 3] {
@@ -203,7 +237,7 @@ impl LaneModel for Plastic {
         let above = wo.z.gt(zero) & wi.z.gt(zero);
         let one = R::splat(1.0);
         let (t_o, t_i) = (one - fresnel_dielectric_lanes(wo.z, self.eta), one - fresnel_dielectric_lanes(wi.z, self.eta));
-        let diffuse = coated_diffuse(self.diffuse_reflectance.0, t_o, t_i, self.eta, self.internal_reflectance, self.nonlinear);
+        let diffuse = coated_diffuse(self.diffuse_reflectance, t_o, t_i, self.eta, self.internal_reflectance, self.nonlinear);
         channels!(|c| R::select(above, diffuse[c], zero))
     }
 

@@ -581,8 +581,8 @@ impl RoughPlastic {
         let rho = rho.map(PerLane);
         let (alpha_x, alpha_y) = (self.coating.distribution.alpha_x, self.coating.distribution.alpha_y);
         match self.coating.distribution.kind {
-            MicrofacetKind::Ggx => Some(PerLaneKernel::PlasticGgx(self.lobe(Ggx { alpha_x, alpha_y }, rho, weight))),
-            MicrofacetKind::Beckmann => Some(PerLaneKernel::PlasticBeckmann(self.lobe(Beckmann { alpha_x, alpha_y }, rho, weight))),
+            MicrofacetKind::Ggx => Some(PerLaneKernel::RoughPlasticGgx(self.lobe(Ggx { alpha_x, alpha_y }, rho, weight))),
+            MicrofacetKind::Beckmann => Some(PerLaneKernel::RoughPlasticBeckmann(self.lobe(Beckmann { alpha_x, alpha_y }, rho, weight))),
             MicrofacetKind::Blinn => None,
         }
     }
