@@ -600,7 +600,7 @@ fn direct_is_the_path_tracer_at_depth_two() {
 /// A textured material whose textures only tint its model (a conductor's `specular_reflectance`, a
 /// dielectric's `specular_reflectance` and `specular_transmittance`, also inside a `twosided`) or set its
 /// roughness (`alpha`, `alpha_u`, `alpha_v` of the rough conductors and dielectric, GGX and Beckmann) or
-/// base reflectance (`plastic`, `roughplastic`) runs one model — or one kernel with each lane's value — for all its
+/// base colour (`plastic`, `roughplastic`, `principled`) runs one model — or one kernel with each lane's value — for all its
 /// lanes in the packets and scales
 /// each lane's values by its texels (`Material::lanes_at`). The scalar `direct` integrator, which builds
 /// each hit's model with the texel written into it, is its reference: every camera sample's radiance the
@@ -654,6 +654,10 @@ fn tinted_and_per_lane_textures_in_packets_are_the_textured_models() {
             checker("diffuse_reflectance", "0.2, 0.7, 0.9", "0.8, 0.8, 0.1")
         ),
         format!(r#"<bsdf type="plastic">{}</bsdf>"#, checker("diffuse_reflectance", "0.1, 0.5, 0.9", "0.9, 0.5, 0.1")),
+        format!(
+            r#"<bsdf type="principled"><float name="metallic" value="0.3"/><float name="spec_trans" value="0.4"/><float name="clearcoat" value="0.5"/>{}</bsdf>"#,
+            checker("base_color", "0.9, 0.3, 0.1", "0.1, 0.6, 0.8")
+        ),
     ];
     let shapes = spheres_in_rows(&spheres, 4);
     let xml = format!(
@@ -672,7 +676,7 @@ fn tinted_and_per_lane_textures_in_packets_are_the_textured_models() {
     let half = gonio::math::simd::Float8::splat(0.5);
     let in_lanes: Vec<_> = s.materials.iter().filter_map(|m| m.lanes_at(half, half, 1)).collect();
     assert_eq!(in_lanes.len(), spheres.len(), "every sphere's material is in the lane form");
-    assert_eq!(in_lanes.iter().filter(|m| m.kernel.is_some()).count(), 7, "the rough ones and the plastics with a parameter per lane");
+    assert_eq!(in_lanes.iter().filter(|m| m.kernel.is_some()).count(), 8, "the rough ones, the plastics and the principled with a parameter per lane");
     let samples: Vec<CameraSample> =
         (0..32).flat_map(|y| (0..32).flat_map(move |x| (0..4).map(move |k| CameraSample { x, y, k }))).collect();
     let (mut packets, mut each) = (vec![gonio::spectrum::Rgb::ZERO; samples.len()], vec![gonio::spectrum::Rgb::ZERO; samples.len()]);

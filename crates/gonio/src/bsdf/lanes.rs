@@ -165,10 +165,13 @@ pub enum LaneKernel<'a> {
 }
 
 /// The kernel of a model with a parameter given per lane ([`Bsdf::per_lane_kernel`]): a textured roughness
-/// (of the rough conductors and dielectric) or base reflectance (of the plastics) in the path tracer's
+/// (of the rough conductors and dielectric) or base colour (of the plastics and `principled`) in the path tracer's
 /// packets runs one kernel call for all the lanes on it, each lane with its own value, instead of a model
 /// and a call per lane. The same lobes as the models' own kernels, over a [`PerLane`] parameter. Read in at
 /// most [`crate::math::param::PER_LANE`] lanes.
+// The variants differ in size (`principled`'s constants per lane are the largest, ~0.7 KB): built on the
+// stack once per packet and material, never boxed (an allocation per packet would cost more).
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Copy, Debug)]
 pub enum PerLaneKernel<'a> {
     ConductorGgx(ConductorLobe<Ggx<PerLane>>),
@@ -178,6 +181,7 @@ pub enum PerLaneKernel<'a> {
     RoughPlasticGgx(PlasticLobe<'a, Ggx, PerLane>),
     RoughPlasticBeckmann(PlasticLobe<'a, Beckmann, PerLane>),
     Plastic(CoatedMirror<PerLane>),
+    Principled(PrincipledLobes<PerLane>),
 }
 
 /// Each kernel of [`PerLaneKernel`], bound to `$k` in `$body`.
@@ -191,6 +195,7 @@ macro_rules! on_per_lane {
             PerLaneKernel::RoughPlasticGgx($k) => $body,
             PerLaneKernel::RoughPlasticBeckmann($k) => $body,
             PerLaneKernel::Plastic($k) => $body,
+            PerLaneKernel::Principled($k) => $body,
         }
     };
 }

@@ -844,8 +844,8 @@ impl Bsdf {
     /// are clamped; the others the model's own): what each lane's model with those values written into it
     /// computes, in one kernel call for all lanes. The parameters: the roughness of the models whose
     /// roughness [`Self::set_float`] sets (except Blinn's, whose exponent is one number), and the base
-    /// reflectance of `plastic` and of `roughplastic` without energy compensation; `None` for other models and
-    /// parameters.
+    /// reflectance of `plastic` and of `roughplastic` without energy compensation, and `principled`'s
+    /// `base_color`; `None` for other models and parameters.
     pub fn per_lane_kernel<'n>(&self, values: impl IntoIterator<Item = (&'n str, LaneValue)>) -> Option<PerLaneKernel<'_>> {
         match self {
             Bsdf::RoughConductor(RoughConductor(c)) | Bsdf::TorranceSparrow(TorranceSparrow(c)) => {
@@ -856,8 +856,11 @@ impl Bsdf {
                 let (ax, ay) = roughness_lanes(&d.distribution, values)?;
                 d.per_lane(ax, ay)
             }
-            Bsdf::RoughPlastic(p) => p.per_lane(base_reflectance_lanes(p.diffuse_reflectance, values)?),
-            Bsdf::Plastic(p) => Some(PerLaneKernel::Plastic(p.per_lane(base_reflectance_lanes(p.diffuse_reflectance, values)?))),
+            Bsdf::RoughPlastic(p) => p.per_lane(colour_lanes("diffuse_reflectance", p.diffuse_reflectance, values)?),
+            Bsdf::Plastic(p) => {
+                Some(PerLaneKernel::Plastic(p.per_lane(colour_lanes("diffuse_reflectance", p.diffuse_reflectance, values)?)))
+            }
+            Bsdf::Principled(p) => Some(PerLaneKernel::Principled(p.per_lane(colour_lanes("base_color", p.base_color, values)?))),
             _ => None,
         }
     }
@@ -959,12 +962,15 @@ pub fn textured_reflectance(value: f32) -> f32 {
     value.clamp(0.0, 1.0)
 }
 
-/// A plastic's base reflectance per lane: `diffuse_reflectance` in `values` (clamped as a texture's,
+/// A colour parameter per lane: the colour `name` in `values` (clamped as a texture's,
 /// [`textured_reflectance`]), else `own`; `None` for any other parameter.
-fn base_reflectance_lanes<'n>(own: Rgb, values: impl IntoIterator<Item = (&'n str, LaneValue)>) -> Option<[[f32; PER_LANE]; 3]> {
+fn colour_lanes<'n>(name: &str, own: Rgb, values: impl IntoIterator<Item = (&'n str, LaneValue)>) -> Option<[[f32; PER_LANE]; 3]> {
     let mut rho = own.0.map(|c| [c; PER_LANE]);
     for value in values {
-        let ("diffuse_reflectance", LaneValue::Colour(c)) = value else { return None };
+        let (n, LaneValue::Colour(c)) = value else { return None };
+        if n != name {
+            return None;
+        }
         rho = c.map(|channel| channel.map(textured_reflectance));
     }
     Some(rho)
@@ -1154,8 +1160,8 @@ mod tests {
     /// A kernel with a parameter per lane ([`Bsdf::per_lane_kernel`]) gives in each lane what that lane's
     /// model — the value written into it with [`Bsdf::set_float`] or [`Bsdf::reflectance_slot`], clamped
     /// as a texture's — gives in its single calls, bit for bit: `f`, `pdf` and `sample` in the path
-    /// tracer's lanes, for GGX and Beckmann, conductors, the dielectric and the plastics, each
-    /// roughness parameter and the plastic's base reflectance, over roughnesses from 0 (clamped to 10⁻⁴)
+    /// tracer's lanes, for GGX and Beckmann, conductors, the dielectric, the plastics and `principled`, each
+    /// roughness parameter and the base colours, over roughnesses from 0 (clamped to 10⁻⁴)
     /// to beyond 10 and reflectances beyond [0, 1], every lane a different one. Models and parameters it
     /// does not cover have none.
     #[test]
@@ -1178,6 +1184,9 @@ mod tests {
             (r#"{"type": "roughplastic", "distribution": "ggx", "int_ior": 1.0, "ext_ior": 1.5}"#, "diffuse_reflectance"),
             (r#"{"type": "plastic"}"#, "diffuse_reflectance"),
             (r#"{"type": "plastic", "nonlinear": true, "specular_reflectance": 0.4}"#, "diffuse_reflectance"),
+            (r#"{"type": "principled"}"#, "base_color"),
+            (r#"{"type": "principled", "metallic": 0.4, "sheen": 0.5, "clearcoat": 0.6, "flatness": 0.3, "spec_tint": 0.5}"#, "base_color"),
+            (r#"{"type": "principled", "spec_trans": 0.7, "roughness": 0.3}"#, "base_color"),
         ];
         let mut rng = Pcg32::new(17, 0);
         let dir = |rng: &mut Pcg32| {
@@ -1186,7 +1195,7 @@ mod tests {
         };
         for (json, name) in cases {
             let model = Bsdf::from_json(json).unwrap();
-            let colour = name == "diffuse_reflectance";
+            let colour = name == "diffuse_reflectance" || name == "base_color";
             let mut sampled = 0;
             for _ in 0..400 {
                 // Roughness from 0 to 10^1.2 (log-uniform), and the ends beyond the range; reflectances in
@@ -1248,6 +1257,8 @@ mod tests {
             (r#"{"type": "roughconductor"}"#, "specular_reflectance", LaneValue::Colour([[0.3; PER_LANE]; 3])),
             (r#"{"type": "roughconductor"}"#, "alpha", LaneValue::Colour([[0.3; PER_LANE]; 3])),
             (r#"{"type": "diffuse"}"#, "alpha", float),
+            (r#"{"type": "principled"}"#, "roughness", float),
+            (r#"{"type": "plastic"}"#, "base_color", LaneValue::Colour([[0.3; PER_LANE]; 3])),
         ];
         for (json, name, value) in none {
             assert!(Bsdf::from_json(json).unwrap().per_lane_kernel([(name, value)]).is_none(), "{json} {name}");

@@ -92,6 +92,7 @@ use super::{BsdfFlags, BsdfModel, BsdfSample};
 use crate::error::{Error, Result};
 use crate::fresnel::{fresnel_dielectric_lanes, reflect_lanes, refract_lanes};
 use crate::math::lanes::{channels, Real, V3};
+use crate::math::param::{Param, PerLane, PER_LANE};
 use crate::math::{Vec2, Vec3};
 use crate::microfacet::reflection::ReflectionLobe;
 use crate::microfacet::{Distribution, Ggx, Gtr1, Shadowing};
@@ -276,11 +277,44 @@ impl Principled {
     pub(crate) fn lanes(&self) -> Option<PrincipledLobes> {
         Some(self.lobes())
     }
+
+    /// The kernel with the `base_color` `base` (per channel, one per lane, clamped to [0, 1] as a
+    /// texture's) instead of its own: each lane's constants are its model's ([`Self::lobes`]), the ones
+    /// the colour sets gathered per lane. [`Bsdf::per_lane_kernel`](super::Bsdf::per_lane_kernel).
+    pub(crate) fn per_lane(&self, base: [[f32; PER_LANE]; 3]) -> PrincipledLobes<PerLane> {
+        let lanes: [PrincipledLobes; PER_LANE] =
+            std::array::from_fn(|l| Principled { base_color: Rgb::new(base[0][l], base[1][l], base[2][l]), ..self.clone() }.lobes());
+        let gather = |field: fn(&PrincipledLobes) -> [f32; 3]| -> [PerLane; 3] {
+            std::array::from_fn(|c| PerLane(std::array::from_fn(|l| field(&lanes[l])[c])))
+        };
+        let k = &lanes[0];
+        PrincipledLobes {
+            spec: k.spec,
+            glass: k.glass,
+            eta: k.eta,
+            fresnel_dielectric: k.fresnel_dielectric,
+            fresnel_a: gather(|k| k.fresnel_a),
+            fresnel_b: gather(|k| k.fresnel_b),
+            w_transmit: k.w_transmit,
+            diffuse: gather(|k| k.diffuse),
+            two_roughness: k.two_roughness,
+            flatness: k.flatness,
+            sheen: gather(|k| k.sheen),
+            clearcoat: k.clearcoat,
+            gtr1: k.gtr1,
+            coat_masking: k.coat_masking,
+            transmitted: gather(|k| k.transmitted),
+            spec_rate: k.spec_rate,
+            clearcoat_weight: k.clearcoat_weight,
+            diffuse_weight: k.diffuse_weight,
+        }
+    }
 }
 
-/// The constants of one [`Principled`] that its lane code reads ([`LaneModel`]).
+/// The constants of one [`Principled`] that its lane code reads ([`LaneModel`]); those that `base_color`
+/// sets are of type `C`: one value, or one per lane ([`Principled::per_lane`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct PrincipledLobes {
+pub struct PrincipledLobes<C = f32> {
     /// The main specular reflection: GGX, Smith, visible normals.
     spec: ReflectionLobe<Ggx>,
     /// The same distribution as a rough dielectric of index η: the transmission lobe.
@@ -288,22 +322,22 @@ pub struct PrincipledLobes {
     eta: f32,
     /// F_p = `fresnel_dielectric` F + `fresnel_a` + `fresnel_b` w (module doc), from above.
     fresnel_dielectric: f32,
-    fresnel_a: [f32; 3],
-    fresnel_b: [f32; 3],
+    fresnel_a: [C; 3],
+    fresnel_b: [C; 3],
     /// w_t = (1 − m) t: the interface's weight from below and the transmission's.
     w_transmit: f32,
     /// w_d `base_color` / π.
-    diffuse: [f32; 3],
+    diffuse: [C; 3],
     two_roughness: f32,
     flatness: f32,
     /// `sheen` (1 − m) mix(1, c_tint, `sheen_tint`).
-    sheen: [f32; 3],
+    sheen: [C; 3],
     /// ¼ `clearcoat`.
     clearcoat: f32,
     gtr1: Gtr1,
     coat_masking: Ggx,
     /// √`base_color` w_t.
-    transmitted: [f32; 3],
+    transmitted: [C; 3],
     spec_rate: f32,
     clearcoat_weight: f32,
     diffuse_weight: f32,
@@ -325,7 +359,7 @@ struct LobeChoice<R: Real> {
     reflection: R,
 }
 
-impl PrincipledLobes {
+impl<C: Param> PrincipledLobes<C> {
     /// Schlick's weight of the Schlick terms at cos = ωo·ωh > 0 (from above): of cos where η > 1, else
     /// of the refracted cosine √(1 − (1 − cos²)/η²) (Mitsuba's rule; 0 past the critical angle).
     #[inline(always)]
@@ -388,7 +422,7 @@ impl PrincipledLobes {
     }
 }
 
-impl LaneModel for PrincipledLobes {
+impl<C: Param> LaneModel for PrincipledLobes<C> {
     fn f_lanes<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> [R; 3] {
         let zero = R::splat(0.0);
         let inside = wo.z.lt(zero);
@@ -415,16 +449,20 @@ impl LaneModel for PrincipledLobes {
             }
             let front = reflection & front;
             out = channels!(|c| {
-                let fp = R::select(inside, f * self.w_transmit, f * self.fresnel_dielectric + w * self.fresnel_b[c] + self.fresnel_a[c]);
+                let fp = R::select(
+                    inside,
+                    f * self.w_transmit,
+                    f * self.fresnel_dielectric + w * self.fresnel_b[c].lanes::<R>() + self.fresnel_a[c].lanes::<R>(),
+                );
                 let spec = R::select(spec_ok, v.value * fp, zero);
-                let lobes = diffuse * self.diffuse[c] + sheen * self.sheen[c] + coat;
+                let lobes = diffuse * self.diffuse[c].lanes::<R>() + sheen * self.sheen[c].lanes::<R>() + coat;
                 R::select(reflection, spec + R::select(front, lobes, zero), zero)
             });
         }
         let refraction = (wo.z * wi.z).lt(zero);
         if self.w_transmit > 0.0 && R::any(refraction) {
             let t = self.glass.transmission(wo, wi, inside);
-            out = channels!(|c| R::select(refraction, t * self.transmitted[c], out[c]));
+            out = channels!(|c| R::select(refraction, t * self.transmitted[c].lanes::<R>(), out[c]));
         }
         // Within f32 underflow of the horizon a lobe can overflow: reported as 0, never NaN/Inf (2026-12).
         channels!(|c| R::select(out[c].is_finite(), out[c], zero))
