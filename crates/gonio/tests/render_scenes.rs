@@ -676,7 +676,11 @@ fn tinted_and_per_lane_textures_in_packets_are_the_textured_models() {
     let half = gonio::math::simd::Float8::splat(0.5);
     let in_lanes: Vec<_> = s.materials.iter().filter_map(|m| m.lanes_at(half, half, 1)).collect();
     assert_eq!(in_lanes.len(), spheres.len(), "every sphere's material is in the lane form");
-    assert_eq!(in_lanes.iter().filter(|m| m.kernel.is_some()).count(), 8, "the rough ones, the plastics and the principled with a parameter per lane");
+    assert_eq!(
+        in_lanes.iter().filter(|m| m.kernel.is_some()).count(),
+        8,
+        "the rough ones, the plastics and the principled with a parameter per lane"
+    );
     let samples: Vec<CameraSample> =
         (0..32).flat_map(|y| (0..32).flat_map(move |x| (0..4).map(move |k| CameraSample { x, y, k }))).collect();
     let (mut packets, mut each) = (vec![gonio::spectrum::Rgb::ZERO; samples.len()], vec![gonio::spectrum::Rgb::ZERO; samples.len()]);
