@@ -26,6 +26,12 @@ impl Scene {
     /// Build every plugin of a parsed scene.
     pub fn build(desc: SceneDescription) -> Result<Scene> {
         let mut warnings = desc.warnings.clone();
+        // The shapes' bitmaps decoded together, in parallel, and held until the shapes are built.
+        let mut files = Vec::new();
+        for p in &desc.shapes {
+            bitmap_files(p, &mut files);
+        }
+        let _decoded = crate::texture::bitmap::decode_images(&files);
         let mut built = Built::default();
         for p in &desc.shapes {
             match p.plugin_type() {
@@ -147,6 +153,18 @@ impl Built {
         });
         p.finish()?;
         Ok(())
+    }
+}
+
+/// The files of the `bitmap` textures in `p` and the descriptions nested in it.
+fn bitmap_files(p: &Props, out: &mut Vec<String>) {
+    if p.plugin_type() == "bitmap" {
+        if let Ok(Some(file)) = p.string("filename") {
+            out.push(file);
+        }
+    }
+    for nested in p.nested() {
+        bitmap_files(nested, out);
     }
 }
 

@@ -124,6 +124,24 @@ fn shared_image(path: &Path) -> Result<SharedImage> {
     Ok(image)
 }
 
+/// Decode the image files `paths` at once, in parallel (a file that fails is left to its bitmap, which
+/// reports the error where it is read): while the returned images are held, the bitmaps built from those
+/// files find them decoded ([`shared_image`]). A scene's materials are built one shape after another;
+/// its textures are decoded together before that.
+#[must_use]
+pub fn decode_images(paths: &[String]) -> DecodedImages {
+    use rayon::prelude::*;
+    let mut unique: Vec<&String> = paths.iter().collect();
+    unique.sort();
+    unique.dedup();
+    DecodedImages { _held: unique.par_iter().filter_map(|p| shared_image(Path::new(p.as_str())).ok()).collect() }
+}
+
+/// Images decoded ahead of their bitmaps ([`decode_images`]), kept while this lives.
+pub struct DecodedImages {
+    _held: Vec<SharedImage>,
+}
+
 impl Bitmap {
     pub fn from_props(p: &Props) -> Result<Self> {
         let filename = p.string("filename")?.ok_or_else(|| Error::spec(p.at(), "`bitmap` needs a `filename`"))?;
