@@ -169,10 +169,7 @@ pub enum LaneKernel<'a> {
 /// packets runs one kernel call for all the lanes on it, each lane with its own value, instead of a model
 /// and a call per lane. The same lobes as the models' own kernels, over a [`PerLane`] parameter. Read in at
 /// most [`crate::math::param::PER_LANE`] lanes.
-// The variants differ in size (`principled`'s constants per lane are the largest, ~0.7 KB): built on the
-// stack once per packet and material, never boxed (an allocation per packet would cost more).
-#[allow(clippy::large_enum_variant)]
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub enum PerLaneKernel<'a> {
     ConductorGgx(ConductorLobe<Ggx<PerLane>>),
     ConductorBeckmann(ConductorLobe<Beckmann<PerLane>>),
@@ -181,7 +178,9 @@ pub enum PerLaneKernel<'a> {
     RoughPlasticGgx(PlasticLobe<'a, Ggx, PerLane>),
     RoughPlasticBeckmann(PlasticLobe<'a, Beckmann, PerLane>),
     Plastic(CoatedMirror<PerLane>),
-    Principled(PrincipledLobes<PerLane>),
+    /// Boxed: its constants per lane (~0.7 KB) would make every kernel that size, and the path tracer keeps
+    /// one per group of lanes in each packet's shading.
+    Principled(Box<PrincipledLobes<PerLane>>),
 }
 
 /// Each kernel of [`PerLaneKernel`], bound to `$k` in `$body`.

@@ -860,7 +860,7 @@ impl Bsdf {
             Bsdf::Plastic(p) => {
                 Some(PerLaneKernel::Plastic(p.per_lane(colour_lanes("diffuse_reflectance", p.diffuse_reflectance, values)?)))
             }
-            Bsdf::Principled(p) => Some(PerLaneKernel::Principled(p.per_lane(colour_lanes("base_color", p.base_color, values)?))),
+            Bsdf::Principled(p) => Some(PerLaneKernel::Principled(Box::new(p.per_lane(colour_lanes("base_color", p.base_color, values)?)))),
             _ => None,
         }
     }

@@ -424,7 +424,7 @@ fn shading<'a>(scene: &'a Scene, p: &Packet, hit: &Surfaces8) -> Shading<'a> {
     let (mut tint, mut tinted) = ([[Float8::splat(1.0); 3]; 2], 0u32);
     let mut models: [Option<Cow<'_, Bsdf>>; W] = Default::default();
     // Groups of lanes running a kernel with a roughness per lane: one per material, found here.
-    let (mut groups_of, mut n_groups, mut kernels, mut grouped) = ([(0u32, 0usize); W], 0usize, [None; W], 0u32);
+    let (mut groups_of, mut n_groups, mut kernels, mut grouped) = ([(0u32, 0usize); W], 0usize, std::array::from_fn(|_| None), 0u32);
     let (u, v) = (Float8::load(&hit.uv[0]), Float8::load(&hit.uv[1]));
     // Without a branch per lane (a lane without a hit holds shape 0 or the shape of an earlier hit in it
     // (`Scene::surfaces_into`): a valid index either way, and an out-of-range one would read as no class).

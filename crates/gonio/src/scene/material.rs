@@ -86,7 +86,7 @@ pub enum InLanes {
 /// What the lanes of a packet on one slotted material run ([`Material::lanes_at`]): `kernel` (a
 /// roughness per lane) or else `model`, for all of them, each lane's values then scaled by its tint of
 /// reflection (`tints[0]`) or transmission (`tints[1]`) where `tinted`.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct LaneMaterial<'a> {
     pub model: &'a Bsdf,
     pub kernel: Option<PerLaneKernel<'a>>,
