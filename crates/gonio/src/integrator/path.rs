@@ -345,7 +345,7 @@ struct Shading<'a> {
     /// The groups of lanes of one model instance (lanes, first lane), `n_groups` of them.
     groups: [(u32, usize); W],
     n_groups: usize,
-    /// Each group's kernel with a roughness per lane, if it has one (it runs instead of the model).
+    /// Each group's kernel with a parameter per lane, if it has one (it runs instead of the model).
     kernels: [Option<PerLaneKernel<'a>>; W],
     /// The shading frames (s, t, n).
     frame: (V3<Float8>, V3<Float8>, V3<Float8>),
@@ -423,7 +423,7 @@ fn shading<'a>(scene: &'a Scene, p: &Packet, hit: &Surfaces8) -> Shading<'a> {
     let (mut rho, mut rho_rows, mut diffuse, mut diffuse_rows) = ([Float8::splat(0.0); 3], Rows3::default(), 0u32, 0u32);
     let (mut tint, mut tinted) = ([[Float8::splat(1.0); 3]; 2], 0u32);
     let mut models: [Option<Cow<'_, Bsdf>>; W] = Default::default();
-    // Groups of lanes running a kernel with a roughness per lane: one per material, found here.
+    // Groups of lanes running a kernel with a parameter per lane: one per material, found here.
     let (mut groups_of, mut n_groups, mut kernels, mut grouped) = ([(0u32, 0usize); W], 0usize, std::array::from_fn(|_| None), 0u32);
     let (u, v) = (Float8::load(&hit.uv[0]), Float8::load(&hit.uv[1]));
     // Without a branch per lane (a lane without a hit holds shape 0 or the shape of an earlier hit in it
@@ -444,9 +444,9 @@ fn shading<'a>(scene: &'a Scene, p: &Packet, hit: &Surfaces8) -> Shading<'a> {
             diffuse |= same;
             continue;
         }
-        // A textured material whose textures only tint its model or set its roughness: that one model (or
-        // its kernel with each lane's roughness) for all its lanes, each lane's values scaled by its tints
-        // (`Shading::tinted`).
+        // A textured material whose textures only tint its model or set parameters it takes per lane: that
+        // one model (or its kernel with each lane's values) for all its lanes, each lane's values scaled by
+        // its tints (`Shading::tinted`).
         if let Some(lm) = material.lanes_at(u, v, same) {
             if lm.tinted {
                 let m = Mask8::from_bitmask(same);
