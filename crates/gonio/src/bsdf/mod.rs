@@ -849,13 +849,9 @@ impl Bsdf {
     pub fn per_lane_kernel<'n>(&self, values: impl IntoIterator<Item = (&'n str, LaneValue)>) -> Option<PerLaneKernel<'_>> {
         match self {
             Bsdf::RoughConductor(RoughConductor(c)) | Bsdf::TorranceSparrow(TorranceSparrow(c)) => {
-                let (ax, ay) = roughness_lanes(&c.distribution, values)?;
-                c.per_lane(ax, ay)
+                c.per_lane(roughness_lanes(&c.distribution, values)?)
             }
-            Bsdf::RoughDielectric(d) => {
-                let (ax, ay) = roughness_lanes(&d.distribution, values)?;
-                d.per_lane(ax, ay)
-            }
+            Bsdf::RoughDielectric(d) => d.per_lane(roughness_lanes(&d.distribution, values)?),
             Bsdf::RoughPlastic(p) => p.per_lane(colour_lanes("diffuse_reflectance", p.diffuse_reflectance, values)?),
             Bsdf::Plastic(p) => {
                 Some(PerLaneKernel::Plastic(p.per_lane(colour_lanes("diffuse_reflectance", p.diffuse_reflectance, values)?)))

@@ -163,7 +163,13 @@ impl Plastic {
     /// methods' `lane_batch_methods!`).
     #[inline(always)]
     pub(crate) fn lanes(&self) -> Option<CoatedMirror<f32>> {
-        Some(self.with_base(self.diffuse_reflectance.0, specular_sampling_weight(self.diffuse_reflectance, self.specular_reflectance)))
+        Some(self.mirror())
+    }
+
+    /// Its lane code with its own parameters.
+    #[inline(always)]
+    fn mirror(&self) -> CoatedMirror<f32> {
+        self.with_base(self.diffuse_reflectance.0, specular_sampling_weight(self.diffuse_reflectance, self.specular_reflectance))
     }
 
     /// Its lane code with the base reflectance `rho` (per channel, one per lane, clamped to [0, 1] as a
@@ -215,15 +221,15 @@ impl BsdfModel for Plastic {
     }
 
     fn f(&self, wo: Vec3, wi: Vec3) -> Rgb {
-        f_one(&self.lanes().expect("every plastic has lane code"), wo, wi)
+        f_one(&self.mirror(), wo, wi)
     }
 
     fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
-        sample_one(&self.lanes().expect("every plastic has lane code"), wo, uc, u)
+        sample_one(&self.mirror(), wo, uc, u)
     }
 
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        pdf_one(&self.lanes().expect("every plastic has lane code"), wo, wi)
+        pdf_one(&self.mirror(), wo, wi)
     }
 
     lane_batch_methods!(lanes);

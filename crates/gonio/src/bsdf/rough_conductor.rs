@@ -54,9 +54,7 @@ use crate::math::lanes::{channels, Real, V3};
 use crate::math::param::PerLane;
 use crate::math::{Vec2, Vec3};
 use crate::microfacet::reflection::ReflectionLobe;
-use crate::microfacet::{
-    alpha_from_blinn_exponent, on_distribution, Beckmann, Distribution, Ggx, MicrofacetDistribution, MicrofacetKind, Shadowing,
-};
+use crate::microfacet::{alpha_from_blinn_exponent, on_distribution, Distribution, MicrofacetDistribution, MicrofacetKind, Shadowing};
 use crate::props::Props;
 use crate::spectrum::Rgb;
 
@@ -181,16 +179,15 @@ impl MicrofacetConductor {
 
     /// The kernel of this model with the roughness (`ax`, `ay`) of each lane instead of its own (GGX and
     /// Beckmann without energy compensation; `None` otherwise): [`Bsdf::per_lane_kernel`](super::Bsdf::per_lane_kernel).
-    pub(crate) fn per_lane(&self, ax: PerLane, ay: PerLane) -> Option<PerLaneKernel<'static>> {
+    pub(crate) fn per_lane(&self, alphas: (PerLane, PerLane)) -> Option<PerLaneKernel<'static>> {
         if self.compensation.is_some() {
             return None;
         }
-        let (alpha_x, alpha_y) = (ax, ay);
-        match self.distribution.kind {
-            MicrofacetKind::Ggx => Some(PerLaneKernel::ConductorGgx(self.lobe(Ggx { alpha_x, alpha_y }))),
-            MicrofacetKind::Beckmann => Some(PerLaneKernel::ConductorBeckmann(self.lobe(Beckmann { alpha_x, alpha_y }))),
-            MicrofacetKind::Blinn => None,
-        }
+        self.distribution.per_lane(
+            alphas,
+            |d| PerLaneKernel::ConductorGgx(self.lobe(d)),
+            |d| PerLaneKernel::ConductorBeckmann(self.lobe(d)),
+        )
     }
 
     /// The kernel of this model when the glossy lobe is all of it (no energy compensation, whose lobe

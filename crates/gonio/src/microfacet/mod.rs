@@ -68,7 +68,6 @@ pub mod distribution;
 pub mod ggx;
 pub mod gtr1;
 pub mod reflection;
-
 #[cfg(test)]
 mod tests;
 
@@ -80,6 +79,7 @@ pub use ggx::Ggx;
 pub use gtr1::Gtr1;
 
 use crate::math::lanes::V3;
+use crate::math::param::PerLane;
 use crate::math::{Vec2, Vec3};
 
 /// The shape of a microfacet normal distribution.
@@ -202,6 +202,21 @@ impl MicrofacetDistribution {
             self.alpha_y = alpha;
         }
         true
+    }
+
+    /// This distribution's kind with the roughness (`ax`, `ay`) of each lane of a packet, as `ggx` or
+    /// `beckmann` make of it; `None` for Blinn (its exponent is one number for all lanes).
+    pub fn per_lane<K>(
+        &self,
+        (ax, ay): (PerLane, PerLane),
+        ggx: impl FnOnce(Ggx<PerLane>) -> K,
+        beckmann: impl FnOnce(Beckmann<PerLane>) -> K,
+    ) -> Option<K> {
+        match self.kind {
+            MicrofacetKind::Ggx => Some(ggx(Ggx { alpha_x: ax, alpha_y: ay })),
+            MicrofacetKind::Beckmann => Some(beckmann(Beckmann { alpha_x: ax, alpha_y: ay })),
+            MicrofacetKind::Blinn => None,
+        }
     }
 
     /// Which roughnesses parameter `name` sets: (along x, along y) — `alpha` both, `alpha_u` x, `alpha_v`

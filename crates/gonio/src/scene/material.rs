@@ -55,7 +55,7 @@ pub enum Material {
     Slotted {
         model: Bsdf,
         textures: Vec<(Slot, SurfaceTexture, Lookup)>,
-        /// Where every texture is a tint ([`Bsdf::tint`]) or a roughness the model takes per lane
+        /// Where every texture is a tint ([`Bsdf::tint`]) or a parameter the model takes per lane
         /// ([`Bsdf::per_lane_kernel`]): the model with the tinted parameters at 1, and how each texture
         /// applies, in `textures`' order ([`Material::lanes_at`]).
         in_lanes: Option<(Bsdf, Vec<InLanes>)>,
@@ -83,8 +83,8 @@ pub enum InLanes {
     Value,
 }
 
-/// What the lanes of a packet on one slotted material run ([`Material::lanes_at`]): `kernel` (a
-/// roughness per lane) or else `model`, for all of them, each lane's values then scaled by its tint of
+/// What the lanes of a packet on one slotted material run ([`Material::lanes_at`]): `kernel` (with
+/// parameters per lane) or else `model`, for all of them, each lane's values then scaled by its tint of
 /// reflection (`tints[0]`) or transmission (`tints[1]`) where `tinted`.
 #[derive(Clone, Debug)]
 pub struct LaneMaterial<'a> {
@@ -225,8 +225,8 @@ impl Material {
     /// The lane form of a slotted material (see `Material::Slotted`): every texture read at texture
     /// coordinates, either as a colour on a parameter that tints its model ([`Bsdf::tint`]), reached through
     /// nothing but `twosided`s of one nested model (a blend's component, or one side of two, is not a tint
-    /// of the whole), or as a float on a roughness of the model itself that it takes per lane
-    /// ([`Bsdf::per_lane_kernel`]).
+    /// of the whole), or on a parameter of the model itself that it takes per lane (a roughness, a base
+    /// colour: [`Bsdf::per_lane_kernel`]).
     fn in_lanes(model: &Bsdf, textures: &[(Slot, SurfaceTexture, Lookup)]) -> Option<(Bsdf, Vec<InLanes>)> {
         let mut base = model.clone();
         let mut how = Vec::with_capacity(textures.len());
@@ -383,11 +383,11 @@ impl Material {
         }
     }
 
-    /// For a material whose every texture is a tint or a roughness taken per lane (see
+    /// For a material whose every texture is a tint or a parameter taken per lane (see
     /// `Material::Slotted`): what its lanes run at texture coordinates (`u`, `v`) of the lanes set in
     /// `lanes` (the others' tints are left unspecified) — the values of [`Self::at`]'s model in each lane,
     /// to rounding (the model multiplies in its tints in its own order). `None` for other materials, and
-    /// where a roughness texture is not a finite number in one of the lanes (each lane's own model then
+    /// where a texture taken per lane is not a finite number in one of the lanes (each lane's own model then
     /// reports it, as [`Self::at`] does).
     #[inline]
     #[must_use]
@@ -418,19 +418,14 @@ impl Material {
                 finite &= !Float8::any(m & !v.is_finite());
                 Float8::select(m, v, Float8::splat(other)).to_array()
             };
-            let values: Vec<(&str, LaneValue)> = textures
-                .iter()
-                .zip(how)
-                .filter(|(_, how)| **how == InLanes::Value)
-                .filter_map(|((slot, texture, lookup), _)| {
-                    let SurfaceTexture::Uv(t) = texture else { return None };
-                    let value = match lookup {
-                        Lookup::Float => LaneValue::Float(lane_value(t.eval_1_lanes(u, v, lanes), 1.0)),
-                        _ => LaneValue::Colour(t.eval_lanes(u, v, lanes).map(|c| lane_value(c, 0.5))),
-                    };
-                    Some((slot.name.as_str(), value))
-                })
-                .collect();
+            let values = textures.iter().zip(how).filter(|(_, how)| **how == InLanes::Value).filter_map(|((slot, texture, lookup), _)| {
+                let SurfaceTexture::Uv(t) = texture else { return None };
+                let value = match lookup {
+                    Lookup::Float => LaneValue::Float(lane_value(t.eval_1_lanes(u, v, lanes), 1.0)),
+                    _ => LaneValue::Colour(t.eval_lanes(u, v, lanes).map(|c| lane_value(c, 0.5))),
+                };
+                Some((slot.name.as_str(), value))
+            });
             kernel = model.per_lane_kernel(values);
             if !finite || kernel.is_none() {
                 return None;
