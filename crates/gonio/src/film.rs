@@ -136,6 +136,17 @@ impl Filter {
     }
 }
 
+/// Channels [`Film::splat`] weights together per row.
+const SPLAT_GROUP: usize = 4;
+
+/// The taps from the first to the last of non-zero weight (empty if all are 0).
+#[inline]
+fn nonzero_span(w: &[f32]) -> std::ops::Range<usize> {
+    let first = w.iter().position(|w| *w != 0.0).unwrap_or(w.len());
+    let last = w.iter().rposition(|w| *w != 0.0).map_or(first, |l| l + 1);
+    first..last
+}
+
 /// The most pixels a film may have: 2²⁶ (8192 × 8192), whose sums take 1.5 GiB and the image 0.75 GiB.
 /// Larger films are refused when the scene is read, before anything is allocated for them, rather than
 /// aborting on a failed allocation midway (2026-11).
@@ -299,19 +310,36 @@ impl Film {
     pub fn splat(&mut self, x0: u32, y0: u32, wx: &[f32], wy: &[f32], v: &[f32]) -> bool {
         debug_assert_eq!(v.len(), self.channels);
         let finite = v.iter().all(|c| c.is_finite());
-        let k = self.channels;
-        // A tap of weight 0 (beyond the radius: one per axis for the Gaussian) adds nothing: skipped.
-        for (j, &wy) in wy.iter().enumerate().filter(|(_, w)| **w != 0.0) {
-            let row = (y0 as usize + j) * self.width as usize + x0 as usize;
+        let (k, width) = (self.channels, self.width as usize);
+        // Only the taps from the first to the last of non-zero weight (the Gaussian has one of weight 0 at
+        // one end of each axis); each row's values times its weight once, in groups of up to
+        // `SPLAT_GROUP` channels, then one multiply-add per tap and channel. (2026-12: per tap and channel
+        // a conversion and two multiplies, with a test per tap, were 13 % of a render of Mitsuba's
+        // matpreview with its default Gaussian.) The same products as before, bit for bit.
+        let (xs, ys) = (nonzero_span(wx), nonzero_span(wy));
+        let wx = &wx[xs.clone()];
+        for (j, &wy) in wy[ys.clone()].iter().enumerate() {
+            let first = (y0 as usize + ys.start + j) * width + x0 as usize + xs.start;
             let wy = f64::from(wy);
-            for (i, &wx) in wx.iter().enumerate().filter(|(_, w)| **w != 0.0) {
-                let wx = f64::from(wx);
-                if finite {
-                    for (s, &c) in self.sum[(row + i) * k..(row + i + 1) * k].iter_mut().zip(v) {
-                        *s += wx * (f64::from(c) * wy);
+            for (w, &wx) in self.weight[first..first + wx.len()].iter_mut().zip(wx) {
+                *w += f64::from(wx) * wy;
+            }
+            if !finite {
+                continue;
+            }
+            let sums = &mut self.sum[first * k..(first + wx.len()) * k];
+            for c0 in (0..k).step_by(SPLAT_GROUP) {
+                let n = (k - c0).min(SPLAT_GROUP);
+                let mut row = [0.0f64; SPLAT_GROUP];
+                for (r, &c) in row.iter_mut().zip(&v[c0..c0 + n]) {
+                    *r = f64::from(c) * wy;
+                }
+                for (pixel, &wx) in sums.chunks_exact_mut(k).zip(wx) {
+                    let wx = f64::from(wx);
+                    for (s, &r) in pixel[c0..c0 + n].iter_mut().zip(&row) {
+                        *s += wx * r;
                     }
                 }
-                self.weight[row + i] += wx * wy;
             }
         }
         finite
