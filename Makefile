@@ -103,7 +103,7 @@ browser:
 # gonio is timed as `make build` builds it (target/release/gonio, for this machine's CPU, as Mitsuba's
 # llvm_ad_rgb JIT-compiles its kernels for it).
 bench: cli python
-	$(CARGO) bench -p gonio
+	$(CARGO) bench -p gonio-bench
 	GONIO_BIN=target/release/gonio $(VPY) bench/render_vs_mitsuba.py
 	$(VPY) bench/suite.py --gonio target/release/gonio --json bench/.cache/suite.json
 	$(VPY) bench/real_scenes.py --gonio target/release/gonio

@@ -1,6 +1,7 @@
 //! Enables `cfg(gonio_avx512)` when the compiler has the AVX-512 target features and intrinsics (Rust
 //! 1.89 and later), which the batch kernels' 16-lane path (`math::avx512`) needs. Older compilers, down to
-//! the MSRV, build gonio without that path. No dependencies: the version is read from `rustc --version`.
+//! the MSRV, build gonio without that path. It uses none of its build-dependencies (see Cargo.toml): the
+//! version is read from `rustc --version`.
 
 use std::process::Command;
 

@@ -32,7 +32,7 @@
 //! instruction counts hardly show: roughconductor's `f` takes 13 per register of rows (it took 20): √(h·h),
 //! the two masking sums' roots and one division for D G1 G1 / (4 cos θo cos θi), then two roots and one
 //! division per RGB channel of the Fresnel term. One thread with AVX-512 (criterion, `batch` group of
-//! `benches/bsdf.rs`): 2.50 → 1.95 ns per row.
+//! `gonio-bench/benches/bsdf.rs`): 2.50 → 1.95 ns per row.
 
 use gonio::bsdf::{Bsdf, BsdfModel, SampleBuffers};
 use gonio::math::{Vec2, Vec3};

@@ -505,7 +505,7 @@ pub const PACKET: usize = 8;
 
 /// Below this many rays a packet's subtree is traversed by each ray alone (Benthin et al. 2012, "Combining
 /// Single and Packet-Ray Tracing for Arbitrary Ray Distributions on the Intel MIC Architecture"): the packet
-/// tests cost the same for one ray as for eight. 2026-12: on a path tracer's packets (benches/bvh.rs,
+/// tests cost the same for one ray as for eight. 2026-12: on a path tracer's packets (gonio-bench/benches/bvh.rs,
 /// `packets`) 1 was 2–3 % faster than 2 for closest hits and 4–5 % for shadow rays on the Cornell box, and
 /// no slower on the material spheres; 3 was slower on both; all eight alone (8) half again as slow.
 const ALONE_BELOW: u32 = 1;

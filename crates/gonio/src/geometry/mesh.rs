@@ -736,7 +736,7 @@ fn triangle_numerators<R: Real>(o: V3<R>, d: V3<R>, p0: V3<R>, e2: V3<R>, ne1: V
 /// The lanes of [`intersect_triangle_lanes`] hit within (0, tmax) and their t (the same bits), without its
 /// branch: t is divided out in every lane. For one ray against a leaf's eight triangles, whether any of
 /// them passes the division-free tests is a coin toss to the branch predictor, and a wrong guess costs more
-/// than the division it would save (2026-12, a path tracer's packets on the Cornell box, benches/bvh.rs
+/// than the division it would save (2026-12, a path tracer's packets on the Cornell box, gonio-bench/benches/bvh.rs
 /// `packets`: closest hits 6–10 % and shadow rays about 10 % faster with [`Triangle8::nearest`] and
 /// [`Triangle8::any`] on this than on the branching test; and a packet's rays against one triangle,
 /// [`Triangle8::intersect_rays`], the same way: see `RAYS_PER_TRIANGLE` in `scene`).
