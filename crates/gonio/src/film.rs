@@ -421,6 +421,48 @@ mod tests {
         }
     }
 
+    /// A splat adds `wx[i] · (v[c] · wy[j])` to channel c of pixel (x0 + i, y0 + j) and `wx[i] · wy[j]` to
+    /// its weight, bit for bit, for any number of channels (several groups of [`SPLAT_GROUP`] and a
+    /// partial one) and weights of 0 anywhere (at the ends, inside, everywhere); a non-finite value adds
+    /// the weights alone.
+    #[test]
+    fn splats_add_each_taps_products() {
+        let mut rng = crate::sampling::Pcg32::new(3, 9);
+        for k in [1, 3, 4, 5, 9] {
+            for round in 0..200 {
+                let (w, h) = (9u32, 7u32);
+                let mut tile = Film::weighted(w, h, k);
+                let mut want = (vec![0.0f64; (w * h) as usize * k], vec![0.0f64; (w * h) as usize]);
+                let weights = |rng: &mut crate::sampling::Pcg32, n: usize| -> Vec<f32> {
+                    (0..n).map(|_| if rng.next_f32() < 0.3 { 0.0 } else { rng.next_f32() }).collect()
+                };
+                for _ in 0..5 {
+                    let (wx, wy) = (weights(&mut rng, 5), weights(&mut rng, 4));
+                    let (x0, y0) = ((rng.next_f32() * 5.0) as u32, (rng.next_f32() * 4.0) as u32);
+                    let mut v: Vec<f32> = (0..k).map(|_| rng.next_f32() * 10.0 - 2.0).collect();
+                    if round % 50 == 7 {
+                        v[k - 1] = f32::NAN;
+                    }
+                    let finite = v.iter().all(|c| c.is_finite());
+                    assert_eq!(tile.splat(x0, y0, &wx, &wy, &v), finite);
+                    for (j, &wy) in wy.iter().enumerate() {
+                        for (i, &wx) in wx.iter().enumerate() {
+                            let p = (y0 as usize + j) * w as usize + x0 as usize + i;
+                            let (wx, wy) = (f64::from(wx), f64::from(wy));
+                            want.1[p] += wx * wy;
+                            for c in 0..k {
+                                if finite {
+                                    want.0[p * k + c] += wx * (f64::from(v[c]) * wy);
+                                }
+                            }
+                        }
+                    }
+                }
+                assert_eq!((tile.sums(), tile.weights().unwrap()), (want.0.as_slice(), want.1.as_slice()), "k = {k}");
+            }
+        }
+    }
+
     /// The filters' weights against Mitsuba 3.9.1's `eval` (tent exactly; the Gaussian to its exp's
     /// accuracy, see [`Filter`]), their radii and borders (`radius()`, `border_size()`).
     #[test]
