@@ -450,9 +450,9 @@ mod tests {
                             let p = (y0 as usize + j) * w as usize + x0 as usize + i;
                             let (wx, wy) = (f64::from(wx), f64::from(wy));
                             want.1[p] += wx * wy;
-                            for c in 0..k {
+                            for (c, &value) in v.iter().enumerate() {
                                 if finite {
-                                    want.0[p * k + c] += wx * (f64::from(v[c]) * wy);
+                                    want.0[p * k + c] += wx * (f64::from(value) * wy);
                                 }
                             }
                         }

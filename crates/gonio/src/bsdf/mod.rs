@@ -845,7 +845,9 @@ impl Bsdf {
     /// computes, in one kernel call for all lanes. The parameters: the roughness of the models whose
     /// roughness [`Self::set_float`] sets (except Blinn's, whose exponent is one number), and the base
     /// reflectance of `plastic` and of `roughplastic` without energy compensation, and `principled`'s
-    /// `base_color`; `None` for other models and parameters.
+    /// `base_color`; `None` for other models and parameters. A kernel is returned only after every value
+    /// has been read ([`Material::lanes_at`](crate::scene::material::Material::lanes_at) evaluates its
+    /// textures as they are read, and checks them for finite numbers after).
     pub fn per_lane_kernel<'n>(&self, values: impl IntoIterator<Item = (&'n str, LaneValue)>) -> Option<PerLaneKernel<'_>> {
         match self {
             Bsdf::RoughConductor(RoughConductor(c)) | Bsdf::TorranceSparrow(TorranceSparrow(c)) => {

@@ -418,6 +418,8 @@ impl Material {
                 finite &= !Float8::any(m & !v.is_finite());
                 Float8::select(m, v, Float8::splat(other)).to_array()
             };
+            // Evaluated as the kernel reads them; it reads all before it returns one, so `finite` then
+            // covers every texture ([`Bsdf::per_lane_kernel`]).
             let values = textures.iter().zip(how).filter(|(_, how)| **how == InLanes::Value).filter_map(|((slot, texture, lookup), _)| {
                 let SurfaceTexture::Uv(t) = texture else { return None };
                 let value = match lookup {
