@@ -24,6 +24,10 @@ For each scene (bench/scenes/*.xml, plus Mitsuba's own unmodified files listed i
   scale. A gonio mean more than 1 % from the reference's is flagged `!`: a scene where the two
   renderers disagree is a correctness finding (unless Mitsuba's own low-spp mean is as far off: noise).
 
+`--mode spectral` renders gonio with `--mode spectral` against Mitsuba's `llvm_ad_spectral` (and references of
+that variant); `--baseline BIN --baseline-mode rgb` then times the same binary's RGB mode in the same rounds,
+the issue-30 ratio spectral / RGB.
+
 Printed: a table (scene, gonio s, Mitsuba s, time ratio gonio/Mitsuba, MSE ratio, mean ratios), then the
 geometric mean of the time ratios and the worst scene. A renderer that fails on a scene is reported with
 its error and the suite goes on with the others; failed scenes are left out of the geometric mean (and
@@ -268,8 +272,9 @@ class Mitsuba:
             self.proc = None
 
 
-def start_mitsuba(threads: int) -> tuple[Mitsuba, str | None]:
-    """The llvm_ad_rgb worker, or scalar_rgb with a loud note (returned) when it cannot start."""
+def start_mitsuba(threads: int, mode: str = "rgb") -> tuple[Mitsuba, str | None]:
+    """The llvm_ad_rgb worker (llvm_ad_spectral for `mode` "spectral"), or scalar_rgb (scalar_spectral) with a
+    loud note (returned) when it cannot start."""
     llvm = llvm_library()
     why = None
     if llvm is None:
@@ -277,13 +282,13 @@ def start_mitsuba(threads: int) -> tuple[Mitsuba, str | None]:
         why = (f"DRJIT_LIBLLVM_PATH={given} does not exist" if given else
                "libLLVM 19 not found by `ldconfig -p` (Debian: apt-get install libllvm19) and DRJIT_LIBLLVM_PATH not set")  # fmt: skip
     else:
-        m = Mitsuba("llvm_ad_rgb", threads, llvm)
+        m = Mitsuba(f"llvm_ad_{mode}", threads, llvm)
         try:
             m.start()
             return m, None
         except RuntimeError as e:
-            why = f"the llvm_ad_rgb worker did not start ({llvm}): {e}"
-    m = Mitsuba("scalar_rgb", threads, None)
+            why = f"the llvm_ad_{mode} worker did not start ({llvm}): {e}"
+    m = Mitsuba(f"scalar_{mode}", threads, None)
     m.start()
     return m, why
 
@@ -292,10 +297,15 @@ def start_mitsuba(threads: int) -> tuple[Mitsuba, str | None]:
 # gonio
 
 
-def run_gonio(binary: Path, scene: Scene, spp: int, threads: int, out: Path, seed: int | None = None) -> tuple[dict, Path]:
+def run_gonio(
+    binary: Path, scene: Scene, spp: int, threads: int, out: Path, seed: int | None = None, mode: str = "rgb"
+) -> tuple[dict, Path]:
     """The whole `gonio render` process: wall and CPU time (all threads); the render loop's own time as
-    gonio reports it goes along as `render` (not used in the table). `seed`: `--seed` (else the scene's)."""
+    gonio reports it goes along as `render` (not used in the table). `seed`: `--seed` (else the scene's);
+    `mode`: `--mode`."""
     cmd = [str(binary), "render", str(scene.path), "-o", str(out), "--spp", str(spp), "--threads", str(threads)]
+    if mode != "rgb":
+        cmd += ["--mode", mode]
     if seed is not None:
         cmd += ["--seed", str(seed)]
     for k, v in scene.defines.items():
@@ -319,9 +329,10 @@ def run_scene(scene: Scene, args, mitsuba: Mitsuba, tmp: Path) -> dict:
     row: dict = {"scene": scene.name, "file": str(scene.path), "defines": scene.defines, "errors": {}}
     if scene.expected_failure:
         row["expected_failure"] = scene.expected_failure
-    renderers = [("gonio", lambda out: run_gonio(args.gonio, scene, args.spp, args.threads, out))]
+    renderers = [("gonio", lambda out: run_gonio(args.gonio, scene, args.spp, args.threads, out, mode=args.mode))]
     if args.baseline:
-        renderers.append(("baseline", lambda out: run_gonio(args.baseline, scene, args.spp, args.threads, out)))
+        baseline_mode = args.baseline_mode or args.mode
+        renderers.append(("baseline", lambda out: run_gonio(args.baseline, scene, args.spp, args.threads, out, mode=baseline_mode)))
     renderers.append(("mitsuba", lambda out: mitsuba.render(scene, args.spp, out)))
     # Warm Mitsuba up: the JIT kernels of this scene compiled and cached, untimed.
     try:
@@ -483,6 +494,11 @@ def main() -> None:
     ap.add_argument("--threads", type=int, default=os.cpu_count(), help="worker threads on both sides (default: all cores)")
     ap.add_argument("--scenes", action="append", metavar="GLOB", help="only scenes whose name matches (repeatable)")
     ap.add_argument("--baseline", type=Path, help="another gonio binary timed in the same rounds (e.g. a build before a change)")
+    ap.add_argument("--mode", choices=["rgb", "spectral"], default="rgb",
+                    help="gonio's --mode, against Mitsuba's llvm_ad_rgb or llvm_ad_spectral (and references of that variant)")
+    ap.add_argument("--baseline-mode", choices=["rgb", "spectral"],
+                    help="the baseline's --mode (default: --mode); `--mode spectral --baseline BIN --baseline-mode rgb` times "
+                         "spectral against RGB mode in the same rounds")  # fmt: skip
     ap.add_argument("--json", type=Path, metavar="OUT", help="write every number to OUT")
     ap.add_argument("--list", action="store_true", help="list the scenes and exit")
     ap.add_argument("--table", type=Path, metavar="JSON", help="print the table of an earlier run's --json output and exit")
@@ -512,10 +528,10 @@ def main() -> None:
     except ImportError:
         sys.exit("mitsuba is not installed in this Python: `make venv` installs it into .venv (requirements-dev.txt)")
     generated_assets()
-    mitsuba, fallback = start_mitsuba(args.threads)
+    mitsuba, fallback = start_mitsuba(args.threads, args.mode)
     if fallback:
         banner = "!" * 100
-        print(f"{banner}\n!! Mitsuba llvm_ad_rgb UNAVAILABLE — timing against scalar_rgb instead, which is NOT the suite's baseline.\n"
+        print(f"{banner}\n!! Mitsuba llvm_ad_{args.mode} UNAVAILABLE — timing against scalar_{args.mode} instead, which is NOT the suite's baseline.\n"
               f"!! {fallback}\n{banner}", flush=True)  # fmt: skip
     print(f"== gonio ({args.gonio}) vs Mitsuba 3 {mitsuba.variant}: {len(scenes)} scenes, {args.spp} spp, {args.threads} threads each, "
           f"fastest of {args.repeats} in alternating rounds; MSE against Mitsuba at {args.ref_spp} spp ({load_note()})", flush=True)  # fmt: skip

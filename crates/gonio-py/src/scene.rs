@@ -8,7 +8,7 @@
 
 use crate::{panic_error, run_released};
 use gonio::math::{Transform, Vec3};
-use gonio::scene::{mitsuba_dict, IntegratorKind, Scene};
+use gonio::scene::{mitsuba_dict, IntegratorKind, Mode, Scene};
 use numpy::{PyArray1, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::create_exception;
 use pyo3::exceptions::{PyFileNotFoundError, PyIsADirectoryError, PyOSError, PyPermissionError, PyValueError};
@@ -308,6 +308,12 @@ impl PyScene {
         self.scene.integrator.channels()
     }
 
+    /// `"rgb"` or `"spectral"`: how the scene was loaded (`load_scene(..., mode=...)`).
+    #[getter]
+    fn mode(&self) -> &'static str {
+        self.scene.mode.name()
+    }
+
     /// Image width in pixels (the film's `width`).
     #[getter]
     fn width(&self) -> u32 {
@@ -440,13 +446,15 @@ fn overrides(defines: Option<&Bound<'_, PyDict>>) -> PyResult<Vec<(String, Strin
 }
 
 /// Load a Mitsuba 3 XML scene file. `defines` override its `<default name=… value=…>` parameters, as
-/// `-D name=value` does on the command line (values are converted with `str`).
+/// `-D name=value` does on the command line (values are converted with `str`). `mode` is `"rgb"` or
+/// `"spectral"` (three sampled wavelengths per path; docs/spectral.md), as `gonio render --mode`.
 #[pyfunction]
-#[pyo3(signature = (path, **defines))]
-fn load_scene(py: Python<'_>, path: PathBuf, defines: Option<&Bound<'_, PyDict>>) -> PyResult<PyScene> {
+#[pyo3(signature = (path, *, mode = "rgb", **defines))]
+fn load_scene(py: Python<'_>, path: PathBuf, mode: &str, defines: Option<&Bound<'_, PyDict>>) -> PyResult<PyScene> {
     let overrides = overrides(defines)?;
     let source = path.display().to_string();
-    let scene = run_released(py, || Scene::load(&path, &overrides))?.map_err(scene_error)?;
+    let mode = Mode::parse(mode).map_err(scene_error)?;
+    let scene = run_released(py, || Scene::load_in(&path, &overrides, mode))?.map_err(scene_error)?;
     PyScene::new(py, scene, source)
 }
 
@@ -472,8 +480,11 @@ fn load_scene(py: Python<'_>, path: PathBuf, defines: Option<&Bound<'_, PyDict>>
 /// (`mitsuba.ScalarTransform4f`). Points are `[x, y, z]`; colours `[r, g, b]`, a number or
 /// `{"type": "rgb", "value": …}`. Relative file names are relative to the working directory. Raises
 /// `gonio.SceneError` (a `ValueError`) naming the dictionary path (`$.ball.bsdf.alpha`) of the problem.
+/// `mode` is `"rgb"` or `"spectral"`, as for `load_scene`.
 #[pyfunction]
-fn load_dict(py: Python<'_>, scene: &Bound<'_, PyAny>) -> PyResult<PyScene> {
+#[pyo3(signature = (scene, *, mode = "rgb"))]
+fn load_dict(py: Python<'_>, scene: &Bound<'_, PyAny>, mode: &str) -> PyResult<PyScene> {
+    let mode = Mode::parse(mode).map_err(scene_error)?;
     if !scene.is_instance_of::<PyDict>() {
         return Err(pyo3::exceptions::PyTypeError::new_err(format!(
             "load_dict expects a dict, got {}",
@@ -481,7 +492,8 @@ fn load_dict(py: Python<'_>, scene: &Bound<'_, PyAny>) -> PyResult<PyScene> {
         )));
     }
     let value = to_json(scene, "$")?;
-    let scene = run_released(py, || mitsuba_dict::load_value(&value, "<dict>").and_then(Scene::build))?.map_err(scene_error)?;
+    let scene =
+        run_released(py, || mitsuba_dict::load_value(&value, "<dict>").and_then(|d| Scene::build_in(d, mode)))?.map_err(scene_error)?;
     PyScene::new(py, scene, "<dict>".into())
 }
 

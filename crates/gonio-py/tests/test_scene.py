@@ -161,6 +161,48 @@ def test_render_equals_cli_exr_bit_for_bit(scene_file, tmp_path):
     assert np.array_equal(cli, py)
 
 
+def test_spectral_mode_equals_cli_and_differs_from_rgb(scene_file, tmp_path):
+    # `mode="spectral"` is `gonio render --mode spectral` bit for bit; its image is another estimate of the
+    # scene (gold and a blue plastic: colours whose spectra differ from their RGB), not the RGB one.
+    out = tmp_path / "cli.exr"
+    subprocess.run(
+        [str(CLI), "render", str(scene_file), "-o", str(out), "--spp", "3", "--seed", "5", "--threads", "2", "-q", "--mode", "spectral"],
+        check=True,
+        timeout=120,
+    )
+    spectral = gonio.load_scene(scene_file, mode="spectral")
+    assert (spectral.mode, gonio.load_scene(scene_file).mode) == ("spectral", "rgb")
+    py = spectral.render(spp=3, seed=5, threads=2, progress=False)
+    assert np.array_equal(gonio.read_image(out), py)
+    # Each path draws its wavelengths from its own stream: the image does not depend on the thread count.
+    assert np.array_equal(py, spectral.render(spp=3, seed=5, threads=1, progress=False))
+    rgb = gonio.load_scene(scene_file).render(spp=3, seed=5, threads=2, progress=False)
+    assert np.isfinite(py).all() and not np.array_equal(py, rgb)
+    # A scene parameter called `mode` is still a define: `mode` itself is keyword-only and checked.
+    with pytest.raises(gonio.SceneError, match="unknown mode `hyperspectral`; expected `rgb` or `spectral`"):
+        gonio.load_scene(scene_file, mode="hyperspectral")
+
+
+def test_spectral_mode_refuses_what_it_does_not_take_yet(tmp_path):
+    # A colour spectral mode cannot take to its spectrum yet is an error naming it and where it is.
+    base = {
+        "type": "scene",
+        "sensor": {"type": "perspective", "film": {"type": "hdrfilm", "width": 8, "height": 8}},
+        "light": {"type": "constant"},
+    }
+    ok = dict(base, ball={"type": "sphere", "bsdf": {"type": "conductor", "material": "Au"}})
+    assert gonio.load_dict(ok, mode="spectral").render(spp=2, progress=False).shape == (8, 8, 3)
+    index = dict(base, ball={"type": "sphere", "bsdf": {"type": "conductor", "eta": [0.2, 0.4, 1.4], "k": [3.0, 2.4, 1.8]}})
+    assert np.isfinite(gonio.load_dict(index, mode="spectral").render(spp=2, progress=False)).all()
+    # Phong derives its lobe choice from its colours when built: it is refused, not rendered with a stale one.
+    bad = dict(base, ball={"type": "sphere", "bsdf": {"type": "phong", "diffuse_reflectance": [0.8, 0.2, 0.1]}})
+    gonio.load_dict(bad)  # RGB mode takes it
+    with pytest.raises(gonio.SceneError, match=r"\$\.ball\.bsdf.*spectral mode does not take this colour \(parameter `diffuse_reflectance` of `phong`\)"):
+        gonio.load_dict(bad, mode="spectral")
+    with pytest.raises(gonio.SceneError, match="unknown mode"):
+        gonio.load_dict(ok, mode="RGB")
+
+
 def test_aov_channels_follow_the_rgb(scene_file, tmp_path):
     # Mitsuba's `aov` integrator: its channels after the RGB, named as Mitsuba names them; the RGB (and the
     # nested image's channels) are the nested path integrator's image; parts of a render carry every channel.

@@ -160,6 +160,11 @@ impl Props {
         &self.at
     }
 
+    /// Every parameter as (name, value, where given), in the order given, without marking any as read.
+    pub fn values(&self) -> impl Iterator<Item = (&str, &Value, &str)> {
+        self.entries.iter().map(|e| (e.name.as_str(), &e.value, e.at.as_str()))
+    }
+
     fn entry(&self, name: &'static str) -> Option<&Entry> {
         self.asked.borrow_mut().push(name);
         let e = self.entries.iter().find(|e| e.name == name)?;

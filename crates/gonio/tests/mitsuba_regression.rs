@@ -10,12 +10,17 @@
 //!    significance 1 − (1 − 0.01)^(1 / pixels).
 //!
 //! Each scene is its own test so they can run (and fail) separately; each prints its passing fraction.
+//!
+//! The same nine scenes in spectral mode (`spectral_*`, issue 30) are judged the same way against Mitsuba's
+//! `llvm_ad_spectral` references, kept small in `tests/data/spectral_refs/` (48 × 48 float32 EXRs, 16 384 spp:
+//! the mean of 64 renders of 256 spp, and the variance of one sample from their spread; written by
+//! `tools/spectral_regression_refs.py`).
 //! The data sits outside the repository: when it is missing the tests say so and pass vacuously only if
 //! `GONIO_SKIP_MISSING_DATA` is set, otherwise they fail.
 
 use gonio::image::read_image;
 use gonio::render::render;
-use gonio::scene::Scene;
+use gonio::scene::{Mode, Scene};
 use gonio::verify::chi2::{gamma_q, sidak_alpha};
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
@@ -36,8 +41,14 @@ fn p_value(z: f64) -> f64 {
     gamma_q(0.5, 0.5 * z * z)
 }
 
-/// Render `name` (e.g. "test_envmap") and apply Mitsuba's z-test; returns the passing fraction.
-fn z_test_scene(name: &str) -> f64 {
+/// Where spectral mode's references are: in the repository.
+fn spectral_refs_dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/spectral_refs")
+}
+
+/// Render `name` (e.g. "test_envmap") in `mode` and apply Mitsuba's z-test against the references of that
+/// mode; returns the passing fraction.
+fn z_test_scene(name: &str, mode: Mode) -> f64 {
     let dir = scenes_dir();
     let xml = dir.join(format!("{name}_path.xml"));
     if !xml.exists() {
@@ -49,9 +60,13 @@ fn z_test_scene(name: &str) -> f64 {
         eprintln!("skipped: {} is missing", xml.display());
         return 1.0;
     }
-    let scene = Scene::load(&xml, &[]).unwrap_or_else(|e| panic!("{name}: {e}"));
-    let reference = read_image(&dir.join(format!("refs/{name}_ref_rgb.exr"))).unwrap();
-    let variance = read_image(&dir.join(format!("refs/{name}_ref_rgb_var.exr"))).unwrap();
+    let scene = Scene::load_in(&xml, &[], mode).unwrap_or_else(|e| panic!("{name}: {e}"));
+    let (refs, kind) = match mode {
+        Mode::Rgb => (dir.join("refs"), "rgb"),
+        Mode::Spectral => (spectral_refs_dir(), "spectral"),
+    };
+    let reference = read_image(&refs.join(format!("{name}_ref_{kind}.exr"))).unwrap();
+    let variance = read_image(&refs.join(format!("{name}_ref_{kind}_var.exr"))).unwrap();
     let pixels = (scene.film.width * scene.film.height) as usize;
     assert_eq!((reference.width * reference.height, variance.width * variance.height), (pixels, pixels));
     let spp = (2e6 / pixels as f64) as u32;
@@ -79,7 +94,8 @@ fn z_test_scene(name: &str) -> f64 {
     let fraction = passed as f64 / img.len() as f64;
     let (px, ch) = (worst.1 / 3, worst.1 % 3);
     println!(
-        "{name}: {:.4} % of pixel-channels pass (need 99.75 %), {spp} spp in {:.1} s, {} non-finite samples; min p = {:.2e} at pixel ({}, {}) {} = {:.4} vs ref {:.4}",
+        "{name} ({}): {:.4} % of pixel-channels pass (need 99.75 %), {spp} spp in {:.1} s, {} non-finite samples; min p = {:.2e} at pixel ({}, {}) {} = {:.4} vs ref {:.4}",
+        mode.name(),
         100.0 * fraction,
         out.seconds,
         out.nonfinite,
@@ -95,25 +111,36 @@ fn z_test_scene(name: &str) -> f64 {
 }
 
 macro_rules! regression_scenes {
-    ($($test:ident = $name:literal),* $(,)?) => {$(
+    ($($test:ident, $spectral:ident = $name:literal),* $(,)?) => {$(
         #[test]
         fn $test() {
-            let fraction = z_test_scene($name);
+            let fraction = z_test_scene($name, Mode::Rgb);
             assert!(fraction >= 0.9975, "{}: only {:.3} % of pixel-channels pass Mitsuba's z-test", $name, 100.0 * fraction);
+        }
+
+        #[test]
+        fn $spectral() {
+            let fraction = z_test_scene($name, Mode::Spectral);
+            assert!(
+                fraction >= 0.9975,
+                "{} (spectral): only {:.3} % of pixel-channels pass Mitsuba's z-test",
+                $name,
+                100.0 * fraction
+            );
         }
     )*};
 }
 
 regression_scenes! {
-    arealight = "test_arealight",
-    constant = "test_constant",
-    envmap = "test_envmap",
-    pointlight = "test_pointlight",
-    roughdielectric = "test_roughdielectric",
-    roughplastic_linear = "test_roughplastic_linear",
-    roughplastic_nonlinear = "test_roughplastic_nonlinear",
-    textured_diffuse = "test_textured_diffuse",
-    textured_roughconductor = "test_textured_roughconductor",
+    arealight, spectral_arealight = "test_arealight",
+    constant, spectral_constant = "test_constant",
+    envmap, spectral_envmap = "test_envmap",
+    pointlight, spectral_pointlight = "test_pointlight",
+    roughdielectric, spectral_roughdielectric = "test_roughdielectric",
+    roughplastic_linear, spectral_roughplastic_linear = "test_roughplastic_linear",
+    roughplastic_nonlinear, spectral_roughplastic_nonlinear = "test_roughplastic_nonlinear",
+    textured_diffuse, spectral_textured_diffuse = "test_textured_diffuse",
+    textured_roughconductor, spectral_textured_roughconductor = "test_textured_roughconductor",
 }
 
 #[test]

@@ -17,7 +17,7 @@
 
 use gonio::image::{check_writable, write_image_with_channels, Image};
 use gonio::render::render;
-use gonio::scene::Scene;
+use gonio::scene::{Mode, Scene};
 use gonio::Error;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
@@ -56,6 +56,10 @@ pub struct Args {
     /// With --ray: samples per pixel in each task (default: about four tasks per CPU of the cluster).
     #[arg(long, requires = "ray")]
     chunk_spp: Option<u32>,
+    /// How light is carried: `rgb`, or `spectral` (three sampled wavelengths per path, the film's colour
+    /// through the CIE 1931 observer; docs/spectral.md says which materials it takes yet).
+    #[arg(long, default_value = "rgb", value_parser = ["rgb", "spectral"])]
+    mode: String,
 }
 
 /// `gonio render --ray`: the same arguments for `python -m gonio.distributed render`.
@@ -87,7 +91,11 @@ fn arg_error(message: String) -> Error {
 }
 
 pub fn run(args: Args) -> Result<ExitCode, Error> {
+    let mode = Mode::parse(&args.mode)?;
     if let Some(address) = &args.ray {
+        if mode != Mode::Rgb {
+            return Err(arg_error("--ray renders in RGB mode only (yet); drop --mode spectral or --ray".into()));
+        }
         return on_ray(address, &args);
     }
     let overrides = args
@@ -101,7 +109,7 @@ pub fn run(args: Args) -> Result<ExitCode, Error> {
     let output = args.output.clone().unwrap_or_else(|| args.scene.with_extension("exr"));
     check_writable(&output)?;
     let load_start = std::time::Instant::now();
-    let scene = Scene::load(&args.scene, &overrides)?;
+    let scene = Scene::load_in(&args.scene, &overrides, mode)?;
     for w in &scene.warnings {
         eprintln!("gonio: warning: {w}");
     }

@@ -86,6 +86,9 @@ class Scene:
     def channels(self) -> List[str]:
         """Names of the channels `render` returns: R, G, B, then an `aov` integrator's (`image.R`, …, `nn.X`, …)."""
     @property
+    def mode(self) -> str:
+        """"rgb" or "spectral": how the scene was loaded (`load_scene(..., mode=...)`)."""
+    @property
     def width(self) -> int:
         """Image width in pixels (the film's `width`)."""
     @property
@@ -140,12 +143,13 @@ def fit(target: Any, models: Sequence[str], strata: int = 12) -> List[Dict[str, 
 def fit_models() -> List[Tuple[str, str]]:
     """(name, description) of every model `fit` knows, as `gonio fit --list`."""
 
-def load_scene(path: PathLike, **defines: Any) -> Scene:
+def load_scene(path: PathLike, *, mode: str = "rgb", **defines: Any) -> Scene:
     """Load a Mitsuba 3 XML scene; `defines` override `<default>` parameters like `-D name=value`.
+    `mode` is "rgb" or "spectral" (three sampled wavelengths per path), as `gonio render --mode`.
 
     Raises FileNotFoundError for a missing file, SceneError for anything wrong inside it."""
 
-def load_dict(scene: Mapping[str, Any]) -> Scene:
+def load_dict(scene: Mapping[str, Any], *, mode: str = "rgb") -> Scene:
     """Build a scene from Mitsuba 3's scene dictionary ({"type": "scene", ...}, as `mitsuba.load_dict`).
 
     Plugins are dicts with a "type"; top-level keys are ids for {"type": "ref", "id": ...}; `to_world` is a

@@ -42,6 +42,10 @@ impl BlendBsdf {
     }
 
     /// The k-th nested model (0: the first, 1: the second), to change parameters it reads as it is.
+    pub(crate) fn mix_mut(&mut self) -> &mut Sum {
+        &mut self.mix
+    }
+
     pub(crate) fn model_mut(&mut self, k: usize) -> Option<&mut Bsdf> {
         self.mix.components_mut().get_mut(k)
     }

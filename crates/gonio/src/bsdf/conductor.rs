@@ -27,6 +27,7 @@ use crate::fresnel::{fresnel_conductor_rgb, fresnel_conductor_rgb_lanes, reflect
 use crate::math::lanes::{channels, Real, V3};
 use crate::math::{Vec2, Vec3};
 use crate::props::Props;
+use crate::spectrum::sampled::unbounded_at;
 use crate::spectrum::{named, Rgb};
 
 /// A smooth conductor.
@@ -35,25 +36,29 @@ pub struct Conductor {
     /// Real part of the complex index; `None` (with `k`) for the 100 % reflecting `material = "none"`.
     pub eta_k: Option<(Rgb, Rgb)>,
     pub specular_reflectance: Rgb,
+    /// The named metal `eta_k` was reduced from (`material`), whose spectra spectral mode reads
+    /// ([`named::conductor_spectra`]); `None` for an index given as `eta`/`k` and for the mirror.
+    pub metal: Option<&'static str>,
 }
 
 impl Conductor {
     /// A conductor with complex index `eta + i k`.
     #[must_use]
     pub fn new(eta: Rgb, k: Rgb) -> Self {
-        Conductor { eta_k: Some((eta, k)), specular_reflectance: Rgb::ONE }
+        Conductor { eta_k: Some((eta, k)), specular_reflectance: Rgb::ONE, metal: None }
     }
 
     /// The perfect mirror (`material = "none"`).
     #[must_use]
     pub fn mirror() -> Self {
-        Conductor { eta_k: None, specular_reflectance: Rgb::ONE }
+        Conductor { eta_k: None, specular_reflectance: Rgb::ONE, metal: None }
     }
 
     /// Read `material` or `eta`/`k`, and `specular_reflectance`. Rough conductors read their Fresnel term
     /// through this too, so the parameters mean the same in every conductor plugin.
     pub fn from_props(p: &Props) -> Result<Self> {
         let material = p.string("material")?;
+        let metal = material.as_deref().and_then(|m| named::CONDUCTORS.iter().copied().find(|&n| n == m && n != "none"));
         let has_index = p.has("eta") || p.has("k");
         let eta = p.rgb_in("eta", Rgb::ZERO, 0.0, f32::MAX)?;
         let k = p.rgb_in("k", Rgb::ZERO, 0.0, f32::MAX)?;
@@ -74,7 +79,20 @@ impl Conductor {
                 Error::spec(p.at(), format!("unknown conductor material `{m}`; expected one of: {}", named::CONDUCTORS.join(", ")))
             })?),
         };
-        Ok(Conductor { eta_k, specular_reflectance })
+        Ok(Conductor { eta_k, specular_reflectance, metal })
+    }
+
+    /// This conductor at the wavelengths `lambda` (nm) in its three channels (spectral mode;
+    /// `scene::spectral`): a named metal's η and k from its spectra, an index given as colours `eta`, `k` by
+    /// their unbounded spectra ([`unbounded_at`]).
+    pub fn set_wavelengths(&mut self, lambda: [f32; 3]) {
+        #[allow(clippy::cast_possible_truncation)]
+        let at = |s: &crate::spectrum::piecewise::PiecewiseLinear| Rgb(lambda.map(|l| s.eval_clamped(f64::from(l)) as f32));
+        self.eta_k = match (self.metal.and_then(named::conductor_spectra), self.eta_k) {
+            (Some(spectra), _) => Some((at(&spectra.0), at(&spectra.1))),
+            (None, Some((eta, k))) => Some((Rgb(unbounded_at(eta.0, lambda)), Rgb(unbounded_at(k.0, lambda)))),
+            (None, None) => None,
+        };
     }
 
     /// Fresnel reflectance times `specular_reflectance` at incidence cosine `cos_theta_i` ≥ 0.

@@ -35,6 +35,11 @@ pub struct Mask {
 }
 
 impl Mask {
+    /// The model it masks.
+    pub(crate) fn nested_mut(&mut self) -> &mut Bsdf {
+        &mut self.nested
+    }
+
     /// `nested` with opacity `opacity` (clamped to [0, 1]).
     #[must_use]
     pub fn new(opacity: f32, nested: Bsdf) -> Self {

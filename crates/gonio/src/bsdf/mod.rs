@@ -876,6 +876,21 @@ impl Bsdf {
         }
     }
 
+    /// Call `f` on every model this one holds as it is (one level down): a `twosided`'s sides, a blend's or
+    /// a sum's components, the model of a `mask` or a normal or bump map.
+    pub fn for_each_nested(&mut self, f: &mut dyn FnMut(&mut Bsdf)) {
+        match self {
+            Bsdf::TwoSided(t) => {
+                t.for_sides(0, 1, f);
+            }
+            Bsdf::Blend(b) => b.mix_mut().components_mut().iter_mut().for_each(f),
+            Bsdf::Sum(s) => s.components_mut().iter_mut().for_each(f),
+            Bsdf::Mask(m) => f(m.nested_mut()),
+            Bsdf::NormalMap(n) => f(n.nested_mut()),
+            _ => {}
+        }
+    }
+
     /// Which lobe colour parameter `name` tints, where it is a pure tint of this model: it scales `f` (and
     /// a sample's `f` and weight) channel by channel for the directions on ωo's side of the surface
     /// ([`Tint::Reflection`]) or through it ([`Tint::Transmission`]), and changes neither `pdf` nor the
@@ -907,6 +922,16 @@ impl Bsdf {
         }
     }
 
+    /// The Fresnel term of a `conductor` or `roughconductor` (not of an energy-compensated one, whose lobe is
+    /// built from it): its index of refraction, to set at a path's wavelengths in spectral mode.
+    pub fn conductor_fresnel(&mut self) -> Option<&mut Conductor> {
+        match self {
+            Bsdf::Conductor(c) => Some(c),
+            Bsdf::RoughConductor(RoughConductor(c)) if c.compensation.is_none() => Some(&mut c.fresnel),
+            _ => None,
+        }
+    }
+
     /// The field that holds this model's colour parameter `name`, where a texture can set it at a hit
     /// without building the model again: a reflectance in [0, 1] per channel (`Props::reflectance`) that
     /// the model reads as it is, deriving nothing from it when built. `None` where the model must be
@@ -924,6 +949,7 @@ impl Bsdf {
         }
         match (self, name) {
             (Bsdf::Diffuse(d), "reflectance") => Some(&mut d.reflectance),
+            (Bsdf::OrenNayar(o), "reflectance") => Some(&mut o.reflectance),
             (Bsdf::Conductor(c), "specular_reflectance") => Some(&mut c.specular_reflectance),
             (Bsdf::RoughConductor(RoughConductor(c)), "specular_reflectance") => Some(&mut c.fresnel.specular_reflectance),
             (Bsdf::Dielectric(d), "specular_reflectance") => Some(&mut d.specular_reflectance),

@@ -59,6 +59,11 @@ pub struct NormalMap {
 }
 
 impl NormalMap {
+    /// The model it perturbs.
+    pub(crate) fn nested_mut(&mut self) -> &mut Bsdf {
+        &mut self.nested
+    }
+
     /// Mitsuba's defaults: invalid normals flipped, the shadowing term applied.
     #[must_use]
     pub fn new(normalmap: Rgb, nested: Bsdf) -> Self {

@@ -32,6 +32,7 @@ use crate::geometry::shape::solid_angle_density;
 use crate::geometry::sphere::sample_sphere_from;
 use crate::geometry::{Ray, Shape};
 use crate::light::area::towards;
+use crate::light::envmap::LaneWavelengths;
 use crate::light::point::point_source_lanes;
 use crate::light::selection::SelectionSums;
 use crate::light::{Light, LightSample};
@@ -41,8 +42,10 @@ use crate::math::{Vec2, Vec3};
 use crate::sampling::mis::power_heuristic_lanes;
 use crate::sampling::warp::uniform_sphere;
 use crate::sampling::Pcg32x8;
+use crate::scene::spectral::reflectances_at;
 use crate::scene::surfaces::{Rows3, Surfaces8};
-use crate::scene::Scene;
+use crate::scene::{Mode, Scene};
+use crate::spectrum::sampled::{path_to_linear_srgb, sample_path_wavelengths};
 use crate::spectrum::Rgb;
 use std::borrow::Cow;
 
@@ -123,6 +126,11 @@ struct Packet {
     /// the lanes that sampled a light there.
     sums: [SelectionSums; W],
     sums_at: u32,
+    /// In spectral mode ([`Mode::Spectral`]), each lane's wavelengths (channel `c` of lane `l` in row `c`)
+    /// and their densities ([`sample_path_wavelengths`]); unused in RGB mode.
+    spectral: bool,
+    lambda: Rows3,
+    lambda_pdf: Rows3,
 }
 
 impl Packet {
@@ -143,7 +151,46 @@ impl Packet {
             delta: 0,
             sums: [SelectionSums::UNIFORM; W],
             sums_at: 0,
+            spectral: false,
+            lambda: Rows3::default(),
+            lambda_pdf: Rows3::default(),
         }
+    }
+
+    /// Lane `lane`'s wavelengths.
+    #[inline(always)]
+    fn lambda(&self, lane: usize) -> [f32; 3] {
+        self.lambda.get(lane).to_array()
+    }
+
+    /// Lanes `lanes` (new paths) draw their wavelengths, in spectral mode: the next number of each one's
+    /// stream.
+    #[inline(always)]
+    fn sample_wavelengths(&mut self, lanes: u32) {
+        let u = self.rng.next_f32(lanes).to_array();
+        for lane in bits(lanes) {
+            let (lambda, pdf) = sample_path_wavelengths(u[lane]);
+            self.lambda.set(lane, Vec3::from_array(lambda));
+            self.lambda_pdf.set(lane, Vec3::from_array(pdf));
+        }
+    }
+
+    /// Emission `le` (linear RGB) found by lanes `lanes`, each from light `light(lane)`, as the path carries
+    /// it: unchanged in RGB mode, and at each lane's wavelengths in spectral mode
+    /// ([`SpectralScene::emission`](crate::scene::SpectralScene::emission)).
+    #[inline(always)]
+    fn emission(&self, scene: &Scene, le: [Float8; 3], lanes: u32, light: impl Fn(usize) -> Option<usize>) -> [Float8; 3] {
+        if !self.spectral {
+            return le;
+        }
+        let mut rows = le.map(|c| c.to_array());
+        for lane in bits(lanes) {
+            let v = scene.spectral.emission(light(lane), [rows[0][lane], rows[1][lane], rows[2][lane]], self.lambda(lane));
+            for (row, v) in rows.iter_mut().zip(v) {
+                row[lane] = v;
+            }
+        }
+        rows.map(|r| Float8::load(&r))
     }
 
     /// The probability of choosing light `index` at the vertex lane `lane`'s ray left
@@ -193,10 +240,28 @@ impl Packet {
         }
     }
 
+    /// Diffuse reflectances `rho` (linear RGB) of lanes `lanes`, each on shape `shape(lane)`, at each lane's
+    /// wavelengths (spectral mode; [`SpectralScene::reflectance`](crate::scene::SpectralScene::reflectance)).
+    #[inline(always)]
+    fn reflectance(&self, scene: &Scene, rho: [Float8; 3], lanes: u32, shape: impl Fn(usize) -> usize) -> [Float8; 3] {
+        let mut rows = rho.map(|c| c.to_array());
+        for lane in bits(lanes) {
+            let v = scene.spectral.reflectance(shape(lane), [rows[0][lane], rows[1][lane], rows[2][lane]], self.lambda(lane));
+            for (row, v) in rows.iter_mut().zip(v) {
+                row[lane] = v;
+            }
+        }
+        rows.map(|r| Float8::load(&r))
+    }
+
     /// Lane `lane`'s path ends: its radiance goes to `out`.
     #[inline(always)]
     fn finish(&mut self, lane: usize, out: &mut [Rgb]) {
-        out[self.sample[lane]] = self.l.rgb(lane);
+        out[self.sample[lane]] = if self.spectral {
+            path_to_linear_srgb(self.lambda(lane), self.lambda_pdf.get(lane).to_array(), self.l.get(lane).to_array())
+        } else {
+            self.l.rgb(lane)
+        };
         self.live &= !(1 << lane);
     }
 }
@@ -286,7 +351,9 @@ fn trace(scene: &Scene, p: &mut Packet, lanes: u32, hit: &mut Surfaces8, setting
     let seen = match environment {
         Some(Light::Constant(constant)) => Some((constant.radiance.0.map(Float8::splat), Float8::splat(constant.pdf_li(Vec3::Z)))),
         Some(Light::EnvMap(env)) if shown & !hit.found != 0 => {
-            let e = env.eval_lanes(p.d.lanes(), shown & !hit.found);
+            // In spectral mode at each lane's wavelengths already (`EnvMap::eval_lanes_at`).
+            let lambda = |lane: usize| p.lambda(lane);
+            let e = env.eval_lanes_at(p.d.lanes(), shown & !hit.found, p.spectral.then_some(&lambda as LaneWavelengths<'_>));
             Some((e.li, e.pdf))
         }
         _ => None,
@@ -321,6 +388,16 @@ fn trace(scene: &Scene, p: &mut Packet, lanes: u32, hit: &mut Surfaces8, setting
     }
     let le = load_rgb(&le);
     let le: [Float8; 3] = std::array::from_fn(|c| Float8::select(Mask8::from_bitmask(sky), sky_le[c], le[c]));
+    // Each lane's light: an emitting surface's, or the environment where the ray escaped.
+    let light_of = |lane: usize| {
+        if hit.found & (1 << lane) != 0 {
+            scene.shape_lights.get(hit.shape[lane] as usize).copied().flatten().map(|i| i as usize)
+        } else {
+            scene.environment.map(|i| i as usize)
+        }
+    };
+    let spectral_sky = if matches!(environment, Some(Light::EnvMap(_))) { sky } else { 0 };
+    let le = p.emission(scene, le, (sky | (shown & (hit.emits | escaped))) & !spectral_sky, light_of);
     let (mut l, beta) = (load_rgb(&p.l), load_rgb(&p.beta));
     let m = Mask8::from_bitmask(lanes);
     for c in 0..3 {
@@ -438,7 +515,11 @@ fn shading<'a>(scene: &'a Scene, p: &Packet, hit: &Surfaces8) -> Shading<'a> {
     });
     for (first, same) in groups(p.live, |l| p.live & lanes_where(|k| class[k] == class[l])) {
         let material = &scene.materials[hit.shape[first] as usize];
+        // In spectral mode, a material with colours runs a copy of its model per lane, at the lane's
+        // wavelengths (`spectral::reflectances_at`); diffuse ones are converted in `rho` below.
+        let chromatic = p.spectral && scene.spectral.chromatic.get(hit.shape[first] as usize).copied().unwrap_or(false);
         if let Some(r) = material.diffuse_reflectance_lanes(u, v, same) {
+            let r = if p.spectral { p.reflectance(scene, r, same, |_| hit.shape[first] as usize) } else { r };
             let m = Mask8::from_bitmask(same);
             rho = std::array::from_fn(|c| Float8::select(m, r[c], rho[c]));
             diffuse |= same;
@@ -447,7 +528,7 @@ fn shading<'a>(scene: &'a Scene, p: &Packet, hit: &Surfaces8) -> Shading<'a> {
         // A textured material whose textures only tint its model or set parameters it takes per lane: that
         // one model (or its kernel with each lane's values) for all its lanes, each lane's values scaled by
         // its tints (`Shading::tinted`).
-        if let Some(lm) = material.lanes_at(u, v, same) {
+        if let Some(lm) = material.lanes_at(u, v, same).filter(|_| !chromatic) {
             if lm.tinted {
                 let m = Mask8::from_bitmask(same);
                 for (lobe, t) in tint.iter_mut().zip(lm.tints) {
@@ -472,13 +553,23 @@ fn shading<'a>(scene: &'a Scene, p: &Packet, hit: &Surfaces8) -> Shading<'a> {
                     rho_rows.set_rgb(lane, r);
                     diffuse_rows |= 1 << lane;
                 }
-                None if material.reads_surface() => models[lane] = Some(scene.bsdf_at(&hit.interaction(lane, 0.0))),
-                None => models[lane] = Some(material.at(uv)),
+                None => {
+                    let model = if material.reads_surface() { scene.bsdf_at(&hit.interaction(lane, 0.0)) } else { material.at(uv) };
+                    models[lane] = Some(if chromatic {
+                        let mut model = model.into_owned();
+                        reflectances_at(&mut model, p.lambda(lane));
+                        Cow::Owned(model)
+                    } else {
+                        model
+                    });
+                }
             }
         }
     }
     if diffuse_rows != 0 {
-        let (m, r) = (Mask8::from_bitmask(diffuse_rows), load_rgb(&rho_rows));
+        let r = load_rgb(&rho_rows);
+        let r = if p.spectral { p.reflectance(scene, r, diffuse_rows, |l| hit.shape[l] as usize) } else { r };
+        let m = Mask8::from_bitmask(diffuse_rows);
         rho = std::array::from_fn(|c| Float8::select(m, r[c], rho[c]));
         diffuse |= diffuse_rows;
     }
@@ -583,6 +674,8 @@ fn light_sample(scene: &Scene, p: &mut Packet, hit: &Surfaces8, sh: &Shading<'_>
     // the point on it in lanes; environments, point lights and spheres in lanes; other lights in full
     // per lane.
     let mut drawn = LightSamples::default();
+    // The lanes whose radiance an environment map gave at their wavelengths already (spectral mode).
+    let mut spectral_li = 0u32;
     let (mut tri, mut tri_n, mut tri_ns, mut pdf_area) = ([Rows3::default(); 3], Rows3::default(), Rows3::default(), Float8::splat(0.0));
     let mut on_mesh = 0u32;
     let (mut sph_center, mut sph_radius, mut sph_inward, mut on_sphere) = (Rows3::default(), Float8::splat(1.0), 0u32, 0u32);
@@ -620,7 +713,9 @@ fn light_sample(scene: &Scene, p: &mut Packet, hit: &Surfaces8, sh: &Shading<'_>
         if let Light::EnvMap(env) = &scene.lights[index] {
             // `EnvMap::sample_li` in lanes (the surfaces' normals are never zero), where the sample
             // carries light.
-            let s = env.sample_lanes(u_c, u_x, u_y, same);
+            let lambda = |lane: usize| p.lambda(lane);
+            let s = env.sample_lanes_at(u_c, u_x, u_y, same, p.spectral.then_some(&lambda as LaneWavelengths<'_>));
+            spectral_li |= same;
             let zero = Float8::splat(0.0);
             let ok = s.valid & m & (s.li[0].ne(zero) | s.li[1].ne(zero) | s.li[2].ne(zero));
             let ray = RayLanes { o: offset_origin_lanes(sp, sn, s.wi), d: s.wi, tmax: Float8::splat(f32::INFINITY) };
@@ -758,7 +853,7 @@ fn light_sample(scene: &Scene, p: &mut Packet, hit: &Surfaces8, sh: &Shading<'_>
     let unweighted = delta | if n_bsdf == 0.0 { smooth } else { 0 };
     let w = Float8::select(Mask8::from_bitmask(unweighted), Float8::splat(1.0), w);
     let scale = wi_local.z.abs() * w / light_pdf;
-    let li = load_rgb(&li);
+    let li = p.emission(scene, load_rgb(&li), visible & !spectral_li, |lane| Some(chosen[lane] as usize));
     let mut l = load_rgb(&p.l);
     let (visible, smooth) = (Mask8::from_bitmask(visible), Mask8::from_bitmask(smooth));
     for c in 0..3 {
@@ -813,7 +908,7 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
         out.fill(Rgb::ZERO);
         return;
     }
-    let mut p = Packet::new();
+    let mut p = Packet { spectral: scene.mode == Mode::Spectral, ..Packet::new() };
     // The surfaces the packet shades, and those the `direct` integrator's several BSDF samples find.
     let (mut hit, mut found) = (Surfaces8::default(), Surfaces8::default());
     let mut next = 0;
@@ -836,6 +931,9 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
             if fill != 0 {
                 let rays = start_lanes(scene, &mixed, &chosen, fill, &mut p.rng);
                 p.start(fill, &rays);
+                if p.spectral {
+                    p.sample_wavelengths(fill);
+                }
             }
             pending |= fill;
             if pending == 0 {

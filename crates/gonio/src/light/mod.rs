@@ -69,6 +69,22 @@ impl Light {
         }
     }
 
+    /// The light's colour where it is one colour throughout, every value it gives being that colour times a
+    /// number (a distance's falloff, a spot's profile, a cosine): the radiance of an area or constant light,
+    /// the intensity of a point or untextured spot light, the irradiance of a directional one. `None` for
+    /// textured lights (a projector, a textured spot, an environment map).
+    #[must_use]
+    pub fn constant_colour(&self) -> Option<Rgb> {
+        match self {
+            Light::Area(l) => Some(l.radiance),
+            Light::Point(l) => Some(l.intensity),
+            Light::Spot(l) => (!l.is_textured()).then_some(l.intensity),
+            Light::Directional(l) => Some(l.irradiance),
+            Light::Constant(l) => Some(l.radiance),
+            Light::Projector(_) | Light::EnvMap(_) => None,
+        }
+    }
+
     /// Whether the light is a delta distribution (no chance of hitting it by BSDF sampling).
     #[must_use]
     pub fn is_delta(&self) -> bool {

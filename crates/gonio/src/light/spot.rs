@@ -41,6 +41,12 @@ pub struct SpotLight {
 }
 
 impl SpotLight {
+    /// Whether a texture is projected (its colour then varies across the beam).
+    #[must_use]
+    pub fn is_textured(&self) -> bool {
+        self.texture.is_some()
+    }
+
     /// A spot at `to_world · 0` shining along `to_world · +z`; angles in degrees, 0 < beam ≤ cutoff ≤ 180
     /// (the caller checks).
     #[must_use]

@@ -3,6 +3,7 @@
 //! know is an error naming the place in the file.
 
 use super::mitsuba_xml::SceneDescription;
+use super::spectral::{check_bsdf, Mode, SpectralScene};
 use super::{Aov, AovKind, IntegratorKind, Material, SamplerSpec, Scene};
 use crate::bsdf::{Bsdf, Diffuse};
 use crate::camera::Camera;
@@ -25,6 +26,14 @@ const SHAPES: &str = "sphere, rectangle, cube, disk, cylinder, obj, ply, seriali
 impl Scene {
     /// Build every plugin of a parsed scene.
     pub fn build(desc: SceneDescription) -> Result<Scene> {
+        Scene::build_in(desc, Mode::Rgb)
+    }
+
+    /// [`Scene::build`] for rendering in `mode`.
+    ///
+    /// # Errors
+    /// Also, in spectral mode, a material it does not take yet ([`super::spectral::check_bsdf`]).
+    pub fn build_in(desc: SceneDescription, mode: Mode) -> Result<Scene> {
         let mut warnings = desc.warnings.clone();
         // The shapes' bitmaps decoded together, in parallel, and held until the shapes are built.
         let mut files = Vec::new();
@@ -32,7 +41,7 @@ impl Scene {
             bitmap_files(p, &mut files);
         }
         let _decoded = crate::texture::bitmap::decode_images(&files);
-        let mut built = Built::default();
+        let mut built = Built { mode, ..Built::default() };
         for p in &desc.shapes {
             match p.plugin_type() {
                 // A declaration for the instances that `<ref>` it; its shapes are built by each instance.
@@ -52,13 +61,20 @@ impl Scene {
                 _ => built.add(p, &Transform::IDENTITY)?,
             }
         }
-        let Built { shapes, materials, shape_lights, mut lights } = built;
+        let Built { shapes, materials, shape_lights, mut lights, chromatic, .. } = built;
         for e in &desc.emitters {
             let light = light_from_props(e)?;
             if light.is_environment() && lights.iter().any(Light::is_environment) {
                 return Err(Error::spec(e.at(), "a scene takes at most one environment emitter"));
             }
             lights.push(light);
+        }
+        if mode == Mode::Spectral {
+            for light in &mut lights {
+                if let Light::EnvMap(env) = light {
+                    env.prepare_spectra();
+                }
+            }
         }
         let sensor = desc.sensor.as_ref().ok_or_else(|| Error::spec(&desc.source, "the scene has no <sensor>"))?;
         let film = match sensor.nested_of("film").as_slice() {
@@ -91,7 +107,17 @@ impl Scene {
                 ));
             }
         }
-        Ok(Scene::assemble(shapes, materials, shape_lights, lights, camera, film, sampler, integrator, warnings))
+        let mut scene = Scene::assemble(shapes, materials, shape_lights, lights, camera, film, sampler, integrator, warnings);
+        if mode == Mode::Spectral {
+            if matches!(scene.integrator, IntegratorKind::Aov { .. }) {
+                return Err(Error::spec(&desc.source, "spectral mode renders the `path` and `direct` integrators; `aov` needs --mode rgb"));
+            }
+            // The table RGB values are taken to spectra with, built now rather than by the first path.
+            let _ = crate::spectrum::upsample::srgb_table();
+            scene.mode = mode;
+            scene.spectral = SpectralScene::new(&scene.materials, &scene.lights, chromatic);
+        }
+        Ok(scene)
     }
 }
 
@@ -103,6 +129,9 @@ struct Built {
     materials: Vec<Material>,
     shape_lights: Vec<Option<u32>>,
     lights: Vec<Light>,
+    mode: Mode,
+    /// In spectral mode, whether each material has colours ([`super::spectral::check_bsdf`]).
+    chromatic: Vec<bool>,
 }
 
 impl Built {
@@ -120,6 +149,12 @@ impl Built {
             [one] => Material::from_props(one)?,
             [_, second, ..] => return Err(Error::spec(second.at(), "a shape takes one <bsdf>")),
         });
+        if self.mode == Mode::Spectral {
+            self.chromatic.push(match nested.as_slice() {
+                [one] => check_bsdf(one)?,
+                _ => false,
+            });
+        }
         if let (Some(material), Some(shape)) = (self.materials.last(), self.shapes.last()) {
             for m in material.mesh_attributes() {
                 let names: Vec<&str> = match shape {

@@ -22,7 +22,7 @@ const CACHE_CAPACITY: usize = 256;
 
 /// BSDF parameters that take a float, not a colour: a texture there is read with Mitsuba's scalar lookup
 /// ([`Texture::eval_1`]), which differs from the colour lookup for checkerboards.
-const SCALAR_PARAMETERS: &[&str] = &[
+pub(crate) const SCALAR_PARAMETERS: &[&str] = &[
     "alpha",
     "alpha_u",
     "alpha_v",

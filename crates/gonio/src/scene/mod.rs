@@ -8,9 +8,11 @@ pub mod material;
 pub mod mesh_files;
 pub mod mitsuba_dict;
 pub mod mitsuba_xml;
+pub mod spectral;
 pub mod surfaces;
 
 pub use material::{LaneMaterial, Material};
+pub use spectral::{Mode, SpectralScene};
 
 use crate::bsdf::Bsdf;
 use crate::camera::Camera;
@@ -154,6 +156,10 @@ pub struct Scene {
     pub warnings: Vec<String>,
     /// Seconds spent building the BVH and its primitive packets (for benchmarks).
     pub bvh_seconds: f64,
+    /// How light is carried: RGB, or sampled wavelengths ([`Scene::build_in`]).
+    pub mode: Mode,
+    /// What spectral mode keeps of the scene (empty in RGB mode).
+    pub spectral: SpectralScene,
     /// Whether each shape's material reads textures (only then are texture coordinates computed at hits).
     textured: Vec<bool>,
     /// Per shape, the first shape with the same constant `diffuse` reflectance (shapes that share a
@@ -488,6 +494,11 @@ impl Scene {
         Scene::build(mitsuba_xml::load_file(path, overrides)?)
     }
 
+    /// [`Scene::load`] for rendering in `mode`.
+    pub fn load_in(path: &Path, overrides: &[(String, String)], mode: Mode) -> Result<Scene> {
+        Scene::build_in(mitsuba_xml::load_file(path, overrides)?, mode)
+    }
+
     /// Assemble a scene and build its BVH.
     #[must_use]
     #[allow(clippy::too_many_arguments)] // one argument per plugin parameter, as in the table above
@@ -565,6 +576,8 @@ impl Scene {
             integrator,
             warnings,
             bvh_seconds,
+            mode: Mode::Rgb,
+            spectral: SpectralScene::default(),
             textured,
             material_class,
             bvh,

@@ -2,8 +2,8 @@
 //! ([`cie`]), and the building blocks of spectral mode — hero-wavelength sampling ([`wavelengths`]),
 //! tabulated spectra ([`piecewise`]), light spectra ([`illuminant`]), RGB → spectrum upsampling
 //! ([`upsample`]), wavelength-dependent indices of refraction ([`dispersion`]) and the film's estimate of
-//! a path's colour from its wavelengths ([`observer`]). Spectral mode is not wired into the renderer yet
-//! (docs/spectral.md).
+//! a path's colour from its wavelengths ([`observer`]); what a path carries in the renderer's spectral mode
+//! ([`sampled`]; docs/spectral.md).
 
 pub mod cie;
 pub mod dispersion;
@@ -12,6 +12,7 @@ pub mod named;
 pub mod observer;
 pub mod piecewise;
 pub mod rgb;
+pub mod sampled;
 pub mod upsample;
 pub mod wavelengths;
 

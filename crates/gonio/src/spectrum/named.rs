@@ -28,6 +28,7 @@
 use std::sync::OnceLock;
 
 use super::cie::{cie1931_xyz, CIE_MAX, CIE_MIN, CIE_Y_NORMALIZATION};
+use super::piecewise::PiecewiseLinear;
 use super::Rgb;
 
 /// Names accepted by `conductor.material`: `"none"` (a perfect mirror) and every metal with embedded
@@ -61,6 +62,21 @@ pub fn conductor(name: &str) -> Option<(Rgb, Rgb)> {
         CONDUCTOR_SPECTRA.iter().map(|&(name, eta, k)| (name, embedded_spd_to_rgb(name, eta), embedded_spd_to_rgb(name, k))).collect()
     });
     presets.iter().find(|p| p.0 == name).map(|&(_, eta, k)| (eta, k))
+}
+
+/// (η, k) of a named conductor as spectra (the embedded `.spd` tables, linearly interpolated; their nodes
+/// span at least 310–885 nm): what spectral mode evaluates at a path's wavelengths. `None` for `"none"`
+/// and unknown names.
+#[must_use]
+pub fn conductor_spectra(name: &str) -> Option<&'static (PiecewiseLinear, PiecewiseLinear)> {
+    static TABLES: OnceLock<Vec<(&'static str, (PiecewiseLinear, PiecewiseLinear))>> = OnceLock::new();
+    let tables = TABLES.get_or_init(|| {
+        let table = |name: &str, text: &str| {
+            PiecewiseLinear::from_spd(text).unwrap_or_else(|e| panic!("embedded spectrum of `{name}` is malformed: {e}"))
+        };
+        CONDUCTOR_SPECTRA.iter().map(|&(name, eta, k)| (name, (table(name, eta), table(name, k)))).collect()
+    });
+    tables.iter().find(|t| t.0 == name).map(|t| &t.1)
 }
 
 /// Reduces one embedded table. The tables are compiled in and checked by the tests, so a parse error

@@ -39,8 +39,15 @@ use super::Rgb;
 /// with density 0 are skipped; a non-finite radiance propagates (the film's NaN checks see it).
 #[must_use]
 pub fn sampled_to_xyz(wavelengths: &SampledWavelengths, radiance: [f32; N_WAVELENGTHS]) -> [f64; 3] {
+    wavelengths_to_xyz(wavelengths.lambda(), wavelengths.pdf(), radiance)
+}
+
+/// [`sampled_to_xyz`] for any number of wavelengths `lambda` drawn with densities `pdf` (the estimate's
+/// average is over all `N`, terminated ones included).
+#[must_use]
+pub fn wavelengths_to_xyz<const N: usize>(lambda: [f32; N], pdf: [f32; N], radiance: [f32; N]) -> [f64; 3] {
     let mut xyz = [0.0_f64; 3];
-    for ((lambda, pdf), l) in wavelengths.lambda().into_iter().zip(wavelengths.pdf()).zip(radiance) {
+    for ((lambda, pdf), l) in lambda.into_iter().zip(pdf).zip(radiance) {
         if pdf == 0.0 {
             continue;
         }
@@ -51,7 +58,7 @@ pub fn sampled_to_xyz(wavelengths: &SampledWavelengths, radiance: [f32; N_WAVELE
         }
     }
     #[allow(clippy::cast_precision_loss)]
-    let scale = CIE_Y_NORMALIZATION / N_WAVELENGTHS as f64;
+    let scale = CIE_Y_NORMALIZATION / N as f64;
     xyz.map(|v| v * scale)
 }
 
