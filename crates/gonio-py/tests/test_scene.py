@@ -147,33 +147,29 @@ def test_render_shape_determinism_and_arguments(scene_file):
             s.render(progress=False, **kwargs)
 
 
+def cli_render(scene_file, out, *args):
+    """`gonio render SCENE -o OUT --threads 2 -q ARGS…` with the CLI binary; returns the image it wrote."""
+    subprocess.run([str(CLI), "render", str(scene_file), "-o", str(out), "--threads", "2", "-q", *args], check=True, timeout=120)
+    return gonio.read_image(out)
+
+
 @pytest.mark.skipif(not CLI.exists(), reason="target/release/gonio not built (make build builds it)")
 def test_render_equals_cli_exr_bit_for_bit(scene_file, tmp_path):
-    out = tmp_path / "cli.exr"
-    subprocess.run(
-        [str(CLI), "render", str(scene_file), "-o", str(out), "--spp", "3", "--seed", "11", "--threads", "2", "-q", "-D", "width=24"],
-        check=True,
-        timeout=120,
-    )
-    cli = gonio.read_image(out)
+    cli = cli_render(scene_file, tmp_path / "cli.exr", "--spp", "3", "--seed", "11", "-D", "width=24")
     py = gonio.load_scene(scene_file, width=24).render(spp=3, seed=11, threads=2, progress=False)
     assert cli.shape == py.shape == (24, 24, 3)
     assert np.array_equal(cli, py)
 
 
+@pytest.mark.skipif(not CLI.exists(), reason="target/release/gonio not built (make build builds it)")
 def test_spectral_mode_equals_cli_and_differs_from_rgb(scene_file, tmp_path):
     # `mode="spectral"` is `gonio render --mode spectral` bit for bit; its image is another estimate of the
     # scene (gold and a blue plastic: colours whose spectra differ from their RGB), not the RGB one.
-    out = tmp_path / "cli.exr"
-    subprocess.run(
-        [str(CLI), "render", str(scene_file), "-o", str(out), "--spp", "3", "--seed", "5", "--threads", "2", "-q", "--mode", "spectral"],
-        check=True,
-        timeout=120,
-    )
+    cli = cli_render(scene_file, tmp_path / "cli.exr", "--spp", "3", "--seed", "5", "--mode", "spectral")
     spectral = gonio.load_scene(scene_file, mode="spectral")
     assert (spectral.mode, gonio.load_scene(scene_file).mode) == ("spectral", "rgb")
     py = spectral.render(spp=3, seed=5, threads=2, progress=False)
-    assert np.array_equal(gonio.read_image(out), py)
+    assert np.array_equal(cli, py)
     # Each path draws its wavelengths from its own stream: the image does not depend on the thread count.
     assert np.array_equal(py, spectral.render(spp=3, seed=5, threads=1, progress=False))
     rgb = gonio.load_scene(scene_file).render(spp=3, seed=5, threads=2, progress=False)

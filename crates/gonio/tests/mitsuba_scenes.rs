@@ -115,6 +115,20 @@ fn rows() -> Option<Vec<Row>> {
     )
 }
 
+/// [`rows`], or `None` (the test then passes vacuously) where the data is missing and
+/// `GONIO_SKIP_MISSING_DATA` is set; missing data without it fails the test.
+fn rows_or_skip() -> Option<Vec<Row>> {
+    let rows = rows();
+    if rows.is_none() {
+        assert!(
+            std::env::var_os("GONIO_SKIP_MISSING_DATA").is_some(),
+            "{DATA}/results.tsv is missing (set GONIO_SKIP_MISSING_DATA to skip)"
+        );
+        eprintln!("skipped: {DATA}/results.tsv is missing");
+    }
+    rows
+}
+
 /// Scale the scene's film down to at most [`MAX_PIXELS`] pixels, its aspect kept.
 fn shrink(scene: &mut Scene) {
     let (w, h) = (f64::from(scene.film.width), f64::from(scene.film.height));
@@ -197,14 +211,7 @@ fn judge(scene: &Scene, spp: u32, row: &Row, want: [f64; 3], ratio: f64, full: b
 
 #[test]
 fn every_scene_loads_or_is_a_documented_refusal_and_means_match_mitsuba() {
-    let Some(rows) = rows() else {
-        assert!(
-            std::env::var_os("GONIO_SKIP_MISSING_DATA").is_some(),
-            "{DATA}/results.tsv is missing (set GONIO_SKIP_MISSING_DATA to skip)"
-        );
-        eprintln!("skipped: {DATA}/results.tsv is missing");
-        return;
-    };
+    let Some(rows) = rows_or_skip() else { return };
     assert_eq!(rows.len(), 55);
     let full = std::env::var_os("GONIO_COMPAT_FULL").is_some();
     let docs = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/mitsuba-compatibility.md")).unwrap();
@@ -347,14 +354,7 @@ fn spectral_means() -> Vec<(String, Option<[f64; 3]>)> {
 /// line, column, "spectral mode does not take …"), and listed in docs/spectral.md.
 #[test]
 fn spectral_means_match_mitsuba() {
-    let Some(rows) = rows() else {
-        assert!(
-            std::env::var_os("GONIO_SKIP_MISSING_DATA").is_some(),
-            "{DATA}/results.tsv is missing (set GONIO_SKIP_MISSING_DATA to skip)"
-        );
-        eprintln!("skipped: {DATA}/results.tsv is missing");
-        return;
-    };
+    let Some(rows) = rows_or_skip() else { return };
     let full = std::env::var_os("GONIO_COMPAT_FULL").is_some();
     let docs = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/spectral.md")).unwrap();
     let (start, mut failures, mut matched, mut compared) = (Instant::now(), Vec::new(), 0, 0);
@@ -443,13 +443,7 @@ fn spectral_means_match_mitsuba() {
 /// its Gaussian filter (relative errors ≤ 4·10⁻⁴ in weights whose ratios make a pixel) and f32 rounding.
 #[test]
 fn aov_channels_match_mitsuba() {
-    let Some(row) = rows().and_then(|rows| rows.into_iter().find(|r| r.id == "d_aov")) else {
-        assert!(
-            std::env::var_os("GONIO_SKIP_MISSING_DATA").is_some(),
-            "{DATA}/results.tsv is missing (set GONIO_SKIP_MISSING_DATA to skip)"
-        );
-        return;
-    };
+    let Some(row) = rows_or_skip().and_then(|rows| rows.into_iter().find(|r| r.id == "d_aov")) else { return };
     let reference: serde_json::Value = serde_json::from_str(include_str!("data/aov_mitsuba.json")).unwrap();
     let list = |key: &str| reference[key].as_array().unwrap().clone();
     let names: Vec<String> = list("channels").iter().map(|v| v.as_str().unwrap().to_string()).collect();

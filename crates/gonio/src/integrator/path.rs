@@ -183,14 +183,7 @@ impl Packet {
         if !self.spectral {
             return le;
         }
-        let mut rows = le.map(|c| c.to_array());
-        for lane in bits(lanes) {
-            let v = scene.spectral.emission(light(lane), [rows[0][lane], rows[1][lane], rows[2][lane]], self.lambda(lane));
-            for (row, v) in rows.iter_mut().zip(v) {
-                row[lane] = v;
-            }
-        }
-        rows.map(|r| Float8::load(&r))
+        map_lanes(le, lanes, |lane, rgb| scene.spectral.emission(light(lane), rgb, self.lambda(lane)))
     }
 
     /// The probability of choosing light `index` at the vertex lane `lane`'s ray left
@@ -244,14 +237,7 @@ impl Packet {
     /// wavelengths (spectral mode; [`SpectralScene::reflectance`](crate::scene::SpectralScene::reflectance)).
     #[inline(always)]
     fn reflectance(&self, scene: &Scene, rho: [Float8; 3], lanes: u32, shape: impl Fn(usize) -> usize) -> [Float8; 3] {
-        let mut rows = rho.map(|c| c.to_array());
-        for lane in bits(lanes) {
-            let v = scene.spectral.reflectance(shape(lane), [rows[0][lane], rows[1][lane], rows[2][lane]], self.lambda(lane));
-            for (row, v) in rows.iter_mut().zip(v) {
-                row[lane] = v;
-            }
-        }
-        rows.map(|r| Float8::load(&r))
+        map_lanes(rho, lanes, |lane, rgb| scene.spectral.reflectance(shape(lane), rgb, self.lambda(lane)))
     }
 
     /// Lane `lane`'s path ends: its radiance goes to `out`.
@@ -264,6 +250,19 @@ impl Packet {
         };
         self.live &= !(1 << lane);
     }
+}
+
+/// `values` with each lane of `lanes` replaced by `f(lane, its three values)`.
+#[inline(always)]
+fn map_lanes(values: [Float8; 3], lanes: u32, f: impl Fn(usize, [f32; 3]) -> [f32; 3]) -> [Float8; 3] {
+    let mut rows = values.map(|c| c.to_array());
+    for lane in bits(lanes) {
+        let v = f(lane, [rows[0][lane], rows[1][lane], rows[2][lane]]);
+        for (row, v) in rows.iter_mut().zip(v) {
+            row[lane] = v;
+        }
+    }
+    rows.map(|r| Float8::load(&r))
 }
 
 #[inline(always)]
