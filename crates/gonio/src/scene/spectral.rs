@@ -207,8 +207,8 @@ fn is_model(p: &Props) -> bool {
 }
 
 /// Model `b` at the wavelengths `lambda`, in `b` and in the models it holds ([`Bsdf::for_each_nested`]):
-/// each colour parameter of [`CONVERTED`] replaced by its reflectance spectrum's values at `lambda`, and a
-/// conductor's index by its spectra's ([`crate::bsdf::Conductor::set_wavelengths`]).
+/// each colour parameter of `CONVERTED` (those [`check_bsdf`] takes) replaced by its reflectance spectrum's
+/// values at `lambda`, and a conductor's index by its spectra's ([`crate::bsdf::Conductor::set_wavelengths`]).
 pub fn reflectances_at(b: &mut Bsdf, lambda: [f32; PATH_WAVELENGTHS]) {
     if let Some(c) = b.conductor_fresnel() {
         c.set_wavelengths(lambda);
