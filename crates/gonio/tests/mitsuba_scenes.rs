@@ -209,78 +209,86 @@ fn judge(scene: &Scene, spp: u32, row: &Row, want: [f64; 3], ratio: f64, full: b
     (m, tol, off, 2 * half * rounds)
 }
 
-#[test]
-fn every_scene_loads_or_is_a_documented_refusal_and_means_match_mitsuba() {
-    let Some(rows) = rows_or_skip() else { return };
-    assert_eq!(rows.len(), 55);
-    let full = std::env::var_os("GONIO_COMPAT_FULL").is_some();
-    let docs = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/mitsuba-compatibility.md")).unwrap();
-    let start = Instant::now();
-    let mut failures = Vec::new();
-    let (mut loaded, mut matched) = (0, 0);
-    for row in &rows {
-        let t0 = Instant::now();
-        let refused = REFUSED.iter().find(|(id, _)| *id == row.id);
-        let mut scene = match (Scene::load(&row.path, &row.defines), refused) {
-            (Err(e), Some((_, want))) => {
+/// What one mode's comparison with Mitsuba expects: the scenes it refuses (with the end of the place in
+/// the error and what it says), those refused already in RGB mode (taken as they are), the scenes that
+/// differ by design (`DIFFERENT`'s form), and where each refused scene must be listed (`docs`, `listing`).
+struct Expected<'a> {
+    mode: Mode,
+    refused: &'a [(&'a str, &'a str)],
+    refused_in_rgb: &'a [(&'a str, &'a str)],
+    different: &'a [(&'a str, Option<f64>, &'a str)],
+    docs: &'a str,
+    listing: fn(&str) -> String,
+}
+
+/// Load each of `scenes` (a row and Mitsuba's mean for it) in `expected.mode`, render it and judge it as
+/// the module docs say ([`judge`]); prints a line per scene. Returns the failures, how many scenes were
+/// rendered and how many matched Mitsuba's mean (at their expected ratio).
+fn compare_with_mitsuba(scenes: &[(&Row, [f64; 3])], expected: &Expected<'_>, full: bool) -> (Vec<String>, usize, usize) {
+    let (mut failures, mut loaded, mut matched) = (Vec::new(), 0, 0);
+    let label = if expected.mode == Mode::Spectral { " spectral" } else { "" };
+    for &(row, want) in scenes {
+        let (id, t0) = (row.id.as_str(), Instant::now());
+        let refused = expected.refused.iter().find(|(r, _)| *r == id);
+        let mut scene = match (Scene::load_in(&row.path, &row.defines, expected.mode), refused) {
+            (Err(e), Some((_, msg))) => {
                 let e = e.to_string();
-                if !e.contains(want) {
-                    failures.push(format!("{}: error changed: {e}\n    (want …{want})", row.id));
+                if !e.contains(msg) {
+                    failures.push(format!("{id}: error changed: {e}\n    (want …{msg})"));
                 }
-                if !docs.contains(&format!("| `{}` |", row.id)) {
-                    failures.push(format!("{}: refused but not listed in docs/mitsuba-compatibility.md", row.id));
+                if !expected.docs.contains(&(expected.listing)(id)) {
+                    failures.push(format!("{id}: refused{label} but not listed in the docs"));
                 }
-                eprintln!("{:<22} refused  {e}", row.id);
+                eprintln!("{id:<22} refused  {e}");
+                continue;
+            }
+            (Err(e), None) if expected.refused_in_rgb.iter().any(|(r, _)| *r == id) => {
+                eprintln!("{id:<22} refused (as in RGB mode)  {e}");
                 continue;
             }
             (Err(e), None) => {
-                failures.push(format!("{}: does not load: {e}", row.id));
+                failures.push(format!("{id}: does not load: {e}"));
                 continue;
             }
             (Ok(_), Some(_)) => {
-                failures.push(format!("{}: loads now: take it out of REFUSED and the docs' list", row.id));
+                failures.push(format!("{id}: loads now: take it out of the refused scenes and the docs' list"));
                 continue;
             }
             (Ok(s), None) => s,
         };
         loaded += 1;
-        assert_eq!((scene.film.width, scene.film.height), row.size, "{}: film size against results.tsv", row.id);
+        assert_eq!((scene.film.width, scene.film.height), row.size, "{id}: film size against results.tsv");
         let spp = if full {
             row.spp
         } else {
             shrink(&mut scene);
             SPP
         };
-        let different = DIFFERENT.iter().find(|(id, _, _)| *id == row.id);
+        let different = expected.different.iter().find(|(d, _, _)| *d == id);
         let ratio = match different {
             Some((_, Some(r), _)) => *r,
             Some((_, None, _)) => f64::NAN,
             None => 1.0,
         };
-        let (m, tol, off, spp) = judge(&scene, spp, row, row.mean, ratio, full);
-        let scale = if ratio.is_finite() { ratio } else { 1.0 };
         // The verdict is the last round's: no channel off by more than its tolerance.
-        let ok = !off;
-        let worst =
-            m.iter().zip(&row.mean).filter(|(_, want)| **want > 0.0).map(|(m, want)| (m / (want * ratio) - 1.0).abs()).fold(0.0, f64::max);
-        let status = match (different, ok) {
+        let (m, tol, off, spp) = judge(&scene, spp, row, want, ratio, full);
+        let scale = if ratio.is_finite() { ratio } else { 1.0 };
+        let worst = m.iter().zip(&want).filter(|(_, w)| **w > 0.0).map(|(m, w)| (m / (w * ratio) - 1.0).abs()).fold(0.0, f64::max);
+        let status = match (different, off) {
             (Some((_, None, _)), _) => "differs",
-            (_, true) => "ok",
-            (_, false) => "MISMATCH",
+            (_, false) => "ok",
+            (_, true) => "MISMATCH",
         };
-        if ok && ratio.is_finite() {
-            matched += 1;
-        }
+        matched += usize::from(status == "ok");
         let line = format!(
-            "{:<22} {status:<8} {}×{} {spp} spp  gonio/Mitsuba {:.4} {:.4} {:.4}  (worst {:.2} %, tolerance ±{:.2} %)  {:.2} s",
-            row.id,
+            "{id:<22} {status:<8} {}×{} {spp} spp  gonio/Mitsuba{label} {:.4} {:.4} {:.4}  (worst {:.2} %, tolerance ±{:.2} %)  {:.2} s",
             scene.film.width,
             scene.film.height,
-            m[0] / row.mean[0],
-            m[1] / row.mean[1],
-            m[2] / row.mean[2],
+            m[0] / want[0],
+            m[1] / want[1],
+            m[2] / want[2],
             100.0 * worst,
-            100.0 * tol.iter().zip(&row.mean).map(|(t, m)| if *m > 0.0 { t / (m * scale) } else { 0.0 }).fold(0.0, f64::max),
+            100.0 * tol.iter().zip(&want).map(|(t, w)| if *w > 0.0 { t / (w * scale) } else { 0.0 }).fold(0.0, f64::max),
             t0.elapsed().as_secs_f64()
         );
         eprintln!("{line}");
@@ -288,6 +296,26 @@ fn every_scene_loads_or_is_a_documented_refusal_and_means_match_mitsuba() {
             failures.push(line);
         }
     }
+    (failures, loaded, matched)
+}
+
+#[test]
+fn every_scene_loads_or_is_a_documented_refusal_and_means_match_mitsuba() {
+    let Some(rows) = rows_or_skip() else { return };
+    assert_eq!(rows.len(), 55);
+    let full = std::env::var_os("GONIO_COMPAT_FULL").is_some();
+    let docs = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/mitsuba-compatibility.md")).unwrap();
+    let start = Instant::now();
+    let expected = Expected {
+        mode: Mode::Rgb,
+        refused: REFUSED,
+        refused_in_rgb: &[],
+        different: DIFFERENT,
+        docs: &docs,
+        listing: |id| format!("| `{id}` |"),
+    };
+    let scenes: Vec<_> = rows.iter().map(|r| (r, r.mean)).collect();
+    let (failures, loaded, matched) = compare_with_mitsuba(&scenes, &expected, full);
     eprintln!(
         "{loaded} of {} scenes load; {matched} match Mitsuba's mean; {} differ by design; {:.1} s",
         rows.len(),
@@ -357,73 +385,23 @@ fn spectral_means_match_mitsuba() {
     let Some(rows) = rows_or_skip() else { return };
     let full = std::env::var_os("GONIO_COMPAT_FULL").is_some();
     let docs = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/spectral.md")).unwrap();
-    let (start, mut failures, mut matched, mut compared) = (Instant::now(), Vec::new(), 0, 0);
-    for (id, want) in spectral_means() {
-        let row = rows.iter().find(|r| r.id == id).unwrap_or_else(|| panic!("{id}: not in results.tsv"));
-        let Some(want) = want else { continue };
-        let t0 = Instant::now();
-        let refused = SPECTRAL_REFUSED.iter().find(|(r, _)| *r == id);
-        let mut scene = match (Scene::load_in(&row.path, &row.defines, Mode::Spectral), refused) {
-            (Err(e), Some((_, msg))) => {
-                let e = e.to_string();
-                if !e.contains(msg) {
-                    failures.push(format!("{id}: error changed: {e}\n    (want …{msg})"));
-                }
-                if !docs.contains(&format!("`{id}`")) {
-                    failures.push(format!("{id}: refused in spectral mode but not listed in docs/spectral.md"));
-                }
-                eprintln!("{id:<22} refused  {e}");
-                continue;
-            }
-            (Err(e), None) if REFUSED.iter().any(|(r, _)| *r == id) => {
-                eprintln!("{id:<22} refused (as in RGB mode)  {e}");
-                continue;
-            }
-            (Err(e), None) => {
-                failures.push(format!("{id}: does not load in spectral mode: {e}"));
-                continue;
-            }
-            (Ok(_), Some(_)) => {
-                failures.push(format!("{id}: loads in spectral mode now: take it out of SPECTRAL_REFUSED and the docs"));
-                continue;
-            }
-            (Ok(s), None) => s,
-        };
-        compared += 1;
-        let spp = if full {
-            row.spp
-        } else {
-            shrink(&mut scene);
-            SPP
-        };
-        let different = SPECTRAL_DIFFERENT.iter().find(|(d, _, _)| *d == id);
-        let ratio = match different {
-            Some((_, Some(r), _)) => *r,
-            Some((_, None, _)) => f64::NAN,
-            None => 1.0,
-        };
-        let (m, tol, off, spp) = judge(&scene, spp, row, want, ratio, full);
-        let status = match (different, off) {
-            (Some((_, None, _)), _) => "differs",
-            (_, false) => "ok",
-            (_, true) => "MISMATCH",
-        };
-        matched += usize::from(status == "ok");
-        let line = format!(
-            "{id:<22} {status:<8} {}×{} {spp} spp  gonio/Mitsuba spectral {:.4} {:.4} {:.4}  (tolerance ±{:.2} %)  {:.2} s",
-            scene.film.width,
-            scene.film.height,
-            m[0] / want[0],
-            m[1] / want[1],
-            m[2] / want[2],
-            100.0 * tol.iter().zip(&want).map(|(t, w)| if *w > 0.0 { t / w } else { 0.0 }).fold(0.0, f64::max),
-            t0.elapsed().as_secs_f64()
-        );
-        eprintln!("{line}");
-        if status == "MISMATCH" {
-            failures.push(line);
-        }
-    }
+    let start = Instant::now();
+    let expected = Expected {
+        mode: Mode::Spectral,
+        refused: SPECTRAL_REFUSED,
+        refused_in_rgb: REFUSED,
+        different: SPECTRAL_DIFFERENT,
+        docs: &docs,
+        listing: |id| format!("`{id}`"),
+    };
+    let scenes: Vec<_> = spectral_means()
+        .into_iter()
+        .filter_map(|(id, want)| {
+            let row = rows.iter().find(|r| r.id == id).unwrap_or_else(|| panic!("{id}: not in results.tsv"));
+            Some((row, want?))
+        })
+        .collect();
+    let (failures, compared, matched) = compare_with_mitsuba(&scenes, &expected, full);
     eprintln!(
         "{compared} scenes rendered in spectral mode; {matched} match Mitsuba's spectral mean; {:.1} s",
         start.elapsed().as_secs_f64()
