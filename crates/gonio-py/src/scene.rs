@@ -311,7 +311,7 @@ impl PyScene {
     /// `"rgb"` or `"spectral"`: how the scene was loaded (`load_scene(..., mode=...)`).
     #[getter]
     fn mode(&self) -> &'static str {
-        self.scene.mode.name()
+        self.scene.mode().name()
     }
 
     /// Image width in pixels (the film's `width`).

@@ -44,7 +44,7 @@ use crate::sampling::warp::uniform_sphere;
 use crate::sampling::Pcg32x8;
 use crate::scene::spectral::reflectances_at;
 use crate::scene::surfaces::{Rows3, Surfaces8};
-use crate::scene::{Mode, Scene};
+use crate::scene::Scene;
 use crate::spectrum::sampled::{path_to_linear_srgb, sample_path_wavelengths};
 use crate::spectrum::Rgb;
 use std::borrow::Cow;
@@ -180,10 +180,8 @@ impl Packet {
     /// ([`SpectralScene::emission`](crate::scene::SpectralScene::emission)).
     #[inline(always)]
     fn emission(&self, scene: &Scene, le: [Float8; 3], lanes: u32, light: impl Fn(usize) -> Option<usize>) -> [Float8; 3] {
-        if !self.spectral {
-            return le;
-        }
-        map_lanes(le, lanes, |lane, rgb| scene.spectral.emission(light(lane), rgb, self.lambda(lane)))
+        let Some(spectral) = &scene.spectral else { return le };
+        map_lanes(le, lanes, |lane, rgb| spectral.emission(light(lane), rgb, self.lambda(lane)))
     }
 
     /// The probability of choosing light `index` at the vertex lane `lane`'s ray left
@@ -237,7 +235,8 @@ impl Packet {
     /// wavelengths (spectral mode; [`SpectralScene::reflectance`](crate::scene::SpectralScene::reflectance)).
     #[inline(always)]
     fn reflectance(&self, scene: &Scene, rho: [Float8; 3], lanes: u32, shape: impl Fn(usize) -> usize) -> [Float8; 3] {
-        map_lanes(rho, lanes, |lane, rgb| scene.spectral.reflectance(shape(lane), rgb, self.lambda(lane)))
+        let Some(spectral) = &scene.spectral else { return rho };
+        map_lanes(rho, lanes, |lane, rgb| spectral.reflectance(shape(lane), rgb, self.lambda(lane)))
     }
 
     /// Lane `lane`'s path ends: its radiance goes to `out`.
@@ -516,7 +515,7 @@ fn shading<'a>(scene: &'a Scene, p: &Packet, hit: &Surfaces8) -> Shading<'a> {
         let material = &scene.materials[hit.shape[first] as usize];
         // In spectral mode, a material with colours runs a copy of its model per lane, at the lane's
         // wavelengths (`spectral::reflectances_at`); diffuse ones are converted in `rho` below.
-        let chromatic = p.spectral && scene.spectral.chromatic.get(hit.shape[first] as usize).copied().unwrap_or(false);
+        let chromatic = scene.spectral.as_ref().is_some_and(|s| s.chromatic.get(hit.shape[first] as usize).copied().unwrap_or(false));
         if let Some(r) = material.diffuse_reflectance_lanes(u, v, same) {
             let r = if p.spectral { p.reflectance(scene, r, same, |_| hit.shape[first] as usize) } else { r };
             let m = Mask8::from_bitmask(same);
@@ -907,7 +906,7 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
         out.fill(Rgb::ZERO);
         return;
     }
-    let mut p = Packet { spectral: scene.mode == Mode::Spectral, ..Packet::new() };
+    let mut p = Packet { spectral: scene.spectral.is_some(), ..Packet::new() };
     // The surfaces the packet shades, and those the `direct` integrator's several BSDF samples find.
     let (mut hit, mut found) = (Surfaces8::default(), Surfaces8::default());
     let mut next = 0;

@@ -114,8 +114,7 @@ impl Scene {
             }
             // The table RGB values are taken to spectra with, built now rather than by the first path.
             let _ = crate::spectrum::upsample::srgb_table();
-            scene.mode = mode;
-            scene.spectral = SpectralScene::new(&scene.materials, &scene.lights, chromatic);
+            scene.spectral = Some(SpectralScene::new(&scene.materials, &scene.lights, chromatic));
         }
         Ok(scene)
     }

@@ -156,10 +156,8 @@ pub struct Scene {
     pub warnings: Vec<String>,
     /// Seconds spent building the BVH and its primitive packets (for benchmarks).
     pub bvh_seconds: f64,
-    /// How light is carried: RGB, or sampled wavelengths ([`Scene::build_in`]).
-    pub mode: Mode,
-    /// What spectral mode keeps of the scene (empty in RGB mode).
-    pub spectral: SpectralScene,
+    /// What spectral mode keeps of the scene; `None` in RGB mode ([`Scene::build_in`], [`Scene::mode`]).
+    pub spectral: Option<SpectralScene>,
     /// Whether each shape's material reads textures (only then are texture coordinates computed at hits).
     textured: Vec<bool>,
     /// Per shape, the first shape with the same constant `diffuse` reflectance (shapes that share a
@@ -494,6 +492,16 @@ impl Scene {
         Scene::build(mitsuba_xml::load_file(path, overrides)?)
     }
 
+    /// How light is carried: RGB, or sampled wavelengths (where [`Self::spectral`] is kept).
+    #[must_use]
+    pub fn mode(&self) -> Mode {
+        if self.spectral.is_some() {
+            Mode::Spectral
+        } else {
+            Mode::Rgb
+        }
+    }
+
     /// [`Scene::load`] for rendering in `mode`.
     pub fn load_in(path: &Path, overrides: &[(String, String)], mode: Mode) -> Result<Scene> {
         Scene::build_in(mitsuba_xml::load_file(path, overrides)?, mode)
@@ -576,8 +584,7 @@ impl Scene {
             integrator,
             warnings,
             bvh_seconds,
-            mode: Mode::Rgb,
-            spectral: SpectralScene::default(),
+            spectral: None,
             textured,
             material_class,
             bvh,

@@ -18,9 +18,8 @@ use crate::bsdf::Bsdf;
 use crate::error::{Error, Result};
 use crate::light::Light;
 use crate::props::{Props, Value};
-use crate::spectrum::illuminant::d65;
 use crate::spectrum::sampled::{emission_at, reflectance_at, PATH_WAVELENGTHS};
-use crate::spectrum::upsample::{srgb_table, RgbUnboundedSpectrum, SigmoidPolynomial};
+use crate::spectrum::upsample::{srgb_table, RgbIlluminantSpectrum, SigmoidPolynomial};
 use crate::spectrum::Rgb;
 
 /// How the renderer carries light.
@@ -59,7 +58,7 @@ impl Mode {
 /// What spectral mode keeps of a scene beside its RGB form (empty in RGB mode): which materials have colours,
 /// and the spectra of the constant colours, fitted once at load ([`srgb_table`]'s `fit`: the round trip
 /// to 1e-4) rather than looked up at every use.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct SpectralScene {
     /// Per shape, whether its material has colours ([`check_bsdf`]): its model is then copied per lane and
     /// set to the lane's wavelengths ([`reflectances_at`]).
@@ -68,7 +67,7 @@ pub struct SpectralScene {
     diffuse: Vec<Option<SigmoidPolynomial>>,
     /// Per light, the spectrum of its colour where it has one ([`Light::constant_colour`]), and that
     /// colour's largest component.
-    lights: Vec<Option<(f32, RgbUnboundedSpectrum)>>,
+    lights: Vec<Option<(f32, RgbIlluminantSpectrum)>>,
 }
 
 impl SpectralScene {
@@ -84,7 +83,7 @@ impl SpectralScene {
             .collect();
         let lights = lights
             .iter()
-            .map(|l| l.constant_colour().filter(|c| c.max_component() > 0.0).map(|c| (c.max_component(), RgbUnboundedSpectrum::new(c))))
+            .map(|l| l.constant_colour().filter(|c| c.max_component() > 0.0).map(|c| (c.max_component(), RgbIlluminantSpectrum::new(c))))
             .collect();
         SpectralScene { chromatic, diffuse, lights }
     }
@@ -113,8 +112,7 @@ impl SpectralScene {
             return [f32::NAN; PATH_WAVELENGTHS];
         }
         let factor = rgb[0].max(rgb[1]).max(rgb[2]).max(0.0) / max;
-        #[allow(clippy::cast_possible_truncation)]
-        lambda.map(|l| factor * spectrum.eval(l) * d65(f64::from(l)) as f32)
+        lambda.map(|l| factor * spectrum.eval(l))
     }
 }
 
