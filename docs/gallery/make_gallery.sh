@@ -235,6 +235,11 @@ for ((k = 0; k < ${#SHOTS[@]}; k += 2)); do
 done
 md '```sh' "GONIO_SCREENSHOTS=docs/gallery .venv/bin/python -m pytest crates/gonio-py/tests/test_explore_browser.py" '```' ""
 
+# 13 -----------------------------------------------------------------------------------------------------------
+md "## 13. Dispersion: a prism spreads white light into its spectrum" ""
+pic 13_dispersion_prism.png "The lecture asks whether BRDFs can model dispersion (rainbows). In spectral mode they can: a narrow white slit seen through an SF11 prism (apex 60°; Schott's Sellmeier law, n = 1.85 at 400 nm and 1.77 at 700 nm) spreads into its spectrum, violet bent most. Each path follows its hero wavelength through the glass. The band's position per wavelength is checked against Snell's law in crates/gonio/tests/dispersion.rs. In RGB mode the same file shows the slit white, at the one index n_d. Scene: [scenes/prism.xml](../../scenes/prism.xml)." \
+    "$GONIO" render scenes/prism.xml --mode spectral -D spp=1024 -o $OUT/13_dispersion_prism.png
+
 mv "$README" "$OUT/README.md"
 ELAPSED=$(($(date +%s) - START))
 echo "make_gallery: done in ${ELAPSED} s" >&2

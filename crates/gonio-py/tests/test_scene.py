@@ -179,6 +179,23 @@ def test_spectral_mode_equals_cli_and_differs_from_rgb(scene_file, tmp_path):
         gonio.load_scene(scene_file, mode="hyperspectral")
 
 
+def test_dispersive_glass_from_a_dictionary():
+    # A dispersive index (issue 30) from Python: RGB mode renders it at n_d, spectral mode spreads it; a law
+    # where it is not taken names the parameter.
+    scene = {
+        "type": "scene",
+        "sensor": {"type": "perspective", "film": {"type": "hdrfilm", "width": 8, "height": 8}},
+        "light": {"type": "constant"},
+        "ball": {"type": "sphere", "bsdf": {"type": "dielectric", "int_ior": "sellmeier(1.03961212, 0.231792344, 1.01046945, 0.00600069867, 0.0200179144, 103.560653)"}},
+    }
+    rgb = gonio.load_dict(scene).render(spp=4, seed=3, progress=False)
+    spectral = gonio.load_dict(scene, mode="spectral").render(spp=4, seed=3, progress=False)
+    assert np.isfinite(spectral).all() and not np.array_equal(rgb, spectral)
+    plastic = dict(scene, ball={"type": "sphere", "bsdf": {"type": "plastic", "int_ior": "sf11"}})
+    with pytest.raises(gonio.SceneError, match=r"\$\.ball\.bsdf.*int_ior.*taken by `dielectric`, `roughdielectric` and `thindielectric` only"):
+        gonio.load_dict(plastic)
+
+
 def test_spectral_mode_refuses_what_it_does_not_take_yet(tmp_path):
     # A colour spectral mode cannot take to its spectrum yet is an error naming it and where it is.
     base = {

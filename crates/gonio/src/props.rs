@@ -14,9 +14,11 @@
 //! | `{"type": "diffuse", …}` under any key      | nested `<bsdf type="diffuse">`       | nested plugin    |
 
 use crate::error::{Error, Result};
+use crate::spectrum::illuminant::Spectrum;
 use crate::spectrum::Rgb;
 use crate::xml::{parse_numbers, parse_spectrum, parse_transform, parse_vector, xml_at, XmlEnv, XmlSource};
 use std::cell::{Cell, RefCell};
+use std::sync::Arc;
 
 /// One parameter value.
 #[derive(Clone, Debug, PartialEq)]
@@ -75,6 +77,8 @@ struct Entry {
     /// A texture's value at a hit ([`Props::set_texture_value`]): the range-checked readers clamp it into
     /// their range instead of rejecting it.
     clamped: bool,
+    /// The spectrum an emitter's `<spectrum>` gave (`value` is its RGB reduction), for spectral mode.
+    spectrum: Option<Arc<Spectrum>>,
 }
 
 /// The parameters of one plugin.
@@ -110,7 +114,7 @@ impl Props {
     /// Add a parameter (the last of equal names wins, as in Mitsuba's dictionaries).
     pub fn set(&mut self, name: &str, value: Value, at: &str) {
         self.entries.retain(|e| e.name != name);
-        self.entries.push(Entry { name: name.into(), value, at: at.into(), used: Cell::new(false), clamped: false });
+        self.entries.push(Entry { name: name.into(), value, at: at.into(), used: Cell::new(false), clamped: false, spectrum: None });
         self.plugins = 1 + self.entries.iter().map(|e| if let Value::Nested(p) = &e.value { p.plugins } else { 0 }).sum::<usize>();
     }
 
@@ -360,6 +364,13 @@ impl Props {
             Value::String(s) => Ok(Some(NumberOrName::Name(s.clone(), e.at.clone()))),
             _ => Err(self.wrong(e, "a number or a name")),
         }
+    }
+
+    /// The spectrum parameter `name` was given as, where an emitter's `<spectrum>` gave one (its value, as
+    /// the other getters read it, is the spectrum's RGB reduction).
+    #[must_use]
+    pub fn spectrum(&self, name: &str) -> Option<Arc<Spectrum>> {
+        self.entries.iter().find(|e| e.name == name).and_then(|e| e.spectrum.clone())
     }
 
     /// A boolean, or `default` when absent.
@@ -671,12 +682,14 @@ impl Props {
                 "point" | "vector" => Value::Vector(parse_vector(child, env, source, 0.0)?),
                 "transform" => Value::Transform(parse_transform(child, env, source)?),
                 "spectrum" => {
-                    let c = parse_spectrum(child, env, source, tag == "emitter")?;
-                    if c.r() == c.g() && c.g() == c.b() {
-                        Value::Number(f64::from(c.r()))
-                    } else {
-                        Value::List(c.to_f64().to_vec())
+                    let (c, spectrum) = parse_spectrum(child, env, source, tag == "emitter")?;
+                    let value =
+                        if c.r() == c.g() && c.g() == c.b() { Value::Number(f64::from(c.r())) } else { Value::List(c.to_f64().to_vec()) };
+                    props.set_checked(&name, value, &cat)?;
+                    if let (Some(spectrum), Some(e)) = (spectrum, props.entries.last_mut()) {
+                        e.spectrum = Some(Arc::new(spectrum));
                     }
+                    continue;
                 }
                 "float" | "integer" | "boolean" | "string" | "rgb" => {
                     let raw = env

@@ -5,7 +5,10 @@
 use crate::error::{Error, Result};
 use crate::math::Transform;
 use crate::props::Props;
+use crate::spectrum::cie::{CIE_MAX, CIE_MIN};
+use crate::spectrum::illuminant::{Blackbody, BlackbodyNormalization, Spectrum};
 use crate::spectrum::named::{parse_spd, reflectance_to_rgb, spectrum_to_rgb};
+use crate::spectrum::piecewise::PiecewiseLinear;
 use crate::spectrum::Rgb;
 use glam::Vec3;
 use std::cell::Cell;
@@ -309,28 +312,53 @@ pub fn parse_vector(node: roxmltree::Node, env: &XmlEnv, source: &XmlSource, def
     Ok(out)
 }
 
-/// `<spectrum value="0.5"/>` (uniform), `value="400:0.1, 500:0.3, …"` or `filename="x.spd"`, reduced to
-/// linear sRGB as Mitsuba's RGB variants do.
+/// `<spectrum value="0.5"/>` (uniform), `value="400:0.1, 500:0.3, …"` or `filename="x.spd"`, and the
+/// spectrum plugins `<spectrum type="d65">` (optional `scale`), `type="blackbody"` (`temperature` in K) and
+/// `type="uniform"` (`value`): reduced to linear sRGB as Mitsuba's RGB variants do, and, inside an
+/// `<emitter>`, kept as the spectrum too, for spectral mode (docs/spectral.md).
 ///
-/// Inside an `<emitter>` the spectrum is radiance: [`spectrum_to_rgb`] (no illuminant). Elsewhere it is a
-/// reflectance, which Mitsuba weights by D65 so that a flat spectrum stays grey; gonio approximates that by
-/// dividing each channel by the response to the equal-energy white ([`reflectance_to_rgb`], the one
-/// reduction of reflectance spectra, also used by spectral RGL files; exact for flat spectra: a flat 0.78
-/// over 400–700 nm gives (0.777, 0.781, 0.775) here and (0.776, 0.780, 0.776) in Mitsuba 3.9.1; 2026-11,
-/// until a D65 table lands in `spectrum`).
-pub fn parse_spectrum(node: roxmltree::Node, env: &XmlEnv, source: &XmlSource, within_emitter: bool) -> Result<Rgb> {
-    let reduce = |w: &[f64], v: &[f64]| if within_emitter { spectrum_to_rgb(w, v) } else { reflectance_to_rgb(w, v) };
+/// Inside an `<emitter>` the spectrum is radiance: [`spectrum_to_rgb`] (no illuminant). A uniform value v
+/// there is the equal-energy spectrum v, linear sRGB v·(1.2049, 0.9482, 0.9093), as in Mitsuba 3 (its RGB
+/// and spectral variants alike, checked on 3.9.1 on 2026-12-06: (1.2048, 0.9483, 0.9089); gonio read it as
+/// (v, v, v) before); `d65` is D65 of luminance `scale`, (1, 1, 1) × `scale`; a `blackbody` is Planck's
+/// law in W·m⁻²·sr⁻¹·nm⁻¹ over [360, 830] nm (Mitsuba 3 renders it in its spectral variants only; gonio's
+/// RGB mode takes its reduction). Elsewhere a spectrum is a reflectance, which Mitsuba weights by D65 so
+/// that a flat spectrum stays grey; gonio approximates that by dividing each channel by the response to the
+/// equal-energy white ([`reflectance_to_rgb`], the one reduction of reflectance spectra, also used by
+/// spectral RGL files; exact for flat spectra: a flat 0.78 over 400–700 nm gives (0.777, 0.781, 0.775)
+/// here and (0.776, 0.780, 0.776) in Mitsuba 3.9.1; 2026-11).
+pub fn parse_spectrum(node: roxmltree::Node, env: &XmlEnv, source: &XmlSource, within_emitter: bool) -> Result<(Rgb, Option<Spectrum>)> {
     let at = xml_at(source, node);
+    let tabulated = |w: Vec<f64>, v: Vec<f64>| -> Result<(Rgb, Option<Spectrum>)> {
+        if !within_emitter {
+            return Ok((reflectance_to_rgb(&w, &v), None));
+        }
+        let rgb = spectrum_to_rgb(&w, &v);
+        let table = PiecewiseLinear::new(w, v).map_err(|e| Error::spec(&at, format!("<spectrum>: {e}")))?;
+        Ok((rgb, Some(Spectrum::Tabulated(table))))
+    };
+    let uniform = |v: f64| -> Result<(Rgb, Option<Spectrum>)> {
+        if within_emitter {
+            let (rgb, _) = tabulated(vec![CIE_MIN, CIE_MAX], vec![v, v])?;
+            Ok((rgb, Some(Spectrum::Constant(v))))
+        } else {
+            #[allow(clippy::cast_possible_truncation)]
+            Ok((Rgb::splat(v as f32), None))
+        }
+    };
+    if let Some(kind) = env.attr(node, "type", source)? {
+        return spectrum_plugin(node, env, source, &kind, within_emitter, &uniform);
+    }
     if let Some(file) = env.attr(node, "filename", source)? {
         let path = env.resolve_file(&file, &at)?;
         let text = std::fs::read_to_string(&path).map_err(|source| Error::Io { path: path.clone(), source })?;
         let (w, v) = parse_spd(&text).map_err(|e| Error::spec(&at, format!("{}: {e}", path.display())))?;
-        return Ok(reduce(&w, &v));
+        return tabulated(w, v);
     }
     let raw = env.required(node, "value", source)?;
     if !raw.contains(':') {
         return match parse_numbers(&raw).as_deref() {
-            Some([v]) => Ok(Rgb::splat(*v as f32)),
+            Some([v]) => uniform(*v),
             _ => Err(Error::spec(at, format!("<spectrum>: expected a number or \"λ:value, …\" pairs, got \"{raw}\""))),
         };
     }
@@ -353,7 +381,66 @@ pub fn parse_spectrum(node: roxmltree::Node, env: &XmlEnv, source: &XmlSource, w
     if wavelengths.len() < 2 {
         return Err(Error::spec(at, "<spectrum>: a wavelength list needs at least two entries"));
     }
-    Ok(reduce(&wavelengths, &values))
+    tabulated(wavelengths, values)
+}
+
+/// `<spectrum type="…">` (see [`parse_spectrum`]): its `<float>` parameters, each taken once.
+fn spectrum_plugin(
+    node: roxmltree::Node,
+    env: &XmlEnv,
+    source: &XmlSource,
+    kind: &str,
+    within_emitter: bool,
+    uniform: &dyn Fn(f64) -> Result<(Rgb, Option<Spectrum>)>,
+) -> Result<(Rgb, Option<Spectrum>)> {
+    let at = xml_at(source, node);
+    let accepted: &[&str] = match kind {
+        "d65" => &["scale"],
+        "blackbody" => &["temperature"],
+        "uniform" => &["value"],
+        _ => {
+            return Err(Error::spec(
+                at,
+                format!("<spectrum type=\"{kind}\">: gonio reads the spectrum types d65, blackbody and uniform, and <spectrum value=…> or filename=…"),
+            ))
+        }
+    };
+    let mut floats: Vec<(String, f64)> = Vec::new();
+    for child in node.children().filter(roxmltree::Node::is_element) {
+        let cat = xml_at(source, child);
+        let name = env.attr(child, "name", source)?.unwrap_or_default();
+        if child.tag_name().name() != "float" || !accepted.contains(&name.as_str()) || floats.iter().any(|(n, _)| *n == name) {
+            return Err(Error::spec(cat, format!("<spectrum type=\"{kind}\"> takes <float name=…> once each of: {}", accepted.join(", "))));
+        }
+        let raw = env.required(child, "value", source)?;
+        let v = raw
+            .trim()
+            .parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| Error::spec(&cat, format!("`{name}`: expected a number, got \"{raw}\"")))?;
+        floats.push((name, v));
+    }
+    let get = |name: &str| floats.iter().find(|(n, _)| n == name).map(|(_, v)| *v);
+    match kind {
+        "d65" => {
+            let scale = get("scale").unwrap_or(1.0);
+            #[allow(clippy::cast_possible_truncation)]
+            Ok((Rgb::splat(scale as f32), within_emitter.then_some(Spectrum::D65 { scale })))
+        }
+        "blackbody" => {
+            let temperature = get("temperature")
+                .ok_or_else(|| Error::spec(&at, "<spectrum type=\"blackbody\"> needs <float name=\"temperature\"> (K)"))?;
+            if !within_emitter || !(temperature > 0.0) {
+                return Err(Error::spec(at, "<spectrum type=\"blackbody\">: an emitter's spectrum, with a temperature > 0 K"));
+            }
+            let body = Blackbody::new(temperature, BlackbodyNormalization::Radiance);
+            let w: Vec<f64> = (0..=470).map(|i| CIE_MIN + f64::from(i)).collect();
+            let v: Vec<f64> = w.iter().map(|&l| body.eval(l)).collect();
+            Ok((spectrum_to_rgb(&w, &v), Some(Spectrum::Blackbody(body))))
+        }
+        _ => uniform(get("value").ok_or_else(|| Error::spec(&at, "<spectrum type=\"uniform\"> needs <float name=\"value\">"))?),
+    }
 }
 
 /// Mitsuba 3's `<rotate>` (`Transform4f::rotate`): M = cos θ I + (1 − cos θ) a aᵀ + sin θ [a]×, with the
@@ -529,11 +616,11 @@ mod tests {
         assert_eq!(env.substitute("a$spp-b", "x").unwrap(), "a64-b");
         assert!(env.substitute("$nope", "f.xml:3:4").unwrap_err().to_string().starts_with("f.xml:3:4: `$nope` is not defined"));
         let doc = roxmltree::Document::parse("<spectrum name=\"r\" value=\"400:0.78, 500:0.78, 600:0.78, 700:0.78\"/>").unwrap();
-        let c = parse_spectrum(first(&doc), &env, &XmlSource::new("s.xml", doc.input_text()), false).unwrap();
+        let c = parse_spectrum(first(&doc), &env, &XmlSource::new("s.xml", doc.input_text()), false).unwrap().0;
         // Mitsuba 3.9.1 (scalar_rgb) loads this reflectance as (0.776367, 0.77981, 0.776029).
         assert!((c.r() - 0.776).abs() < 2e-3 && (c.g() - 0.780).abs() < 2e-3 && (c.b() - 0.776).abs() < 2e-3, "{c}");
         let doc = roxmltree::Document::parse("<spectrum name=\"radiance\" value=\"400:0, 500:8, 600:15.6, 700:18.4\"/>").unwrap();
-        let c = parse_spectrum(first(&doc), &env, &XmlSource::new("s.xml", doc.input_text()), true).unwrap();
+        let c = parse_spectrum(first(&doc), &env, &XmlSource::new("s.xml", doc.input_text()), true).unwrap().0;
         // Mitsuba 3.9.1 loads this area-light radiance as (20.7108, 10.8546, 2.77115).
         assert!(
             (c.r() / 20.7108 - 1.0).abs() < 2e-3 && (c.g() / 10.8546 - 1.0).abs() < 2e-3 && (c.b() / 2.77115 - 1.0).abs() < 5e-3,

@@ -4,14 +4,17 @@
 //!
 //! | parameter                | type            | default | meaning                                         |
 //! |--------------------------|-----------------|---------|-------------------------------------------------|
-//! | `int_ior`                | float or name   | `bk7` (1.5046) | index of the inside (below the surface, z < 0) |
-//! | `ext_ior`                | float or name   | `air` (1.000277) | index of the outside (z > 0)               |
+//! | `int_ior`                | float, name or law | `bk7` (1.5046) | index of the inside (below the surface, z < 0) |
+//! | `ext_ior`                | float, name or law | `air` (1.000277) | index of the outside (z > 0)            |
+//! | `dispersive`             | bool            | false   | read `int_ior`/`ext_ior` names as gonio's dispersive glasses ([`Dispersion`]) |
+//! | `abbe`                   | float > 0       | —       | Abbe number V_d: `int_ior` (a number or name) becomes its value at 587.56 nm of a dispersive Cauchy law |
 //! | `specular_reflectance`   | rgb [0,1]       | 1       | multiplier on reflection (not physical)         |
 //! | `specular_transmittance` | rgb [0,1]       | 1       | multiplier on transmission (not physical)       |
 //! | `fresnel`                | bool            | true    | gonio's teaching switch: `false` replaces F(θ) by the constant F(0) = ((η−1)/(η+1))² (total internal reflection stays) |
 //!
 //! Both sides scatter: `wo` below the surface sees the interface from the inside. Names are those of
-//! Mitsuba's IOR table (`vacuum`, `air`, `water`, `bk7`, `diamond`, …).
+//! Mitsuba's IOR table (`vacuum`, `air`, `water`, `bk7`, `diamond`, …). An index may also vary with
+//! wavelength ([`Dispersion`], shared with `roughdielectric` and `thindielectric`).
 //!
 //! Sampling picks reflection with probability F and refraction with 1 − F, so both weights are 1 times
 //! the multipliers, and refraction carries the radiance factor (ηᵢ/ηₜ)² (see [`crate::bsdf`]).
@@ -34,7 +37,10 @@ use crate::fresnel::{cos2_transmitted, fresnel_dielectric, fresnel_dielectric_la
 use crate::math::lanes::{channels, Real, V3};
 use crate::math::{Vec2, Vec3};
 use crate::props::{NumberOrName, Props};
+use crate::spectrum::dispersion::{Cauchy, Ior, Sellmeier, LAMBDA_D, NAMED_GLASSES};
+use crate::spectrum::wavelengths::{LAMBDA_MAX, LAMBDA_MIN};
 use crate::spectrum::{named, Rgb};
+use std::sync::Arc;
 
 /// A smooth dielectric interface.
 #[derive(Clone, Debug, PartialEq)]
@@ -44,17 +50,22 @@ pub struct Dielectric {
     pub specular_reflectance: Rgb,
     pub specular_transmittance: Rgb,
     pub fresnel: bool,
+    /// How η varies with wavelength, if it does; `eta` is then its value at [`LAMBDA_D`] (or at the
+    /// wavelength spectral mode set, [`crate::bsdf::Bsdf::dispersion_mut`]).
+    pub dispersion: Option<Arc<Dispersion>>,
 }
 
 impl Dielectric {
     #[must_use]
     pub fn new(eta: f32) -> Self {
-        Dielectric { eta, specular_reflectance: Rgb::ONE, specular_transmittance: Rgb::ONE, fresnel: true }
+        Dielectric { eta, specular_reflectance: Rgb::ONE, specular_transmittance: Rgb::ONE, fresnel: true, dispersion: None }
     }
 
     pub fn from_props(p: &Props) -> Result<Self> {
+        let (eta, dispersion) = interface_ior(p)?;
         Ok(Dielectric {
-            eta: relative_ior(p)?,
+            eta,
+            dispersion,
             specular_reflectance: p.reflectance("specular_reflectance", Rgb::ONE)?,
             specular_transmittance: p.reflectance("specular_transmittance", Rgb::ONE)?,
             fresnel: p.bool("fresnel", true)?,
@@ -80,10 +91,12 @@ impl Dielectric {
     }
 }
 
-/// Read `int_ior` / `ext_ior` (numbers > 0 or names from Mitsuba's table) and return their ratio.
-/// Shared by every model with a dielectric interface.
-pub(crate) fn relative_ior(p: &Props) -> Result<f32> {
-    relative_ior_with_default(p, 1.5046)
+/// Read `int_ior` / `ext_ior` (numbers > 0 or names from Mitsuba's table) and return their ratio: the
+/// plastics' interface, which does not disperse.
+pub(crate) fn relative_ior_with_default(p: &Props, int_default: f32) -> Result<f32> {
+    let int_ior = constant_ior(p, "int_ior", int_default)?;
+    let ext_ior = constant_ior(p, "ext_ior", 1.000_277)?;
+    check_relative(p, int_ior / ext_ior, &format!("int_ior / ext_ior = {int_ior} / {ext_ior}"))
 }
 
 /// The relative index η = `int_ior` / `ext_ior` must lie in [1/`MAX_RELATIVE_IOR`, `MAX_RELATIVE_IOR`]
@@ -94,43 +107,174 @@ pub(crate) fn relative_ior(p: &Props) -> Result<f32> {
 /// far inside: germanium in air, the densest common dielectric, has η = 4.
 pub const MAX_RELATIVE_IOR: f32 = 20.0;
 
-/// [`relative_ior`] with another default for `int_ior` (the plastics default to polypropylene, 1.49).
-pub(crate) fn relative_ior_with_default(p: &Props, int_default: f32) -> Result<f32> {
-    let int_ior = ior(p, "int_ior", int_default)?;
-    let ext_ior = ior(p, "ext_ior", 1.000_277)?;
-    let eta = int_ior / ext_ior;
-    if !(1.0 / MAX_RELATIVE_IOR..=MAX_RELATIVE_IOR).contains(&eta) {
-        return Err(Error::spec(
-            p.at(),
-            format!(
-                "`{}`: the relative index int_ior / ext_ior = {int_ior} / {ext_ior} = {eta} must lie in [1/{MAX_RELATIVE_IOR}, {MAX_RELATIVE_IOR}]",
-                p.plugin_type()
-            ),
-        ));
+fn check_relative(p: &Props, eta: f32, ratio: &str) -> Result<f32> {
+    if (1.0 / MAX_RELATIVE_IOR..=MAX_RELATIVE_IOR).contains(&eta) {
+        return Ok(eta);
     }
-    Ok(eta)
+    Err(Error::spec(
+        p.at(),
+        format!("`{}`: the relative index {ratio} = {eta} must lie in [1/{MAX_RELATIVE_IOR}, {MAX_RELATIVE_IOR}]", p.plugin_type()),
+    ))
 }
 
-fn ior(p: &Props, name: &'static str, default: f32) -> Result<f32> {
+/// An index of refraction given as a number in (0, 10000) or a name from Mitsuba's table.
+fn constant_ior(p: &Props, name: &'static str, default: f32) -> Result<f32> {
     match p.number_or_name(name)? {
         None => Ok(default),
-        Some(NumberOrName::Number(v, at)) => {
-            if v > 0.0 && v.is_finite() && v < 1e4 {
-                Ok(v as f32)
-            } else {
-                Err(Error::spec(
-                    at,
-                    format!("parameter `{name}` of `{}` must be an index of refraction in (0, 10000), got {v}", p.plugin_type()),
-                ))
-            }
-        }
+        Some(NumberOrName::Number(v, at)) => number_ior(p, name, v, &at),
         Some(NumberOrName::Name(n, at)) => named::dielectric_ior(&n).ok_or_else(|| {
+            let law = law_ior(&n, true).is_ok();
             Error::spec(
                 at,
-                format!("parameter `{name}`: unknown material `{n}`; expected a number or one of: {}", named::DIELECTRICS.join(", ")),
+                if law {
+                    format!(
+                        "parameter `{name}` of `{}`: an index that varies with wavelength is taken by `dielectric`, \
+                         `roughdielectric` and `thindielectric` only; give a number or one of: {}",
+                        p.plugin_type(),
+                        named::DIELECTRICS.join(", ")
+                    )
+                } else {
+                    format!("parameter `{name}`: unknown material `{n}`; expected a number or one of: {}", named::DIELECTRICS.join(", "))
+                },
             )
         }),
     }
+}
+
+fn number_ior(p: &Props, name: &str, v: f64, at: &str) -> Result<f32> {
+    if v > 0.0 && v.is_finite() && v < 1e4 {
+        #[allow(clippy::cast_possible_truncation)]
+        Ok(v as f32)
+    } else {
+        Err(Error::spec(at, format!("parameter `{name}` of `{}` must be an index of refraction in (0, 10000), got {v}", p.plugin_type())))
+    }
+}
+
+/// The indices of a dielectric interface whose relative index varies with wavelength: dispersion
+/// (issue 30; laws and named glasses in [`crate::spectrum::dispersion`]). The models hold η at one
+/// wavelength; RGB mode renders them at [`LAMBDA_D`], spectral mode at each path's hero wavelength, and
+/// the path tracer then follows that wavelength alone (docs/spectral.md, "Dispersion").
+///
+/// `int_ior` and `ext_ior` take, besides a number or a Mitsuba name:
+///
+/// | value | index |
+/// |---|---|
+/// | `"sellmeier(B1, …, Bn, C1, …, Cn)"` | n² = 1 + Σ Bᵢ λ² / (λ² − Cᵢ), λ in µm, Cᵢ in µm², 1 ≤ n ≤ 4 |
+/// | `"cauchy(A, B)"`, `"cauchy(A, B, C)"` | n = A + B / λ² + C / λ⁴, λ in µm |
+/// | a name of [`NAMED_GLASSES`] | that glass (`fused silica`, `baf10`, `f2`, `sf11`, pbrt-v4's `glass-*`) |
+///
+/// Mitsuba's names keep Mitsuba's constants (`bk7` is 1.5046, `water` 1.333, `diamond` 2.419), so that its
+/// scenes render as there; with `dispersive` = true a name is read from [`NAMED_GLASSES`] instead
+/// (`bk7` is then Schott N-BK7's Sellmeier law, n_d = 1.5168). `abbe` = V_d turns a number or a name
+/// `int_ior` into the Cauchy law through that n_d with that Abbe number, as glTF's
+/// `KHR_materials_dispersion` defines it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Dispersion {
+    /// The inside's index.
+    pub int_ior: Ior,
+    /// The outside's index.
+    pub ext_ior: Ior,
+}
+
+impl Dispersion {
+    /// The relative index int_ior / ext_ior at `lambda` nm.
+    #[must_use]
+    pub fn eta(&self, lambda: f32) -> f32 {
+        let l = f64::from(lambda);
+        #[allow(clippy::cast_possible_truncation)]
+        let eta = (self.int_ior.eta(l) / self.ext_ior.eta(l)) as f32;
+        eta
+    }
+}
+
+/// The relative index of a dielectric interface at [`LAMBDA_D`] and, where it varies with wavelength, how
+/// ([`Dispersion`]). Shared by `dielectric`, `roughdielectric` and `thindielectric`. A dispersive
+/// relative index must stay within [1/`MAX_RELATIVE_IOR`, `MAX_RELATIVE_IOR`] at every wavelength spectral
+/// mode draws (checked every nanometre).
+pub(crate) fn interface_ior(p: &Props) -> Result<(f32, Option<Arc<Dispersion>>)> {
+    let dispersive = p.bool("dispersive", false)?;
+    let int_ior = index(p, "int_ior", 1.5046, dispersive)?;
+    let ext_ior = index(p, "ext_ior", 1.000_277, dispersive)?;
+    let int_ior = if p.has("abbe") {
+        let abbe = p.float_positive("abbe", 1.0)?;
+        let Ior::Constant(n_d) = int_ior else {
+            return Err(Error::spec(
+                p.at_param("abbe"),
+                format!("`{}`: `abbe` makes a constant `int_ior` dispersive; `int_ior` already varies with wavelength", p.plugin_type()),
+            ));
+        };
+        Ior::from_abbe(n_d, f64::from(abbe)).map_err(|e| Error::spec(p.at_param("abbe"), format!("`abbe`: {e}")))?
+    } else {
+        int_ior
+    };
+    let d = Dispersion { int_ior, ext_ior };
+    let ratio = |l: f64| format!("int_ior / ext_ior at {l} nm = {} / {}", d.int_ior.eta(l), d.ext_ior.eta(l));
+    #[allow(clippy::cast_possible_truncation)]
+    let eta = check_relative(p, d.eta(LAMBDA_D as f32), &ratio(LAMBDA_D))?;
+    if !(d.int_ior.is_dispersive() || d.ext_ior.is_dispersive()) {
+        return Ok((eta, None));
+    }
+    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+    for nm in LAMBDA_MIN as u32..=LAMBDA_MAX as u32 {
+        #[allow(clippy::cast_precision_loss)]
+        check_relative(p, d.eta(nm as f32), &ratio(f64::from(nm)))?;
+    }
+    Ok((eta, Some(Arc::new(d))))
+}
+
+/// One index of a dielectric interface (see [`Dispersion`]).
+fn index(p: &Props, name: &'static str, default: f32, dispersive: bool) -> Result<Ior> {
+    match p.number_or_name(name)? {
+        None => Ok(Ior::Constant(f64::from(default))),
+        Some(NumberOrName::Number(v, at)) => number_ior(p, name, v, &at).map(|n| Ior::Constant(f64::from(n))),
+        Some(NumberOrName::Name(n, at)) => match named::dielectric_ior(&n).filter(|_| !dispersive) {
+            Some(v) => Ok(Ior::Constant(f64::from(v))),
+            None => law_ior(&n, dispersive).map_err(|e| Error::spec(at, format!("parameter `{name}` of `{}`: {e}", p.plugin_type()))),
+        },
+    }
+}
+
+/// An index named or given by its law (see [`Dispersion`]); the message says what was expected.
+fn law_ior(text: &str, dispersive: bool) -> std::result::Result<Ior, String> {
+    let t = text.trim();
+    let call = |law: &str| {
+        t.strip_prefix(law)
+            .and_then(|r| r.trim_start().strip_prefix('('))
+            .and_then(|r| r.trim_end().strip_suffix(')'))
+            .map(|args| args.split(',').map(|a| a.trim().parse::<f64>()).collect::<std::result::Result<Vec<f64>, _>>())
+    };
+    let bad = |e: &dyn std::fmt::Display| format!("`{t}`: {e}");
+    if let Some(args) = call("sellmeier") {
+        let args = args.map_err(|_| bad(&"expected sellmeier(B1, …, Bn, C1, …, Cn) with numbers"))?;
+        if args.len() % 2 != 0 {
+            return Err(bad(&format!("expected as many B as C coefficients, got {} numbers", args.len())));
+        }
+        let (b, c) = args.split_at(args.len() / 2);
+        return Sellmeier::new(b, c).map(Ior::Sellmeier).map_err(|e| bad(&e));
+    }
+    if let Some(args) = call("cauchy") {
+        let args = args.map_err(|_| bad(&"expected cauchy(A, B) or cauchy(A, B, C) with numbers"))?;
+        let law = match args[..] {
+            [a, b] => Cauchy { a, b, c: 0.0 },
+            [a, b, c] => Cauchy { a, b, c },
+            _ => return Err(bad(&format!("expected cauchy(A, B) or cauchy(A, B, C), got {} numbers", args.len()))),
+        };
+        if ![law.a, law.b, law.c].iter().all(|v| v.is_finite()) {
+            return Err(bad(&"the coefficients must be finite"));
+        }
+        return Ok(Ior::Cauchy(law));
+    }
+    Ior::named(t).ok_or_else(|| {
+        if dispersive {
+            format!("unknown glass `{t}`; with `dispersive`, expected one of: {}", NAMED_GLASSES.join(", "))
+        } else {
+            format!(
+                "unknown material `{t}`; expected a number, sellmeier(…), cauchy(…), one of Mitsuba's names ({}) or a dispersive glass ({})",
+                named::DIELECTRICS.join(", "),
+                NAMED_GLASSES.join(", ")
+            )
+        }
+    })
 }
 
 /// The delta sampling shared by the smooth interfaces (`dielectric`, `thindielectric`), in lanes: mirror
@@ -316,6 +460,82 @@ mod tests {
         }
         // Total internal reflection is geometry, not Fresnel: it stays.
         assert_eq!(d.reflected_fraction(-0.1), 1.0);
+    }
+
+    fn model(spec: &str) -> Result<crate::bsdf::Bsdf> {
+        crate::bsdf::Bsdf::from_json(spec)
+    }
+
+    fn error(spec: &str) -> String {
+        model(spec).err().map(|e| e.to_string()).unwrap_or_else(|| panic!("{spec} should be refused"))
+    }
+
+    /// The ways of giving an index that varies with wavelength, and what each means at n_d (RGB mode) and
+    /// across the spectrum.
+    #[test]
+    fn dispersive_indices() {
+        use crate::bsdf::Bsdf;
+        let dispersion = |spec: &str| -> (f32, Arc<Dispersion>) {
+            match model(spec).unwrap() {
+                Bsdf::Dielectric(d) => (d.eta, d.dispersion.unwrap_or_else(|| panic!("{spec}: not dispersive"))),
+                other => panic!("{other:?}"),
+            }
+        };
+        // Schott N-BK7 by its Sellmeier coefficients: n_d = 1.5168, blue bends more than red.
+        let (eta, d) = dispersion(
+            r#"{"type": "dielectric", "ext_ior": 1, "int_ior": "sellmeier(1.03961212, 0.231792344, 1.01046945, 0.00600069867, 0.0200179144, 103.560653)"}"#,
+        );
+        assert!((eta - 1.5168).abs() < 1e-4, "{eta}");
+        assert!(d.eta(400.0) > d.eta(550.0) && d.eta(550.0) > d.eta(700.0));
+        // The same glass by name with `dispersive`; without it `bk7` is Mitsuba's constant 1.5046.
+        let (eta, named) = dispersion(r#"{"type": "dielectric", "ext_ior": 1, "int_ior": "bk7", "dispersive": true}"#);
+        assert!((eta - 1.5168).abs() < 1e-4, "{eta}");
+        assert_eq!(named.eta(450.0), d.eta(450.0));
+        match model(r#"{"type": "dielectric", "ext_ior": 1, "int_ior": "bk7"}"#).unwrap() {
+            Bsdf::Dielectric(m) => assert_eq!((m.eta, m.dispersion), (1.5046, None)),
+            other => panic!("{other:?}"),
+        }
+        // A name only gonio's dispersive table has needs no flag; the index is relative to `ext_ior`.
+        let (eta, d) = dispersion(r#"{"type": "dielectric", "int_ior": "sf11", "ext_ior": 1.5}"#);
+        assert!((eta - 1.784_72 / 1.5).abs() < 1e-4, "{eta}");
+        assert!((d.eta(LAMBDA_D as f32) - eta).abs() < 1e-6);
+        // An Abbe number turns n_d into glTF's Cauchy law: V_d comes back.
+        let (eta, d) = dispersion(r#"{"type": "dielectric", "ext_ior": 1, "int_ior": 1.6, "abbe": 30}"#);
+        assert!((eta - 1.6).abs() < 1e-6);
+        assert!((d.int_ior.abbe_number() - 30.0).abs() < 1e-9);
+        // Cauchy with two or three terms.
+        let (_, d) = dispersion(r#"{"type": "dielectric", "ext_ior": 1, "int_ior": "cauchy(1.5, 0.004, 0.0001)"}"#);
+        let l = 0.5f64;
+        assert!((f64::from(d.eta(500.0)) - (1.5 + 0.004 / (l * l) + 0.0001 / l.powi(4))).abs() < 1e-6);
+        // Both other dielectric models take it; `roughdielectric` refuses indices equal at some wavelength.
+        assert!(model(r#"{"type": "thindielectric", "int_ior": "f2"}"#).unwrap().is_dispersive());
+        assert!(model(r#"{"type": "roughdielectric", "int_ior": "water", "dispersive": true}"#).unwrap().is_dispersive());
+        let e = error(r#"{"type": "roughdielectric", "int_ior": "cauchy(1.33, 0.003)", "ext_ior": 1.335}"#);
+        assert!(e.contains("must differ at every wavelength") && e.contains("equal near"), "{e}");
+    }
+
+    /// Malformed laws, and laws where they are not taken, are refused with the parameter named.
+    #[test]
+    fn dispersive_indices_refused() {
+        for (spec, expect) in [
+            (r#"{"type": "dielectric", "int_ior": "sellmeier(1.0, 0.2, 0.01)"}"#, "as many B as C"),
+            (r#"{"type": "dielectric", "int_ior": "sellmeier(1, 2, 3, 4, 5, 6, 7, 8, 9, 10)"}"#, "1 to 4"),
+            (r#"{"type": "dielectric", "int_ior": "cauchy(1.5)"}"#, "cauchy(A, B) or cauchy(A, B, C)"),
+            (r#"{"type": "dielectric", "int_ior": "cauchy(1.5, x)"}"#, "with numbers"),
+            (r#"{"type": "dielectric", "int_ior": "crown"}"#, "unknown material `crown`"),
+            (r#"{"type": "dielectric", "int_ior": "acetone", "dispersive": true}"#, "unknown glass `acetone`; with `dispersive`"),
+            (r#"{"type": "dielectric", "int_ior": "sf11", "abbe": 40}"#, "`abbe` makes a constant `int_ior` dispersive"),
+            (r#"{"type": "dielectric", "int_ior": 1.5, "abbe": 0}"#, "abbe"),
+            // An absorption band inside the visible range: n² < 0 below 500 nm.
+            (r#"{"type": "dielectric", "int_ior": "sellmeier(1.0, 0.25)"}"#, "must lie in"),
+            (r#"{"type": "plastic", "int_ior": "sf11"}"#, "taken by `dielectric`, `roughdielectric` and `thindielectric` only"),
+            (r#"{"type": "roughplastic", "int_ior": "cauchy(1.5, 0.01)"}"#, "taken by `dielectric`"),
+            (r#"{"type": "plastic", "int_ior": 1.5, "abbe": 40}"#, "abbe"),
+        ] {
+            let e = error(spec);
+            assert!(e.contains(expect), "{spec}: {e}");
+            assert!(e.contains("int_ior") || e.contains("abbe"), "{spec}: the parameter is named: {e}");
+        }
     }
 
     #[test]

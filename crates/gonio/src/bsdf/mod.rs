@@ -922,6 +922,29 @@ impl Bsdf {
         }
     }
 
+    /// A dispersive dielectric interface's law and its relative index η, to set at a path's wavelength in
+    /// spectral mode (`dielectric`, `thindielectric`, and `roughdielectric` without energy compensation,
+    /// whose lobes are built from η; [`Self::is_dispersive`] tells those apart).
+    pub fn dispersion_mut(&mut self) -> Option<(&dielectric::Dispersion, &mut f32)> {
+        match self {
+            Bsdf::Dielectric(d) => Some((d.dispersion.as_deref()?, &mut d.eta)),
+            Bsdf::ThinDielectric(d) => Some((d.dispersion.as_deref()?, &mut d.eta)),
+            Bsdf::RoughDielectric(d) if d.compensation.is_none() => Some((d.dispersion.as_deref()?, &mut d.eta)),
+            _ => None,
+        }
+    }
+
+    /// Whether this model (not the models it holds) has an index that varies with wavelength.
+    #[must_use]
+    pub fn is_dispersive(&self) -> bool {
+        match self {
+            Bsdf::Dielectric(d) => d.dispersion.is_some(),
+            Bsdf::ThinDielectric(d) => d.dispersion.is_some(),
+            Bsdf::RoughDielectric(d) => d.dispersion.is_some(),
+            _ => false,
+        }
+    }
+
     /// The Fresnel term of a `conductor` or `roughconductor` (not of an energy-compensated one, whose lobe is
     /// built from it): its index of refraction, to set at a path's wavelengths in spectral mode.
     pub fn conductor_fresnel(&mut self) -> Option<&mut Conductor> {

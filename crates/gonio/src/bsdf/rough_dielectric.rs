@@ -7,8 +7,9 @@
 //! | `distribution`           | `beckmann` \| `ggx` | `beckmann` | the microfacet distribution (as in Mitsuba)   |
 //! | `alpha`                  | float [1e-4, 10]| 0.1          | roughness (RMS slope for Beckmann); isotropic     |
 //! | `alpha_u`, `alpha_v`     | float [1e-4, 10]| `alpha`      | anisotropic roughness (instead of `alpha`)        |
-//! | `int_ior`                | float or name   | `bk7` (1.5046) | index below the surface (z < 0)                 |
-//! | `ext_ior`                | float or name   | `air` (1.000277) | index above the surface (z > 0); must differ from `int_ior` |
+//! | `int_ior`                | float, name or law | `bk7` (1.5046) | index below the surface (z < 0); may vary with wavelength ([`Dispersion`]) |
+//! | `ext_ior`                | float, name or law | `air` (1.000277) | index above the surface (z > 0); must differ from `int_ior` |
+//! | `dispersive`, `abbe`     |                 |         | as for `dielectric` ([`Dispersion`])             |
 //! | `specular_reflectance`   | rgb [0,1]       | 1            | multiplier on reflection (not physical)          |
 //! | `specular_transmittance` | rgb [0,1]       | 1            | multiplier on transmission (not physical)        |
 //! | `sample_visible`         | bool            | true         | sample the visible normals (Heitz & d'Eon 2014) rather than D·cos |
@@ -61,7 +62,7 @@
 //! assert!(s.weight.r() <= 1.0 / 2.25 + 1e-6);
 //! ```
 
-use super::dielectric::relative_ior;
+use super::dielectric::{interface_ior, Dispersion};
 use super::energy_compensation::DielectricCompensation;
 use super::lanes::{f_one, flag_lanes, pdf_one, sample_one, LaneModel, LaneSample, PerLaneKernel};
 use super::rough_conductor::{read_distribution, MicrofacetParams};
@@ -75,6 +76,7 @@ use crate::microfacet::reflection::ReflectionLobe;
 use crate::microfacet::{on_distribution, Distribution, MicrofacetDistribution, MicrofacetKind, Shadowing};
 use crate::props::Props;
 use crate::spectrum::Rgb;
+use std::sync::Arc;
 
 /// The glossy transmission lobe.
 pub(crate) const GLOSSY_TRANSMISSION: BsdfFlags = BsdfFlags(2 | 8);
@@ -92,6 +94,8 @@ pub struct RoughDielectric {
     pub sample_visible: bool,
     /// The multiple-scattering lobes added by `energy_compensation` ([`DielectricCompensation`]).
     pub compensation: Option<DielectricCompensation>,
+    /// How η varies with wavelength, if it does ([`Dispersion`]).
+    pub dispersion: Option<Arc<Dispersion>>,
 }
 
 /// The single-scattering fate of the energy arriving along one direction (see
@@ -100,6 +104,23 @@ pub struct RoughDielectric {
 pub struct EnergySplit {
     pub reflected: f64,
     pub transmitted: f64,
+}
+
+/// A wavelength (nm, on a 1 nm grid over the range spectral mode draws) where the relative index of `d`
+/// is 1 or crosses it.
+fn equal_indices(d: &Dispersion) -> Option<f32> {
+    use crate::spectrum::wavelengths::{LAMBDA_MAX, LAMBDA_MIN};
+    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, clippy::cast_precision_loss)]
+    let grid = (LAMBDA_MIN as u32..=LAMBDA_MAX as u32).map(|nm| nm as f32);
+    let mut previous: Option<f32> = None;
+    for nm in grid {
+        let side = d.eta(nm) - 1.0;
+        if side == 0.0 || previous.is_some_and(|p| p * side < 0.0) {
+            return Some(nm);
+        }
+        previous = Some(side);
+    }
+    None
 }
 
 impl RoughDielectric {
@@ -114,6 +135,7 @@ impl RoughDielectric {
             specular_transmittance: Rgb::ONE,
             sample_visible: true,
             compensation: None,
+            dispersion: None,
         }
     }
 
@@ -127,12 +149,19 @@ impl RoughDielectric {
 
     pub fn from_props(p: &Props) -> Result<Self> {
         let distribution = read_distribution(p, &MicrofacetParams::MITSUBA)?;
-        let eta = relative_ior(p)?;
+        let (eta, dispersion) = interface_ior(p)?;
         // η = 1 makes every microfacet refract straight through: a Dirac delta no rough lobe can represent.
         if eta == 1.0 {
             return Err(Error::spec(p.at(), "`roughdielectric`: `int_ior` and `ext_ior` must differ".to_string()));
         }
+        if let Some(nm) = dispersion.as_deref().and_then(equal_indices) {
+            return Err(Error::spec(
+                p.at(),
+                format!("`roughdielectric`: `int_ior` and `ext_ior` must differ at every wavelength; they are equal near {nm} nm"),
+            ));
+        }
         let b = RoughDielectric {
+            dispersion,
             specular_reflectance: p.reflectance("specular_reflectance", Rgb::ONE)?,
             specular_transmittance: p.reflectance("specular_transmittance", Rgb::ONE)?,
             sample_visible: p.bool("sample_visible", true)?,

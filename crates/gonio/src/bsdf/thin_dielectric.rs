@@ -8,8 +8,9 @@
 //!
 //! | parameter                | type          | default | meaning                                    |
 //! |--------------------------|---------------|---------|--------------------------------------------|
-//! | `int_ior`                | float or name | `bk7`   | index of the slab                           |
-//! | `ext_ior`                | float or name | `air`   | index around it                             |
+//! | `int_ior`                | float, name or law | `bk7` | index of the slab; may vary with wavelength ([`Dispersion`]) |
+//! | `ext_ior`                | float, name or law | `air` | index around it                        |
+//! | `dispersive`, `abbe`     |               |         | as for `dielectric` ([`Dispersion`])        |
 //! | `specular_reflectance`   | rgb [0,1]     | 1       | multiplier on reflection                    |
 //! | `specular_transmittance` | rgb [0,1]     | 1       | multiplier on transmission                  |
 //!
@@ -25,7 +26,7 @@
 //! assert!((s.pdf - (1.0 - 2.0 * 0.04 / 1.04)).abs() < 1e-6);
 //! ```
 
-use super::dielectric::{reflect_or_transmit, relative_ior};
+use super::dielectric::{interface_ior, reflect_or_transmit, Dispersion};
 use super::lanes::{sample_one, LaneModel, LaneSample};
 use super::{BsdfFlags, BsdfModel, BsdfSample};
 use crate::error::Result;
@@ -34,6 +35,7 @@ use crate::math::lanes::{Real, V3};
 use crate::math::{Vec2, Vec3};
 use crate::props::Props;
 use crate::spectrum::Rgb;
+use std::sync::Arc;
 
 /// A thin dielectric slab.
 #[derive(Clone, Debug, PartialEq)]
@@ -42,12 +44,16 @@ pub struct ThinDielectric {
     pub eta: f32,
     pub specular_reflectance: Rgb,
     pub specular_transmittance: Rgb,
+    /// How η varies with wavelength, if it does ([`Dispersion`]).
+    pub dispersion: Option<Arc<Dispersion>>,
 }
 
 impl ThinDielectric {
     pub fn from_props(p: &Props) -> Result<Self> {
+        let (eta, dispersion) = interface_ior(p)?;
         Ok(ThinDielectric {
-            eta: relative_ior(p)?,
+            eta,
+            dispersion,
             specular_reflectance: p.reflectance("specular_reflectance", Rgb::ONE)?,
             specular_transmittance: p.reflectance("specular_transmittance", Rgb::ONE)?,
         })
@@ -134,7 +140,7 @@ mod tests {
 
     #[test]
     fn slab_reflectance_is_the_sum_of_the_interreflection_series() {
-        let slab = ThinDielectric { eta: 1.5, specular_reflectance: Rgb::ONE, specular_transmittance: Rgb::ONE };
+        let slab = ThinDielectric { eta: 1.5, specular_reflectance: Rgb::ONE, specular_transmittance: Rgb::ONE, dispersion: None };
         for cos in [1.0f32, 0.6, 0.2, 0.01] {
             let r = fresnel_dielectric(cos, 1.5);
             let t = 1.0 - r;

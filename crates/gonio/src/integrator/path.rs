@@ -42,10 +42,10 @@ use crate::math::{Vec2, Vec3};
 use crate::sampling::mis::power_heuristic_lanes;
 use crate::sampling::warp::uniform_sphere;
 use crate::sampling::Pcg32x8;
-use crate::scene::spectral::reflectances_at;
+use crate::scene::spectral::{reflectances_at, Dependence};
 use crate::scene::surfaces::{Rows3, Surfaces8};
 use crate::scene::Scene;
-use crate::spectrum::sampled::{path_to_linear_srgb, sample_path_wavelengths};
+use crate::spectrum::sampled::{path_to_linear_srgb, sample_path_wavelengths, PATH_WAVELENGTHS};
 use crate::spectrum::Rgb;
 use std::borrow::Cow;
 
@@ -131,6 +131,8 @@ struct Packet {
     spectral: bool,
     lambda: Rows3,
     lambda_pdf: Rows3,
+    /// The lanes that follow their hero wavelength alone ([`Packet::terminate_secondary`]).
+    terminated: u32,
 }
 
 impl Packet {
@@ -154,6 +156,7 @@ impl Packet {
             spectral: false,
             lambda: Rows3::default(),
             lambda_pdf: Rows3::default(),
+            terminated: 0,
         }
     }
 
@@ -172,6 +175,25 @@ impl Packet {
             let (lambda, pdf) = sample_path_wavelengths(u[lane]);
             self.lambda.set(lane, Vec3::from_array(lambda));
             self.lambda_pdf.set(lane, Vec3::from_array(pdf));
+        }
+    }
+
+    /// In spectral mode, the live lanes on a dispersive material ([`Dependence::Dispersion`]) follow their
+    /// hero wavelength alone from here: its model refracts each wavelength its own way, and the lane's copy
+    /// runs at the hero's ([`reflectances_at`]). The other wavelengths' throughput becomes 0 and the hero's
+    /// is multiplied by their number, so that the film's average over the wavelengths
+    /// ([`path_to_linear_srgb`]) counts the hero for all of them: the estimate of one wavelength drawn with
+    /// the same density, unbiased (pbrt-v4's `TerminateSecondary`, Wilkie et al. 2014 §4). Once per path.
+    #[inline(always)]
+    fn terminate_secondary(&mut self, scene: &Scene, hit: &Surfaces8) {
+        let Some(spectral) = &scene.spectral else { return };
+        for lane in bits(self.live & !self.terminated) {
+            if spectral.dependence.get(hit.shape[lane] as usize) == Some(&Dependence::Dispersion) {
+                let beta = self.beta.get(lane);
+                #[allow(clippy::cast_precision_loss)]
+                self.beta.set(lane, Vec3::new(beta.x * PATH_WAVELENGTHS as f32, 0.0, 0.0));
+                self.terminated |= 1 << lane;
+            }
         }
     }
 
@@ -210,6 +232,7 @@ impl Packet {
     #[inline(always)]
     fn start(&mut self, lanes: u32, rays: &RayLanes<Float8>) {
         self.live |= lanes;
+        self.terminated &= !lanes;
         let m = Mask8::from_bitmask(lanes);
         self.o.store(V3::select(m, rays.o, self.o.lanes()));
         self.d.store(V3::select(m, rays.d, self.d.lanes()));
@@ -515,7 +538,8 @@ fn shading<'a>(scene: &'a Scene, p: &Packet, hit: &Surfaces8) -> Shading<'a> {
         let material = &scene.materials[hit.shape[first] as usize];
         // In spectral mode, a material with colours runs a copy of its model per lane, at the lane's
         // wavelengths (`spectral::reflectances_at`); diffuse ones are converted in `rho` below.
-        let chromatic = scene.spectral.as_ref().is_some_and(|s| s.chromatic.get(hit.shape[first] as usize).copied().unwrap_or(false));
+        let chromatic =
+            scene.spectral.as_ref().is_some_and(|s| s.dependence.get(hit.shape[first] as usize).is_some_and(|d| *d != Dependence::None));
         if let Some(r) = material.diffuse_reflectance_lanes(u, v, same) {
             let r = if p.spectral { p.reflectance(scene, r, same, |_| hit.shape[first] as usize) } else { r };
             let m = Mask8::from_bitmask(same);
@@ -950,6 +974,7 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
         }
 
         let sh = shading(scene, &p, &hit);
+        p.terminate_secondary(scene, &hit);
         next_event(scene, &mut p, &hit, &sh, settings);
         if bsdf_samples != 1 {
             // The `direct` integrator's BSDF samples, other than one: each is traced here for the emission

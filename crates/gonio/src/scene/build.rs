@@ -3,7 +3,7 @@
 //! know is an error naming the place in the file.
 
 use super::mitsuba_xml::SceneDescription;
-use super::spectral::{check_bsdf, Mode, SpectralScene};
+use super::spectral::{check_bsdf, Dependence, Mode, SpectralScene};
 use super::{Aov, AovKind, IntegratorKind, Material, SamplerSpec, Scene};
 use crate::bsdf::{Bsdf, Diffuse};
 use crate::camera::Camera;
@@ -18,8 +18,10 @@ use crate::geometry::{Mesh, Shape};
 use crate::light::{AreaLight, ConstantLight, DirectionalLight, EnvMap, Light, PointLight, ProjectorLight, SpotLight};
 use crate::math::Transform;
 use crate::props::Props;
+use crate::spectrum::illuminant::Spectrum;
 use crate::spectrum::Rgb;
 use glam::Vec3;
+use std::sync::Arc;
 
 const SHAPES: &str = "sphere, rectangle, cube, disk, cylinder, obj, ply, serialized, sdfgrid, shapegroup, instance";
 
@@ -61,13 +63,14 @@ impl Scene {
                 _ => built.add(p, &Transform::IDENTITY)?,
             }
         }
-        let Built { shapes, materials, shape_lights, mut lights, chromatic, .. } = built;
+        let Built { shapes, materials, shape_lights, mut lights, dependence, mut light_spectra, .. } = built;
         for e in &desc.emitters {
             let light = light_from_props(e)?;
             if light.is_environment() && lights.iter().any(Light::is_environment) {
                 return Err(Error::spec(e.at(), "a scene takes at most one environment emitter"));
             }
             lights.push(light);
+            light_spectra.push(EMISSION.iter().find_map(|name| e.spectrum(name)));
         }
         if mode == Mode::Spectral {
             for light in &mut lights {
@@ -114,7 +117,7 @@ impl Scene {
             }
             // The table RGB values are taken to spectra with, built now rather than by the first path.
             let _ = crate::spectrum::upsample::srgb_table();
-            scene.spectral = Some(SpectralScene::new(&scene.materials, &scene.lights, chromatic));
+            scene.spectral = Some(SpectralScene::new(&scene.materials, &scene.lights, dependence, &light_spectra));
         }
         Ok(scene)
     }
@@ -129,9 +132,14 @@ struct Built {
     shape_lights: Vec<Option<u32>>,
     lights: Vec<Light>,
     mode: Mode,
-    /// In spectral mode, whether each material has colours ([`super::spectral::check_bsdf`]).
-    chromatic: Vec<bool>,
+    /// In spectral mode, how each material depends on wavelength ([`super::spectral::check_bsdf`]).
+    dependence: Vec<Dependence>,
+    /// Per light, the spectrum its emission was given as, where an `<emitter>`'s `<spectrum>` gave one.
+    light_spectra: Vec<Option<Arc<Spectrum>>>,
 }
+
+/// The parameters that hold a light's emission (`radiance`, `intensity`, `irradiance`).
+const EMISSION: [&str; 3] = ["radiance", "intensity", "irradiance"];
 
 impl Built {
     /// Add shape `p`, placed by `outer` after its own `to_world` (an instance's transform, or the identity).
@@ -149,9 +157,9 @@ impl Built {
             [_, second, ..] => return Err(Error::spec(second.at(), "a shape takes one <bsdf>")),
         });
         if self.mode == Mode::Spectral {
-            self.chromatic.push(match nested.as_slice() {
+            self.dependence.push(match nested.as_slice() {
                 [one] => check_bsdf(one)?,
-                _ => false,
+                _ => Dependence::None,
             });
         }
         if let (Some(material), Some(shape)) = (self.materials.last(), self.shapes.last()) {
@@ -181,6 +189,7 @@ impl Built {
                 let radiance = e.rgb_in("radiance", Rgb::ONE, 0.0, f32::MAX)?;
                 e.finish()?;
                 self.lights.push(Light::Area(AreaLight { shape: (self.shapes.len() - 1) as u32, radiance }));
+                self.light_spectra.push(e.spectrum("radiance"));
                 Some((self.lights.len() - 1) as u32)
             }
             [_, second, ..] => return Err(Error::spec(second.at(), "a shape takes one <emitter>")),

@@ -18,9 +18,11 @@ use crate::bsdf::Bsdf;
 use crate::error::{Error, Result};
 use crate::light::Light;
 use crate::props::{Props, Value};
+use crate::spectrum::illuminant::Spectrum;
 use crate::spectrum::sampled::{emission_at, reflectance_at, PATH_WAVELENGTHS};
 use crate::spectrum::upsample::{srgb_table, RgbIlluminantSpectrum, SigmoidPolynomial};
 use crate::spectrum::Rgb;
+use std::sync::Arc;
 
 /// How the renderer carries light.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -55,25 +57,42 @@ impl Mode {
     }
 }
 
+/// How a material depends on wavelength in spectral mode ([`check_bsdf`]); ordered, so that a material's
+/// is the largest of its models'.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Dependence {
+    /// The same at every wavelength (every colour grey): it runs as in RGB mode.
+    #[default]
+    None,
+    /// It has colours: each lane runs a copy of its model set to the lane's wavelengths
+    /// ([`reflectances_at`]).
+    Colours,
+    /// Its index of refraction varies with wavelength ([`crate::bsdf::dielectric::Dispersion`]): each lane
+    /// runs a copy of its model at the lane's hero wavelength, and the path follows that wavelength alone
+    /// from there (the others are terminated: pbrt-v4's rule, docs/spectral.md).
+    Dispersion,
+}
+
 /// What spectral mode keeps of a scene beside its RGB form (empty in RGB mode): which materials have colours,
 /// and the spectra of the constant colours, fitted once at load ([`srgb_table`]'s `fit`: the round trip
 /// to 1e-4) rather than looked up at every use.
 #[derive(Clone, Debug)]
 pub struct SpectralScene {
-    /// Per shape, whether its material has colours ([`check_bsdf`]): its model is then copied per lane and
-    /// set to the lane's wavelengths ([`reflectances_at`]).
-    pub chromatic: Vec<bool>,
+    /// Per shape, how its material depends on wavelength ([`check_bsdf`]).
+    pub dependence: Vec<Dependence>,
     /// Per shape, the reflectance spectrum of a `diffuse` material of one colour.
     diffuse: Vec<Option<SigmoidPolynomial>>,
-    /// Per light, the spectrum of its colour where it has one ([`Light::constant_colour`]), and that
-    /// colour's largest component.
-    lights: Vec<Option<(f32, RgbIlluminantSpectrum)>>,
+    /// Per light of one colour ([`Light::constant_colour`]): that colour's largest component, and its
+    /// spectrum — as the scene gave it (an emitter's `<spectrum>`), else the colour's RGB illuminant
+    /// spectrum.
+    lights: Vec<Option<(f32, Arc<Spectrum>)>>,
 }
 
 impl SpectralScene {
-    /// The spectra of `materials` (one per shape, `chromatic` as [`check_bsdf`] found them) and `lights`.
+    /// The spectra of `materials` (one per shape, `dependence` as [`check_bsdf`] found it) and `lights`
+    /// (`given`: per light, the spectrum its emission was given as, if it was).
     #[must_use]
-    pub fn new(materials: &[Material], lights: &[Light], chromatic: Vec<bool>) -> Self {
+    pub fn new(materials: &[Material], lights: &[Light], dependence: Vec<Dependence>, given: &[Option<Arc<Spectrum>>]) -> Self {
         let diffuse = materials
             .iter()
             .map(|m| match m {
@@ -83,9 +102,15 @@ impl SpectralScene {
             .collect();
         let lights = lights
             .iter()
-            .map(|l| l.constant_colour().filter(|c| c.max_component() > 0.0).map(|c| (c.max_component(), RgbIlluminantSpectrum::new(c))))
+            .enumerate()
+            .map(|(i, l)| {
+                let c = l.constant_colour().filter(|c| c.max_component() > 0.0)?;
+                let spectrum =
+                    given.get(i).cloned().flatten().unwrap_or_else(|| Arc::new(Spectrum::Illuminant(RgbIlluminantSpectrum::new(c))));
+                Some((c.max_component(), spectrum))
+            })
             .collect();
-        SpectralScene { chromatic, diffuse, lights }
+        SpectralScene { dependence, diffuse, lights }
     }
 
     /// The reflectance `rgb` of shape `shape`'s diffuse material at the wavelengths `lambda`: from its
@@ -105,14 +130,15 @@ impl SpectralScene {
     #[inline]
     #[must_use]
     pub fn emission(&self, light: Option<usize>, rgb: [f32; 3], lambda: [f32; PATH_WAVELENGTHS]) -> [f32; PATH_WAVELENGTHS] {
-        let Some((max, spectrum)) = light.and_then(|i| self.lights.get(i).copied().flatten()) else {
+        let Some((max, spectrum)) = light.and_then(|i| self.lights.get(i)).and_then(Option::as_ref) else {
             return emission_at(rgb, lambda);
         };
         if rgb.iter().any(|v| v.is_nan()) {
             return [f32::NAN; PATH_WAVELENGTHS];
         }
         let factor = rgb[0].max(rgb[1]).max(rgb[2]).max(0.0) / max;
-        lambda.map(|l| factor * spectrum.eval(l))
+        #[allow(clippy::cast_possible_truncation)]
+        lambda.map(|l| factor * spectrum.eval(f64::from(l)) as f32)
     }
 }
 
@@ -125,19 +151,19 @@ const CONVERTED: &[&str] =
 /// [`Bsdf::for_each_nested`]).
 const CONTAINERS: &[&str] = &["twosided", "blendbsdf", "sum", "mask", "normalmap", "bumpmap"];
 
-/// Whether spectral mode renders the `<bsdf>` `p` (see the module docs); `Ok(true)` where it has colours
-/// (that are not grey), which then vary with wavelength.
+/// Whether spectral mode renders the `<bsdf>` `p` (see the module docs), and how it depends on wavelength.
 ///
 /// # Errors
-/// A colour spectral mode does not take yet, naming the parameter and where it was given.
-pub fn check_bsdf(p: &Props) -> Result<bool> {
+/// A colour or an index spectral mode does not take yet, naming the parameter and where it was given.
+pub fn check_bsdf(p: &Props) -> Result<Dependence> {
     check_model(p, true)
 }
 
 /// [`check_bsdf`] for a model reached through [`CONTAINERS`] only (`convertible`) or not. A colour is taken
 /// where [`reflectances_at`] sets it: the model built from `p` (its textures left at their defaults) holds
-/// it in a [`Bsdf::reflectance_slot`], or it is a conductor's named metal ([`Bsdf::conductor_fresnel`]).
-fn check_model(p: &Props, convertible: bool) -> Result<bool> {
+/// it in a [`Bsdf::reflectance_slot`], or it is a conductor's named metal ([`Bsdf::conductor_fresnel`]). A
+/// dispersive index is taken where [`Bsdf::dispersion_mut`] sets it.
+fn check_model(p: &Props, convertible: bool) -> Result<Dependence> {
     let plugin = p.plugin_type();
     let compensated = p.values().any(|(name, v, _)| name == "energy_compensation" && matches!(v, Value::Bool(true)));
     let mut model: Option<Bsdf> = None;
@@ -149,7 +175,22 @@ fn check_model(p: &Props, convertible: bool) -> Result<bool> {
         }
         Ok(model.clone().unwrap_or_else(|| unreachable!("built above")))
     };
-    let mut chromatic = false;
+    let mut dependence = Dependence::None;
+    if matches!(plugin, "dielectric" | "thindielectric" | "roughdielectric") && built()?.is_dispersive() {
+        let refuse = |what: &str| {
+            Err(Error::spec(
+                p.at(),
+                format!("spectral mode does not take {what} (`int_ior`/`ext_ior` of `{plugin}`) yet; render it with --mode rgb"),
+            ))
+        };
+        if built()?.dispersion_mut().is_none() {
+            return refuse("a dispersive index in an energy-compensated model");
+        }
+        if !convertible {
+            return refuse("a dispersive index here");
+        }
+        dependence = Dependence::Dispersion;
+    }
     for (name, value, at) in p.values() {
         let refuse = |what: &str| {
             Err(Error::spec(
@@ -164,13 +205,13 @@ fn check_model(p: &Props, convertible: bool) -> Result<bool> {
                 if !(convertible && (index || CONVERTED.contains(&name) && built()?.reflectance_slot(name).is_some())) {
                     return refuse(what);
                 }
-                chromatic = true;
+                dependence = dependence.max(Dependence::Colours);
             }
             Value::String(s) if name == "material" && s != "none" => {
                 if !(convertible && built()?.conductor_fresnel().is_some()) {
                     return refuse(if compensated { "a named metal in an energy-compensated model" } else { "a named metal here" });
                 }
-                chromatic = true;
+                dependence = dependence.max(Dependence::Colours);
             }
             Value::Nested(t) if t.class() == "texture" => {
                 let scalar = super::material::SCALAR_PARAMETERS.contains(&name) || plugin == "bumpmap" || name == "normalmap";
@@ -184,11 +225,11 @@ fn check_model(p: &Props, convertible: bool) -> Result<bool> {
                             "a texture on this colour"
                         });
                     }
-                    chromatic = true;
+                    dependence = dependence.max(Dependence::Colours);
                 }
             }
             Value::Nested(m) if is_model(m) => {
-                chromatic |= check_model(m, convertible && CONTAINERS.contains(&plugin))?;
+                dependence = dependence.max(check_model(m, convertible && CONTAINERS.contains(&plugin))?);
             }
             _ => {}
         }
@@ -196,7 +237,7 @@ fn check_model(p: &Props, convertible: bool) -> Result<bool> {
     if matches!(plugin, "measured" | "merl") {
         return Err(Error::spec(p.at(), format!("spectral mode does not take `{plugin}` (its RGB data) yet; render it with --mode rgb")));
     }
-    Ok(chromatic)
+    Ok(dependence)
 }
 
 /// Whether a nested plugin is a model (not a texture nor a spectrum).
@@ -206,10 +247,14 @@ fn is_model(p: &Props) -> bool {
 
 /// Model `b` at the wavelengths `lambda`, in `b` and in the models it holds ([`Bsdf::for_each_nested`]):
 /// each colour parameter of `CONVERTED` (those [`check_bsdf`] takes) replaced by its reflectance spectrum's
-/// values at `lambda`, and a conductor's index by its spectra's ([`crate::bsdf::Conductor::set_wavelengths`]).
+/// values at `lambda`, a conductor's index by its spectra's ([`crate::bsdf::Conductor::set_wavelengths`]),
+/// and a dispersive dielectric's by its value at the hero wavelength `lambda[0]`.
 pub fn reflectances_at(b: &mut Bsdf, lambda: [f32; PATH_WAVELENGTHS]) {
     if let Some(c) = b.conductor_fresnel() {
         c.set_wavelengths(lambda);
+    }
+    if let Some((law, eta)) = b.dispersion_mut() {
+        *eta = law.eta(lambda[0]);
     }
     for name in CONVERTED {
         if let Some(r) = b.reflectance_slot(name) {

@@ -1,5 +1,7 @@
-//! Helpers shared by the spectrum tests (`mod common;` in each).
+//! Helpers shared by the spectrum tests (`mod common;` in each; each test file uses some of them).
+#![allow(dead_code)]
 
+use gonio::render::RenderOutput;
 use gonio::spectrum::cie::{cie1931_xyz, CIE_MAX, CIE_MIN, CIE_Y_NORMALIZATION};
 
 /// XYZ of a spectrum: composite 3-point Gauss–Legendre on 0.5 nm steps over [360, 830] nm (2820 nodes;
@@ -22,4 +24,14 @@ pub fn xyz_of(s: impl Fn(f64) -> f64) -> [f64; 3] {
         }
     }
     xyz
+}
+
+/// Each channel's mean over an image's pixels and its standard error.
+pub fn mean_and_se(img: &RenderOutput) -> [(f64, f64); 3] {
+    std::array::from_fn(|c| {
+        let v: Vec<f64> = img.data.chunks(3).map(|p| f64::from(p[c])).collect();
+        let n = v.len() as f64;
+        let mean = v.iter().sum::<f64>() / n;
+        (mean, (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt())
+    })
 }
