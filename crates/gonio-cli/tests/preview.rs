@@ -104,6 +104,28 @@ fn grid_and_several_bsdfs_are_laid_out_in_rows_and_columns() {
 }
 
 #[test]
+fn spectral_mode_previews_dispersive_glass_in_the_white_furnace_as_white() {
+    // Spectral mode (issue 30): a dispersive diamond sphere (each path following its hero wavelength through
+    // it) and a coloured diffuse one, in the white furnace. The diamond sphere is the furnace's white within
+    // noise; the diffuse sphere's colour is its reflectance, as in RGB mode, within the upsampling's 1 %.
+    let dir = Scratch::new("preview-spectral");
+    let exr = dir.join("spectral.exr");
+    let e = exr.to_str().unwrap();
+    let diamond = r#"{"type": "dielectric", "int_ior": "diamond", "dispersive": true}"#;
+    ok(&gonio(&["preview", diamond, "--env", "constant", "--mode", "spectral", "--size", "32", "--spp", "64", "-o", e, "--quiet"]));
+    let c = centre_mean(&read_image(&exr).unwrap());
+    for v in c.0 {
+        assert!((v - 1.0).abs() < 0.03, "the diamond sphere in the furnace: {c}");
+    }
+    let paper = r#"{"type": "diffuse", "reflectance": [0.2, 0.4, 0.8]}"#;
+    ok(&gonio(&["preview", paper, "--env", "constant", "--mode", "spectral", "--size", "32", "--spp", "64", "-o", e, "--quiet"]));
+    let c = centre_mean(&read_image(&exr).unwrap());
+    for (v, want) in c.0.iter().zip([0.2f32, 0.4, 0.8]) {
+        assert!((v / want - 1.0).abs() < 0.03, "the blue paper in the furnace: {c}");
+    }
+}
+
+#[test]
 fn bad_input_is_one_line_and_exit_code_two() {
     let dir = Scratch::new("preview-bad");
     let png = dir.join("x.png");
@@ -123,6 +145,11 @@ fn bad_input_is_one_line_and_exit_code_two() {
         (&["preview", d, "-o", "/tmp/sphere.jpg"], ".png, .exr or .hdr"),
         (&["preview", d, "--spp", "0", "-o", p], "--spp"),
         (&["preview", "/no/such/material.xml", "-o", p], "/no/such/material.xml"),
+        (&["preview", d, "--mode", "spectral", "--ray", "auto", "-o", p], "--ray renders in RGB mode only"),
+        (
+            &["preview", r#"{"type": "phong", "diffuse_reflectance": [0.8, 0.2, 0.1]}"#, "--mode", "spectral", "-o", p],
+            "`diffuse_reflectance` of `phong`",
+        ),
     ];
     for (args, expect) in cases {
         assert_one_line_error(args, expect);

@@ -124,7 +124,7 @@ impl PyPreviewLighting {
 /// samples dropped. `threads`: the render's threads (default: all cores).
 #[pyfunction]
 #[allow(clippy::too_many_arguments)]
-#[pyo3(signature = (spec, grid, point, lighting, size, spp, seed, threads = None, source = "<string>"))]
+#[pyo3(signature = (spec, grid, point, lighting, size, spp, seed, threads = None, source = "<string>", mode = "rgb"))]
 fn _render_preview<'py>(
     py: Python<'py>,
     spec: &str,
@@ -136,7 +136,9 @@ fn _render_preview<'py>(
     seed: u64,
     threads: Option<usize>,
     source: &str,
+    mode: &str,
 ) -> PyResult<(Bound<'py, PyAny>, u64)> {
+    let mode = gonio::scene::Mode::parse(mode).map_err(spec_error)?;
     let mut pool = rayon::ThreadPoolBuilder::new();
     if let Some(n) = threads {
         if n == 0 {
@@ -147,9 +149,10 @@ fn _render_preview<'py>(
     let pool = pool.build().map_err(|e| PyOSError::new_err(format!("cannot start render threads: {e}")))?;
     let lighting = &lighting.0;
     // A sweep holds descriptions that are not `Sync`: it is built inside the pool.
-    let out =
-        run_released(py, || pool.install(|| sweep(spec, grid, source)?.render(point, lighting, size, spp, seed, &AtomicBool::new(false))))?
-            .map_err(spec_error)?;
+    let out = run_released(py, || {
+        pool.install(|| sweep(spec, grid, source)?.render(point, lighting, size, spp, seed, mode, &AtomicBool::new(false)))
+    })?
+    .map_err(spec_error)?;
     let (h, w) = (out.image.height, out.image.width);
     Ok((PyArray1::from_vec(py, out.image.data).reshape([h, w, 3])?.into_any(), out.nonfinite))
 }

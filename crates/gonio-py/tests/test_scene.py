@@ -398,3 +398,15 @@ def test_an_error_in_the_progress_bar_cancels_the_render(scene_file, monkeypatch
         big.render(spp=100_000, progress=True)
     assert time.monotonic() - start < 5.0
     assert calls == ["update", "close"]
+
+
+def test_preview_in_spectral_mode():
+    # `gonio.preview(..., mode="spectral")` is `gonio preview --mode spectral`: a dispersive sphere in the
+    # white furnace stays white; a colour spectral mode cannot take yet, and an unknown mode, are errors.
+    spec = {"type": "thindielectric", "int_ior": "cauchy(1.5, 0.02)"}
+    img = gonio.preview(spec, env="constant", size=32, spp=128, mode="spectral").images[0]
+    assert np.allclose(img[8:24, 8:24].reshape(-1, 3).mean(axis=0), 1.0, atol=0.03)
+    with pytest.raises(gonio.SpecError, match="`diffuse_reflectance` of `phong`"):
+        gonio.preview({"type": "phong", "diffuse_reflectance": [0.8, 0.2, 0.1]}, size=8, spp=1, mode="spectral")
+    with pytest.raises(gonio.SpecError, match="unknown mode `hyper`"):
+        gonio.preview({"type": "diffuse"}, size=8, spp=1, mode="hyper")

@@ -29,7 +29,7 @@
 //! use gonio::preview::{preview_scene, Lighting};
 //! use gonio::scene::Material;
 //! let material = Material::Fixed(gonio::Bsdf::from_json(r#"{"type": "diffuse"}"#).unwrap());
-//! let scene = preview_scene(material, &Lighting::Constant(gonio::Rgb::ONE), 32).unwrap();
+//! let scene = preview_scene(material, &Lighting::Constant(gonio::Rgb::ONE), 32, None).unwrap();
 //! assert_eq!((scene.film.width, scene.film.height), (32, 32));
 //! ```
 
@@ -42,7 +42,8 @@ use crate::image::{read_image, Image};
 use crate::light::{ConstantLight, DirectionalLight, EnvMap, Light};
 use crate::math::Transform;
 use crate::render::render;
-use crate::scene::{IntegratorKind, Material, SamplerSpec, Scene};
+use crate::scene::spectral::Dependence;
+use crate::scene::{IntegratorKind, Material, SamplerSpec, Scene, SpectralScene};
 use crate::spectrum::Rgb;
 use glam::Vec3;
 use std::f32::consts::PI;
@@ -140,11 +141,13 @@ pub fn gradient_sky(width: usize, height: usize) -> Image {
 
 /// A scene holding one unit sphere with `material` at the origin, a `size × size` film and `lighting`,
 /// rendered by the path tracer (unbounded depth, Russian roulette from depth 5; the environment is seen
-/// behind the sphere).
+/// behind the sphere). In spectral mode (`spectral`: how the material depends on wavelength, as
+/// [`check_bsdf`](crate::scene::spectral::check_bsdf) found it) the scene carries wavelengths
+/// (docs/spectral.md).
 ///
 /// # Errors
 /// When the environment image cannot be read (the error names the file) or `size` is 0.
-pub fn preview_scene(material: Material, lighting: &Lighting, size: u32) -> Result<Scene> {
+pub fn preview_scene(material: Material, lighting: &Lighting, size: u32, spectral: Option<Dependence>) -> Result<Scene> {
     if size == 0 {
         return Err(Error::spec("preview", "the image size must be at least 1 pixel"));
     }
@@ -183,7 +186,14 @@ pub fn preview_scene(material: Material, lighting: &Lighting, size: u32) -> Resu
     // The sphere subtends a half-angle asin(1/d); widen the view so that it fills FILL of the frame.
     let fov = 2.0 * ((1.0 / CAMERA_DISTANCE).asin().tan() / FILL).atan().to_degrees();
     let camera = Camera::new(to_world, fov, "x", size, size, 0.01, 1.0e4, "preview")?;
-    Ok(Scene::assemble(
+    if spectral.is_some() {
+        for light in &mut lights {
+            if let Light::EnvMap(env) = light {
+                env.prepare_spectra();
+            }
+        }
+    }
+    let mut scene = Scene::assemble(
         vec![Shape::Sphere(sphere)],
         vec![material],
         vec![None],
@@ -193,7 +203,11 @@ pub fn preview_scene(material: Material, lighting: &Lighting, size: u32) -> Resu
         SamplerSpec { sample_count: 64, seed: 0 },
         IntegratorKind::Path { max_depth: -1, rr_depth: 5, hide_emitters: false },
         Vec::new(),
-    ))
+    );
+    if let Some(dependence) = spectral {
+        scene.spectral = Some(SpectralScene::new(&scene.materials, &scene.lights, vec![dependence], &[]));
+    }
+    Ok(scene)
 }
 
 /// A rendered lit sphere.
@@ -206,7 +220,7 @@ pub struct PreviewImage {
 
 /// Render the lit sphere of [`preview_scene`] with `spp` samples per pixel. `material` builds the material
 /// (called once per rendered part: a directional light and its ambient are rendered apart and added, see
-/// the module docs). `cancel` stops the render between tiles.
+/// the module docs); `spectral` as [`preview_scene`] takes it. `cancel` stops the render between tiles.
 ///
 /// # Errors
 /// Those of `material` and [`preview_scene`]; `spp` 0.
@@ -216,6 +230,7 @@ pub fn render_preview(
     size: u32,
     spp: u32,
     seed: u64,
+    spectral: Option<Dependence>,
     cancel: &AtomicBool,
 ) -> Result<PreviewImage> {
     if spp == 0 {
@@ -230,7 +245,7 @@ pub fn render_preview(
     let mut sum: Option<Image> = None;
     let mut nonfinite = 0;
     for part in &parts {
-        let scene = preview_scene(material()?, part, size)?;
+        let scene = preview_scene(material()?, part, size, spectral)?;
         let out = render(&scene, spp, seed, cancel, &|_| {});
         nonfinite += out.nonfinite;
         let image = Image { width: out.width as usize, height: out.height as usize, data: out.data };
@@ -302,7 +317,7 @@ mod tests {
 
     fn render_mean_of_centre(bsdf: &str, lighting: &Lighting, size: u32, spp: u32) -> (Image, Rgb) {
         let material = Material::Fixed(Bsdf::from_json(bsdf).unwrap());
-        let scene = preview_scene(material, lighting, size).unwrap();
+        let scene = preview_scene(material, lighting, size, None).unwrap();
         let out = render(&scene, spp, 7, &AtomicBool::new(false), &|_| {});
         let image = Image { width: out.width as usize, height: out.height as usize, data: out.data };
         // The central half of the frame lies on the sphere (it fills 90 % of the width).
@@ -333,7 +348,7 @@ mod tests {
     fn directional_light_lights_the_side_facing_it() {
         let lighting = Lighting::Directional { towards_light: Vec3::new(1.0, 0.0, 0.0), ambient: AMBIENT };
         let material = || Ok(Material::Fixed(Bsdf::from_json(r#"{"type": "diffuse", "reflectance": 0.8}"#)?));
-        let image = render_preview(&material, &lighting, 32, 4, 1, &AtomicBool::new(false)).unwrap().image;
+        let image = render_preview(&material, &lighting, 32, 4, 1, None, &AtomicBool::new(false)).unwrap().image;
         // +x is the image's right: the right edge of the sphere faces the light (radiance ≈ ρ · cos θ + ambient),
         // the left edge sees only the ambient (ρ · AMBIENT = 0.032 in expectation; one pixel at 4 spp is noisy).
         let (left, right) = (image.get(5, 16), image.get(26, 16));
@@ -356,10 +371,10 @@ mod tests {
     #[test]
     fn bad_lighting_and_size_are_errors() {
         let m = || Material::Fixed(Bsdf::from_json(r#"{"type": "diffuse"}"#).unwrap());
-        assert!(preview_scene(m(), &Lighting::Directional { towards_light: Vec3::ZERO, ambient: 0.0 }, 8).is_err());
-        assert!(preview_scene(m(), &Lighting::Directional { towards_light: Vec3::Y, ambient: f32::NAN }, 8).is_err());
-        assert!(preview_scene(m(), &Lighting::Constant(Rgb::ONE), 0).is_err());
-        let e = preview_scene(m(), &Lighting::Environment("/no/such/sky.hdr".into()), 8).unwrap_err();
+        assert!(preview_scene(m(), &Lighting::Directional { towards_light: Vec3::ZERO, ambient: 0.0 }, 8, None).is_err());
+        assert!(preview_scene(m(), &Lighting::Directional { towards_light: Vec3::Y, ambient: f32::NAN }, 8, None).is_err());
+        assert!(preview_scene(m(), &Lighting::Constant(Rgb::ONE), 0, None).is_err());
+        let e = preview_scene(m(), &Lighting::Environment("/no/such/sky.hdr".into()), 8, None).unwrap_err();
         assert!(e.to_string().contains("/no/such/sky.hdr"), "{e}");
     }
 

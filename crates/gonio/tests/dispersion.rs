@@ -403,7 +403,7 @@ fn dispersive_indices_spectral_mode_cannot_follow_are_refused_at_load() {
 /// by a small sun of one wavelength λ shows its bow only where the sun stands at least D_min(λ) from the
 /// viewing direction. Rendered, around the bow's impact point, with the sun (0.3° across, a 6 nm band of
 /// emission around λ) 0.5° beyond and
-/// 0.8° short of D_min(λ) for λ = 450 and 650 nm (D_min 139.4° and 137.7°, 1.7° apart: a renderer that
+/// 0.8° short of D_min(λ) for λ = 450 and 650 nm (D_min 138.87° and 137.73°, 1.15° apart: a renderer that
 /// bent every wavelength alike, at n_d, would light the 450 nm sun short of its angle): beyond, the light
 /// lies at the impact parameter of minimum deviation b = sin i (its mean distance from the sphere's centre
 /// within 0.025 of the radius; measured 2026-12-06: 0.005 and 0.012); short of it, under a tenth of that

@@ -10,6 +10,7 @@ use crate::spec::{in_json_file, load_props};
 use glam::Vec3;
 use gonio::image::write_image;
 use gonio::preview::{contact_sheet, GridAxis, Lighting, Sweep};
+use gonio::scene::Mode;
 use gonio::Error;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -53,6 +54,9 @@ pub struct Args {
     /// Random seed.
     #[arg(long, default_value_t = 0)]
     seed: u64,
+    /// How light is carried: `rgb`, or `spectral` (as `gonio render --mode`; docs/spectral.md).
+    #[arg(long, default_value = "rgb", value_parser = ["rgb", "spectral"])]
+    mode: String,
     /// Worker threads (default: all cores).
     #[arg(long)]
     threads: Option<usize>,
@@ -172,7 +176,11 @@ pub fn run(args: Args) -> Result<ExitCode, Error> {
     if !args.exposure.is_finite() || args.exposure.abs() > 30.0 {
         return Err(arg_error(format!("--exposure must be in [-30, 30], got {}", args.exposure)));
     }
+    let mode = Mode::parse(&args.mode)?;
     if let Some(address) = &args.ray {
+        if mode != Mode::Rgb {
+            return Err(arg_error("--ray renders in RGB mode only (yet); drop --mode spectral or --ray".into()));
+        }
         return on_ray(address, &args);
     }
     let lighting = lighting(&args)?;
@@ -188,7 +196,7 @@ pub fn run(args: Args) -> Result<ExitCode, Error> {
     let mut nonfinite = 0;
     for (arg, sweep) in &sweeps {
         for point in 0..sweep.len() {
-            let out = sweep.render(point, &lighting, args.size, args.spp, args.seed, &cancel).map_err(|e| in_json_file(arg, e))?;
+            let out = sweep.render(point, &lighting, args.size, args.spp, args.seed, mode, &cancel).map_err(|e| in_json_file(arg, e))?;
             nonfinite += out.nonfinite;
             tiles.push(out.image);
         }

@@ -288,6 +288,7 @@ def preview(
     output_dir: Optional[PathLike] = None,
     exposure: float = 0.0,
     source: str = "<string>",
+    mode: str = "rgb",
 ) -> PreviewResult:
     """Lit spheres of a material, one per point of `grid` (e.g. `{"alpha": [0.05, 0.3], "material": ["Au", "Cu"]}`:
     the product, row-major). `env`: None/"gradient" (the built-in sky), "constant", an image file or array;

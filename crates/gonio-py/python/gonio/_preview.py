@@ -115,9 +115,9 @@ class Sweep:
         points = [{name: given[name][j] for name, j in zip(given, idx)} for idx in indices]
         return Sweep(spec, source, text, labels, points, columns)
 
-    def render(self, point: int, lighting: Any, settings: "Settings", threads: Optional[int] = None) -> Tuple[np.ndarray, int]:
+    def render(self, point: int, lighting: Any, settings: "Settings", threads: Optional[int] = None, mode: str = "rgb") -> Tuple[np.ndarray, int]:
         return _gonio._render_preview(self.spec, self.grid, point, lighting, settings.size, settings.spp, settings.seed,
-                                      threads=threads, source=self.source)
+                                      threads=threads, source=self.source, mode=mode)
 
 
 @dataclasses.dataclass
@@ -152,6 +152,7 @@ def preview(
     output_dir: Optional[Union[str, os.PathLike]] = None,
     exposure: float = 0.0,
     source: str = "<string>",
+    mode: str = "rgb",
 ) -> PreviewResult:
     """Render lit spheres of a material (``gonio preview``): one per point of ``grid``, the product of the
     values of its parameters in row-major order, e.g. ``grid={"alpha": [0.05, 0.1, 0.3], "material":
@@ -163,7 +164,8 @@ def preview(
     furnace), a lat-long image file's path or an (H, W, 3) float32 array — or ``light``, a direction
     (x, y, z) towards a directional light of irradiance π (+x right, +y up, +z towards the viewer) with a
     dim ambient. Each sphere is ``size`` × ``size`` pixels at ``spp`` samples per pixel with seed ``seed``,
-    rendered with ``threads`` threads (default: all cores).
+    rendered with ``threads`` threads (default: all cores), in ``mode`` ``"rgb"`` or ``"spectral"`` (three
+    sampled wavelengths per path, as ``gonio render --mode spectral``; docs/spectral.md).
 
     Returns a ``PreviewResult`` (images, their grid points and labels, ``sheet()`` the contact sheet).
     ``output`` writes the contact sheet, ``output_dir`` each sphere (both scaled by 2^``exposure``).
@@ -177,7 +179,7 @@ def preview(
     lighting = _gonio.PreviewLighting(env, None if light is None else tuple(light))
     images, nonfinite = [], 0
     for i in range(len(sweep.labels)):
-        image, dropped = sweep.render(i, lighting, settings, threads)
+        image, dropped = sweep.render(i, lighting, settings, threads, mode)
         images.append(image)
         nonfinite += dropped
     result = PreviewResult(images, sweep.points, sweep.labels, sweep.columns, nonfinite, time.perf_counter() - start)

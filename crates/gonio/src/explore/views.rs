@@ -155,7 +155,7 @@ pub fn sphere(bsdf: &Bsdf, q: &HashMap<String, String>, environment: Lighting, c
         return Err(Error::spec("seed", format!("must be in [0, 10⁹], got {seed}")));
     }
     let material = || Ok(Material::Fixed(bsdf.clone()));
-    let out = render_preview(&material, &lighting, size as u32, spp as u32, seed as u64, cancel)?;
+    let out = render_preview(&material, &lighting, size as u32, spp as u32, seed as u64, None, cancel)?;
     crate::image::encode_png(&out.image)
 }
 

@@ -21,6 +21,7 @@
 use super::{render_preview, Lighting, PreviewImage};
 use crate::error::{Error, Result};
 use crate::props::{Props, Value};
+use crate::scene::spectral::{check_bsdf, Mode};
 use crate::scene::Material;
 use std::sync::atomic::AtomicBool;
 
@@ -251,15 +252,30 @@ impl Sweep {
         (0..self.len()).try_for_each(|i| self.material(i).map(drop))
     }
 
-    /// Render point `point` as [`render_preview`] does.
+    /// Render point `point` as [`render_preview`] does, in `mode`.
     ///
     /// # Errors
-    /// Those of [`Sweep::material`] and [`render_preview`].
-    pub fn render(&self, point: usize, lighting: &Lighting, size: u32, spp: u32, seed: u64, cancel: &AtomicBool) -> Result<PreviewImage> {
+    /// Those of [`Sweep::material`] and [`render_preview`]; in spectral mode, a material it does not take
+    /// yet ([`check_bsdf`]).
+    #[allow(clippy::too_many_arguments)]
+    pub fn render(
+        &self,
+        point: usize,
+        lighting: &Lighting,
+        size: u32,
+        spp: u32,
+        seed: u64,
+        mode: Mode,
+        cancel: &AtomicBool,
+    ) -> Result<PreviewImage> {
         if point >= self.len() {
             return Err(grid_error(format!("point {point} of a sweep of {} points", self.len())));
         }
-        render_preview(&|| self.material(point), lighting, size, spp, seed, cancel)
+        let spectral = match mode {
+            Mode::Rgb => None,
+            Mode::Spectral => Some(check_bsdf(&self.props(point))?),
+        };
+        render_preview(&|| self.material(point), lighting, size, spp, seed, spectral, cancel)
     }
 }
 
