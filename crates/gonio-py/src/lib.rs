@@ -12,6 +12,9 @@
 use batch::{broadcast, finish, for_chunks, output, Arg, Out};
 use gonio::bsdf::{Bsdf, BsdfFlags, BsdfModel, RowCheck, SampleColumns, PLUGINS};
 use gonio::math::{Vec2, Vec3};
+use gonio::props::Props;
+use gonio::scene::spectral::{check_bsdf, reflectances_at, Dependence};
+use gonio::spectrum::wavelengths::{LAMBDA_MAX, LAMBDA_MIN};
 use gonio::Rgb;
 use numpy::{PyArray1, PyArrayDyn, PyUntypedArrayMethods};
 use pyo3::create_exception;
@@ -212,14 +215,136 @@ pub(crate) struct PyBsdf {
     pub(crate) bsdf: Bsdf,
     /// The description it was built from, for `__repr__`.
     pub(crate) spec: String,
+    /// How it depends on wavelength, as spectral mode reads it, or why spectral mode does not take it
+    /// (`scene::spectral::check_bsdf`): what `wavelengths=` of `f`, `pdf` and `sample` needs.
+    pub(crate) spectral: Result<Dependence, String>,
+}
+
+impl PyBsdf {
+    /// The model built from `props` (a description `spec`), with its spectral reading.
+    pub(crate) fn new(props: &Props, spec: String) -> gonio::Result<Self> {
+        let bsdf = Bsdf::from_props(props)?;
+        Ok(PyBsdf { bsdf, spec, spectral: check_bsdf(props).map_err(|e| e.to_string()) })
+    }
+
+    /// The model at each row's wavelength (nm, column `lambda` of `n` rows), for `wavelengths=`: each
+    /// distinct wavelength's copy of the model set as spectral mode sets a path's
+    /// (`scene::spectral::reflectances_at`, all three channels at that wavelength), and the rows it serves.
+    fn at_wavelengths(&self, lambda: &Arg<'_>, n: usize) -> PyResult<Vec<(Bsdf, Vec<usize>)>> {
+        if let Err(e) = &self.spectral {
+            return Err(SpecError::new_err(format!("wavelengths: {e}")));
+        }
+        let col = lambda.column();
+        let mut groups: Vec<(f32, Vec<usize>)> = Vec::new();
+        let mut index: std::collections::HashMap<u32, usize> = std::collections::HashMap::new();
+        for i in 0..n {
+            let l = col.get(i, 0);
+            if !(f64::from(LAMBDA_MIN)..=f64::from(LAMBDA_MAX)).contains(&l) {
+                return Err(PyValueError::new_err(format!(
+                    "wavelengths[{i}] = {l}: expected a wavelength in [{LAMBDA_MIN}, {LAMBDA_MAX}] nm"
+                )));
+            }
+            #[allow(clippy::cast_possible_truncation)]
+            let l = l as f32;
+            let g = *index.entry(l.to_bits()).or_insert_with(|| {
+                groups.push((l, Vec::new()));
+                groups.len() - 1
+            });
+            groups[g].1.push(i);
+        }
+        Ok(groups
+            .into_iter()
+            .map(|(l, rows)| {
+                let mut model = self.bsdf.clone();
+                reflectances_at(&mut model, [l; 3]);
+                (model, rows)
+            })
+            .collect())
+    }
+}
+
+impl PyBsdf {
+    /// `sample` with `wavelengths=`: each row's sample of the model at its wavelength.
+    fn sample_at_wavelengths<'py>(
+        &self,
+        py: Python<'py>,
+        (wo, uc, u, wavelengths): (&Bound<'py, PyAny>, &Bound<'py, PyAny>, &Bound<'py, PyAny>, &Bound<'py, PyAny>),
+        normalize: bool,
+    ) -> PyResult<PySample> {
+        let (ao, auc, au, al) =
+            (Arg::read(wo, "wo", 3)?, Arg::read(uc, "uc", 1)?, Arg::read(u, "u", 2)?, Arg::read(wavelengths, "wavelengths", 1)?);
+        let (n, batched) = broadcast(&[&ao, &auc, &au, &al])?;
+        let (mut bo, mut buc, mut bu) = (Vec::new(), Vec::new(), Vec::new());
+        let (co, cuc, cu) = (ao.column(), auc.column(), au.column());
+        let (Some(wo), Some(uc), Some(u)) =
+            (co.directions(0..n, normalize, &mut bo), cuc.unit_numbers(0..n, &mut buc), cu.unit_pairs(0..n, &mut bu))
+        else {
+            return Err(first_bad_row(&[&ao], &[&auc, &au], normalize));
+        };
+        let groups = self.at_wavelengths(&al, n)?;
+        let (mut wi, mut f, mut pdf, mut weight) = (vec![0.0f32; 3 * n], vec![0.0f32; n], vec![0.0f32; n], vec![0.0f32; n]);
+        let (mut flags, mut eta, mut valid) = (vec![0u32; n], vec![0.0f32; n], vec![false; n]);
+        for (model, rows) in &groups {
+            for &r in rows {
+                if let Some(s) = model.sample(wo[r], uc[r], u[r]) {
+                    wi[3 * r..3 * r + 3].copy_from_slice(&s.wi.to_array());
+                    (f[r], pdf[r], weight[r], flags[r], eta[r], valid[r]) = (s.f.r(), s.pdf, s.weight.r(), s.flags.0, s.eta, true);
+                }
+            }
+        }
+        Ok(PySample {
+            wi: finish(PyArray1::from_vec(py, wi), 3, batched)?.unbind(),
+            f: finish(PyArray1::from_vec(py, f), 1, batched)?.unbind(),
+            pdf: finish(PyArray1::from_vec(py, pdf), 1, batched)?.unbind(),
+            weight: finish(PyArray1::from_vec(py, weight), 1, batched)?.unbind(),
+            flags: finish(PyArray1::from_vec(py, flags), 1, batched)?.unbind(),
+            eta: finish(PyArray1::from_vec(py, eta), 1, batched)?.unbind(),
+            valid: finish(PyArray1::from_vec(py, valid), 1, batched)?.unbind(),
+        })
+    }
+}
+
+/// `f` or `pdf` with `wavelengths=`: `eval(model at the row's wavelength, wo, wi)` per row, one number each.
+fn over_pairs_at_wavelengths<'py>(
+    py: Python<'py>,
+    bsdf: &PyBsdf,
+    (wo, wi, wavelengths): (&Bound<'py, PyAny>, &Bound<'py, PyAny>, &Bound<'py, PyAny>),
+    normalize: bool,
+    eval: impl Fn(&Bsdf, Vec3, Vec3) -> f32,
+) -> PyResult<Bound<'py, PyAny>> {
+    let (ao, ai, al) = (Arg::read(wo, "wo", 3)?, Arg::read(wi, "wi", 3)?, Arg::read(wavelengths, "wavelengths", 1)?);
+    let (n, batched) = broadcast(&[&ao, &ai, &al])?;
+    let (mut bo, mut bi, co, ci) = (Vec::new(), Vec::new(), ao.column(), ai.column());
+    let (Some(dirs_o), Some(dirs_i)) = (co.directions(0..n, normalize, &mut bo), ci.directions(0..n, normalize, &mut bi)) else {
+        return Err(first_bad_row(&[&ao, &ai], &[], normalize));
+    };
+    let groups = bsdf.at_wavelengths(&al, n)?;
+    let mut values = vec![0.0f32; n];
+    for (model, rows) in &groups {
+        for &r in rows {
+            values[r] = eval(model, dirs_o[r], dirs_i[r]);
+        }
+    }
+    finish(PyArray1::from_vec(py, values), 1, batched)
 }
 
 #[pymethods]
 impl PyBsdf {
     /// f(wo, wi): the BSDF value in sr⁻¹ without the cosine, float32 RGB of shape (N, 3), or (3,) when both
-    /// directions have shape (3,). Zero for delta lobes (see `sample`).
-    #[pyo3(signature = (wo, wi, *, normalize = false))]
-    fn f<'py>(&self, py: Python<'py>, wo: &Bound<'py, PyAny>, wi: &Bound<'py, PyAny>, normalize: bool) -> PyResult<Bound<'py, PyAny>> {
+    /// directions have shape (3,). Zero for delta lobes (see `sample`). With `wavelengths` (nm, a number or
+    /// shape (N,)), the value at each row's wavelength as spectral mode renders the model: shape (N,).
+    #[pyo3(signature = (wo, wi, *, normalize = false, wavelengths = None))]
+    fn f<'py>(
+        &self,
+        py: Python<'py>,
+        wo: &Bound<'py, PyAny>,
+        wi: &Bound<'py, PyAny>,
+        normalize: bool,
+        wavelengths: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        if let Some(l) = wavelengths {
+            return over_pairs_at_wavelengths(py, self, (wo, wi, l), normalize, |m, wo, wi| m.f(wo, wi).r());
+        }
         let bsdf = &self.bsdf;
         over_pairs(
             py,
@@ -233,9 +358,20 @@ impl PyBsdf {
     }
 
     /// The solid-angle density with which `sample` produces `wi` from `wo` (smooth lobes only), float32 of
-    /// shape (N,), or a scalar when both directions have shape (3,).
-    #[pyo3(signature = (wo, wi, *, normalize = false))]
-    fn pdf<'py>(&self, py: Python<'py>, wo: &Bound<'py, PyAny>, wi: &Bound<'py, PyAny>, normalize: bool) -> PyResult<Bound<'py, PyAny>> {
+    /// shape (N,), or a scalar when both directions have shape (3,); with `wavelengths`, the model's at each
+    /// row's wavelength (as `f`).
+    #[pyo3(signature = (wo, wi, *, normalize = false, wavelengths = None))]
+    fn pdf<'py>(
+        &self,
+        py: Python<'py>,
+        wo: &Bound<'py, PyAny>,
+        wi: &Bound<'py, PyAny>,
+        normalize: bool,
+        wavelengths: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        if let Some(l) = wavelengths {
+            return over_pairs_at_wavelengths(py, self, (wo, wi, l), normalize, |m, wo, wi| m.pdf(wo, wi));
+        }
         let bsdf = &self.bsdf;
         over_pairs(
             py,
@@ -250,8 +386,10 @@ impl PyBsdf {
 
     /// Sample `wi` given `wo` (shape (3,) or (N, 3)), `uc` (lobe choice; a number or shape (N,)) and `u`
     /// (direction; shape (2,) or (N, 2)), all in [0, 1]. Returns a `BsdfSample` of arrays; rows where the
-    /// model does not scatter have `valid == False` and zeros elsewhere.
-    #[pyo3(signature = (wo, uc, u, *, normalize = false))]
+    /// model does not scatter have `valid == False` and zeros elsewhere. With `wavelengths` (as `f`), each
+    /// row samples the model at its wavelength (a dispersive glass refracts each its own way), and `f` and
+    /// `weight` are one number per row.
+    #[pyo3(signature = (wo, uc, u, *, normalize = false, wavelengths = None))]
     fn sample<'py>(
         &self,
         py: Python<'py>,
@@ -259,7 +397,11 @@ impl PyBsdf {
         uc: &Bound<'py, PyAny>,
         u: &Bound<'py, PyAny>,
         normalize: bool,
+        wavelengths: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<PySample> {
+        if let Some(l) = wavelengths {
+            return self.sample_at_wavelengths(py, (wo, uc, u, l), normalize);
+        }
         let (ao, auc, au) = (Arg::read(wo, "wo", 3)?, Arg::read(uc, "uc", 1)?, Arg::read(u, "u", 2)?);
         let (n, batched) = broadcast(&[&ao, &auc, &au])?;
         let (wi_out, wi_ptr) = output::<f32>(py, 3 * n)?;
@@ -434,8 +576,7 @@ impl PySample {
 #[pyfunction]
 fn from_json(py: Python<'_>, text: &str) -> PyResult<PyBsdf> {
     let text_owned = text.to_owned();
-    let bsdf = run_released(py, || Bsdf::from_json(&text_owned))?.map_err(spec_error)?;
-    Ok(PyBsdf { bsdf, spec: text.to_owned() })
+    run_released(py, || Props::from_json(&text_owned).and_then(|p| PyBsdf::new(&p, text_owned.clone())))?.map_err(spec_error)
 }
 
 /// Build a model from an XML document whose root (or only `<bsdf>` child) is a `<bsdf>` element; `source`
@@ -444,8 +585,8 @@ fn from_json(py: Python<'_>, text: &str) -> PyResult<PyBsdf> {
 #[pyo3(signature = (text, source = "<string>"))]
 fn from_xml(py: Python<'_>, text: &str, source: &str) -> PyResult<PyBsdf> {
     let (text_owned, source_owned) = (text.to_owned(), source.to_owned());
-    let bsdf = run_released(py, || Bsdf::from_xml(&text_owned, &source_owned))?.map_err(spec_error)?;
-    Ok(PyBsdf { bsdf, spec: text.to_owned() })
+    run_released(py, || Props::from_xml_bsdf(&text_owned, &source_owned).and_then(|p| PyBsdf::new(&p, text_owned.clone())))?
+        .map_err(spec_error)
 }
 
 /// Free the memory kept for reuse by large result arrays (see `batch::pool`); the number of bytes freed.

@@ -448,3 +448,35 @@ def test_large_results_reuse_memory_and_stay_correct(spec):
     assert kept.shape == (n, 3) and np.isfinite(kept).all()
     gonio._gonio._release_buffers()
     assert gonio._gonio._cached_buffer_bytes() == 0
+
+
+def test_f_pdf_and_sample_at_wavelengths():
+    # `wavelengths=` evaluates the model as spectral mode renders it at each row's wavelength (issue 30).
+    bk7 = "sellmeier(1.03961212, 0.231792344, 1.01046945, 0.00600069867, 0.0200179144, 103.560653)"
+    glass = gonio.load_bsdf({"type": "dielectric", "int_ior": bk7, "ext_ior": 1.0})
+    lam = np.array([400.0, 550.0, 700.0], np.float32)
+    theta = np.radians(50.0)
+    wo = np.array([np.sin(theta), 0.0, np.cos(theta)], np.float32)
+    s = glass.sample(wo, 0.99, [0.5, 0.5], wavelengths=lam)  # uc = 0.99: refraction at every wavelength
+    assert s.valid.all() and s.f.shape == (3,) and s.weight.shape == (3,) and s.wi.shape == (3, 3)
+    # Snell's law with the Sellmeier index at each wavelength (λ in µm): blue bends most.
+    l2 = (lam.astype(np.float64) / 1000.0) ** 2
+    n = np.sqrt(1 + sum(b * l2 / (l2 - c) for b, c in [(1.03961212, 0.00600069867), (0.231792344, 0.0200179144), (1.01046945, 103.560653)]))
+    sin_t = np.hypot(s.wi[:, 0], s.wi[:, 1])
+    assert np.allclose(sin_t, np.sin(theta) / n, atol=1e-5)
+    assert sin_t[0] < sin_t[1] < sin_t[2]
+    # A red paper reflects more at 650 nm than at 450 nm; a grey one the same everywhere; pdf ignores colour.
+    red = gonio.load_bsdf({"type": "diffuse", "reflectance": [0.8, 0.1, 0.1]})
+    f = red.f([0, 0, 1], [0, 0, 1], wavelengths=[450.0, 650.0])
+    assert f.shape == (2,) and f[1] > 4 * f[0]
+    grey = gonio.load_bsdf({"type": "diffuse", "reflectance": 0.5})
+    assert np.allclose(grey.f([0, 0, 1], [0, 0, 1], wavelengths=[400.0, 600.0, 800.0]), 0.5 / np.pi, rtol=1e-6)
+    assert np.isclose(red.pdf([0, 0, 1], [0, 0, 1], wavelengths=500.0), 1 / np.pi, rtol=1e-6)
+    # A single pair at a single wavelength is a number; a model spectral mode does not take, and a
+    # wavelength outside 360–830 nm, are errors.
+    assert np.ndim(grey.f([0, 0, 1], [0, 0, 1], wavelengths=550.0)) == 0
+    phong = gonio.load_bsdf({"type": "phong", "diffuse_reflectance": [0.8, 0.2, 0.1]})
+    with pytest.raises(gonio.SpecError, match="wavelengths: .*`diffuse_reflectance` of `phong`"):
+        phong.f([0, 0, 1], [0, 0, 1], wavelengths=550.0)
+    with pytest.raises(ValueError, match=r"wavelengths\[1\] = 900.*\[360, 830\] nm"):
+        grey.f([0, 0, 1], [0, 0, 1], wavelengths=[500.0, 900.0])

@@ -58,12 +58,16 @@ class Bsdf:
     def plugin(self) -> str: ...
     @property
     def spec(self) -> str: ...
-    def f(self, wo: ArrayLike, wi: ArrayLike, *, normalize: bool = False) -> npt.NDArray[np.float32]:
-        """f(wo, wi) in 1/sr without the cosine: shape (N, 3), or (3,) for two (3,) directions."""
-    def pdf(self, wo: ArrayLike, wi: ArrayLike, *, normalize: bool = False) -> npt.NDArray[np.float32]:
-        """Solid-angle pdf of `sample` (smooth lobes): shape (N,), or a scalar for two (3,) directions."""
-    def sample(self, wo: ArrayLike, uc: ArrayLike, u: ArrayLike, *, normalize: bool = False) -> BsdfSample:
-        """Sample wi given wo ((3,) or (N, 3)), uc (scalar or (N,)) and u ((2,) or (N, 2)) in [0, 1]."""
+    def f(self, wo: ArrayLike, wi: ArrayLike, *, normalize: bool = False, wavelengths: Optional[ArrayLike] = None) -> npt.NDArray[np.float32]:
+        """f(wo, wi) in 1/sr without the cosine: shape (N, 3), or (3,) for two (3,) directions. With
+        `wavelengths` (nm, scalar or (N,)): the value at each row's wavelength as spectral mode renders
+        the model, shape (N,)."""
+    def pdf(self, wo: ArrayLike, wi: ArrayLike, *, normalize: bool = False, wavelengths: Optional[ArrayLike] = None) -> npt.NDArray[np.float32]:
+        """Solid-angle pdf of `sample` (smooth lobes): shape (N,), or a scalar for two (3,) directions;
+        with `wavelengths`, the model's at each row's wavelength."""
+    def sample(self, wo: ArrayLike, uc: ArrayLike, u: ArrayLike, *, normalize: bool = False, wavelengths: Optional[ArrayLike] = None) -> BsdfSample:
+        """Sample wi given wo ((3,) or (N, 3)), uc (scalar or (N,)) and u ((2,) or (N, 2)) in [0, 1]; with
+        `wavelengths`, each row at its wavelength (f and weight then one number per row)."""
     def albedo(self, wo: ArrayLike, *, samples: int = 100_000, seed: int = 0, normalize: bool = False) -> npt.NDArray[np.float32]:
         """Directional albedo by Monte Carlo: shape (N, 3), or (3,) for a single wo."""
     def __eq__(self, other: object) -> bool: ...
