@@ -30,6 +30,26 @@ fn check_reads_an_xml_file_and_prints_json() {
 }
 
 #[test]
+fn check_at_wavelengths_runs_the_harness_on_the_model_at_each() {
+    // `--wavelengths` (issue 30): the model as spectral mode renders it at each wavelength, one report each:
+    // a dispersive glass (refracting at the index of that wavelength) and gold (η and k of that wavelength).
+    for model in [
+        r#"{"type": "roughdielectric", "distribution": "ggx", "alpha": 0.5, "int_ior": "bk7", "dispersive": true}"#,
+        r#"{"type": "roughconductor", "distribution": "ggx", "alpha": 0.3, "material": "Au"}"#,
+    ] {
+        let out = gonio(&["check", model, "--wavelengths", "450,650", "--json", "--samples", "200000", "--sweep", "100000"]);
+        assert_eq!(out.status.code(), Some(0), "{model}: {}", String::from_utf8_lossy(&out.stdout));
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("valid JSON");
+        let reports = v.as_array().expect("a report per wavelength");
+        assert_eq!(reports.len(), 2);
+        for (r, nm) in reports.iter().zip(["450", "650"]) {
+            assert_eq!(r["passed"], true, "{model} at {nm} nm");
+            assert!(r["name"].as_str().is_some_and(|n| n.ends_with(&format!("@ {nm} nm"))), "{r}");
+        }
+    }
+}
+
+#[test]
 fn bad_input_is_one_line_and_exit_code_two() {
     let bad_xml = data("bad_param.xml");
     let cases: &[(&[&str], &str)] = &[
@@ -44,6 +64,11 @@ fn bad_input_is_one_line_and_exit_code_two() {
         (&["check", "<bsdf type=\"diffuse\">"], "not valid XML"),
         (&["check", &bad_xml], "bad_param.xml:3:5: unknown parameter `roughness`"),
         (&["check", "/no/such/file.xml"], "/no/such/file.xml"),
+        (&["check", r#"{"type": "diffuse"}"#, "--wavelengths", "300"], "300 nm is outside [360, 830] nm"),
+        (
+            &["check", r#"{"type": "phong", "diffuse_reflectance": [0.8, 0.2, 0.1]}"#, "--wavelengths", "500"],
+            "`diffuse_reflectance` of `phong`",
+        ),
     ];
     for (args, expect) in cases {
         assert_one_line_error(args, expect);

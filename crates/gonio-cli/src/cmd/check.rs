@@ -1,7 +1,9 @@
 //! `gonio check BSDF` and `gonio check --all`.
 
-use crate::spec::load_bsdf;
+use crate::spec::{in_json_file, load_props};
 use crate::stdout::{out, outln};
+use gonio::scene::spectral::{check_bsdf, reflectances_at};
+use gonio::spectrum::wavelengths::{LAMBDA_MAX, LAMBDA_MIN};
 use gonio::verify::{check_named, expect_violation, sweep::sweep, test_directions, CheckConfig, Report};
 use gonio::{Bsdf, Error};
 use std::path::PathBuf;
@@ -39,6 +41,36 @@ pub struct Args {
     /// Folder for the observed/expected histograms of failed chi-square tests.
     #[arg(long, default_value = "gonio-check-histograms")]
     histograms: PathBuf,
+    /// Check the model at each of these wavelengths (nm, comma-separated, in [360, 830]) as spectral mode
+    /// renders it (its colours' spectra, a metal's η and k, a dispersive glass's index there), instead of
+    /// in RGB: one report per wavelength.
+    #[arg(long, value_name = "NM,NM,...", value_delimiter = ',', conflicts_with = "all")]
+    wavelengths: Vec<f32>,
+}
+
+/// The model of `arg` at each of `wavelengths` (named `arg @ λ nm`), as spectral mode sets a path's
+/// (`gonio::scene::spectral::reflectances_at`); refused where spectral mode does not take the model.
+fn at_wavelengths(arg: &str, wavelengths: &[f32]) -> Result<Vec<(String, Bsdf)>, Error> {
+    let props = load_props(arg)?;
+    let bsdf = Bsdf::from_props(&props).map_err(|e| in_json_file(arg, e))?;
+    if wavelengths.is_empty() {
+        return Ok(vec![(arg.to_string(), bsdf)]);
+    }
+    check_bsdf(&props).map_err(|e| in_json_file(arg, e))?;
+    wavelengths
+        .iter()
+        .map(|&l| {
+            if !(LAMBDA_MIN..=LAMBDA_MAX).contains(&l) {
+                return Err(Error::Spec {
+                    at: "command line".into(),
+                    message: format!("--wavelengths: {l} nm is outside [{LAMBDA_MIN}, {LAMBDA_MAX}] nm"),
+                });
+            }
+            let mut model = bsdf.clone();
+            reflectances_at(&mut model, [l; 3]);
+            Ok((format!("{arg} @ {l} nm"), model))
+        })
+        .collect()
 }
 
 pub fn run(args: Args) -> Result<ExitCode, Error> {
@@ -59,8 +91,7 @@ pub fn run(args: Args) -> Result<ExitCode, Error> {
         Bsdf::examples().into_iter().map(load).collect::<Result<_, _>>()?
     } else {
         let arg = args.bsdf.expect("clap requires BSDF unless --all");
-        let bsdf = load_bsdf(&arg)?;
-        vec![(arg, bsdf)]
+        at_wavelengths(&arg, &args.wavelengths)?
     };
     // With --all, the non-physical models kept for teaching must fail the row they are known to break.
     let violations: Vec<(String, Bsdf, &'static str)> = if args.all {
@@ -130,8 +161,11 @@ pub fn run(args: Args) -> Result<ExitCode, Error> {
                 })
                 .collect();
             serde_json::json!({ "examples": all, "violations": violations })
-        } else {
+        } else if all.len() == 1 {
             all.into_iter().next().unwrap_or_default()
+        } else {
+            // --wavelengths: a report per wavelength.
+            serde_json::Value::Array(all)
         };
         outln!("{}", serde_json::to_string_pretty(&value).unwrap_or_default());
     } else {
