@@ -14,10 +14,16 @@
 //! A peaked lobe defeats any fixed quadrature: a microfacet lobe of α = 0.01 is narrower than a cell, so
 //! a fixed 6 × 6 Gauss–Legendre rule per cell sees it at a few nodes or not at all (it made correct
 //! models "integrate to 1.27–3.8"). Each cell is therefore integrated adaptively: the tensor Gauss–
-//! Legendre rules of order n (`integration_res`) and 2n are compared, and where they differ by more than
-//! 10⁻⁴ of the part's expected count (or 10⁻⁴ counts shared by area) the part is split into 4 and each
-//! quarter integrated the same way, down to 10 splits; the value kept is the order-2n one. Parts still
-//! disagreeing at the limit are named in the result's message.
+//! Legendre rule of order 2n on the part is compared with the rule of order n on the part and on four
+//! unequal parts of it (split at 0.4 of each side), and where either differs by more than 10⁻⁴ of the
+//! part's expected count (or 10⁻⁴ counts shared by area) the part is split into 4 and each quarter
+//! integrated the same way, down to 10 splits; the value kept is the order-2n one. Parts still
+//! disagreeing at the limit are named in the result's message. (Until 2026-12-06 only the two rules on
+//! the whole part were compared: both symmetric about its centre, so a pdf with a step between their
+//! central nodes — a GGX `roughdielectric`'s transmission cutting off at cos θi ≈ −0.027 at cos θo = 0.05
+//! for η ≈ 1.75–1.88 — gave both the same half-way answer, 11 % above the integral, and the sampler
+//! failed at p = 10⁻³³. Comparing with the unequal parts alone was tried and lost 9·10⁻⁵ of an α = 10⁻³
+//! lobe: the order-2n rule must also be checked against the order-n rule on the same part.)
 //!
 //! A lobe much narrower than the nodes' spacing can fall between the nodes of both rules, which then
 //! agree on the wrong answer. The samples say where to look: a cell that holds samples but expects
@@ -484,6 +490,9 @@ const MAX_DEPTH: u32 = 10;
 /// bound it from below: that lobe evaluated at `f32` directions carries ~10⁻⁴ relative noise per node,
 /// ~10⁻⁵ per rule, and at 10⁻⁵ every part of it ran to the depth limit, taking a minute per test).
 const QUADRATURE_TOLERANCE: f64 = 1e-4;
+/// Where the low rule's parts split a (sub)cell, as a fraction of each side (2026-12-06: any fraction but
+/// 1/2, which would keep the comparison symmetric; the pdf of a step at 0.46 is then integrated right).
+const UNEQUAL_SPLIT: f64 = 0.4;
 /// A cell whose observed count is this many standard deviations √max(E, 1) from its expected count is
 /// integrated again, refined to the depth limit along its samples (2026-11: a correct sampler puts a
 /// cell beyond 5σ with probability ~6·10⁻⁷, so correct models rarely pay for it).
@@ -542,8 +551,9 @@ fn pointwise(density: impl Fn(f64, f64) -> f64 + Sync) -> impl Fn(&[(f64, f64)],
     }
 }
 
-/// Adaptive tensor-product Gauss–Legendre quadrature of a density over rectangles: rule n against rule
-/// 2n, split into 4 where they disagree, optionally forced down along sample positions.
+/// Adaptive tensor-product Gauss–Legendre quadrature of a density over rectangles: rule 2n against rule n,
+/// on the part and on four unequal parts of it, split into 4 where they disagree, optionally forced down
+/// along sample positions.
 struct Quadrature<'a> {
     density: Density<'a>,
     low: Rule,
@@ -586,7 +596,17 @@ impl Quadrature<'_> {
         // Tolerance in probability: a fraction of this part's own expected count, with a floor of
         // QUADRATURE_TOLERANCE counts shared among the parts of a cell by area.
         let floor = 0.25f64.powi(depth as i32) / self.samples;
-        let converged = (fine - coarse).abs() <= QUADRATURE_TOLERANCE * fine.abs().max(floor);
+        let tolerance = QUADRATURE_TOLERANCE * fine.abs().max(floor);
+        // Where the two rules agree, the low rule on four unequal parts too: not symmetric about the
+        // centre as both rules are.
+        let converged = (fine - coarse).abs() <= tolerance && {
+            let (sa, sb) = (a[0] + UNEQUAL_SPLIT * (a[1] - a[0]), b[0] + UNEQUAL_SPLIT * (b[1] - b[0]));
+            let unequal = [([a[0], sa], [b[0], sb]), ([a[0], sa], [sb, b[1]]), ([sa, a[1]], [b[0], sb]), ([sa, a[1]], [sb, b[1]])]
+                .iter()
+                .map(|&(qa, qb)| self.rule(&self.low, qa, qb))
+                .sum::<f64>();
+            (fine - unequal).abs() <= tolerance
+        };
         if depth >= MAX_DEPTH {
             return CellIntegral { value: fine, at_depth_limit: !converged };
         }
@@ -1434,6 +1454,22 @@ mod tests {
     }
 
     #[test]
+    fn adaptive_quadrature_integrates_a_step_between_the_central_nodes() {
+        // A density of 1 left of x = 0.46 and 0 right of it: the step lies between the two central nodes
+        // of the order-6 and the order-12 rules on the unit square, which both answer 0.5. The order-6
+        // rule on unequal parts does not, and the quadrature splits down to the step (2026-12-06: this is
+        // the shape of a roughdielectric's transmission cut-off at grazing angles, integrated 11 % high).
+        let step = |x: f64, _y: f64| if x < 0.46 { 1.0 } else { 0.0 };
+        let quad = Quadrature { density: &pointwise(step), low: Rule::new(6), high: Rule::new(12), samples: 1e6 };
+        let whole = |rule: &Rule| quad.rule(rule, [0.0, 1.0], [0.0, 1.0]);
+        assert!((whole(&quad.low) - 0.5).abs() < 1e-12 && (whole(&quad.high) - 0.5).abs() < 1e-12, "both rules alone say 0.5");
+        // Polynomial rules never agree across a step: the parts along it reach the depth limit (a note in
+        // the result), 1/1024 wide, and the integral is right to their width's share.
+        let r = quad.integrate([0.0, 1.0], [0.0, 1.0], 0, &[], None);
+        assert!((r.value - 0.46).abs() < 1e-4, "{r:?}");
+    }
+
+    #[test]
     fn guided_quadrature_finds_the_tail_of_a_lobe_narrow_along_one_axis() {
         // The shape of a roughdielectric Beckmann α = 10⁻³ transmission lobe in a chi-square cell,
         // scaled to the unit square: narrow along x (between the nodes of both rules until deep splits),
@@ -1449,6 +1485,17 @@ mod tests {
         let guide = [(0.3, 0.5), (-0.8, -0.4), (1.1, 0.9), (-0.2, -1.0)].map(|(u, v)| (x0 + u * sx, y0 + v * sy));
         let guided = quad.integrate([0.0, 1.0], [0.0, 1.0], 0, &guide, Focus::around(&guide).as_ref());
         assert!((guided.value - 1.0).abs() < 1e-6, "{guided:?}");
+    }
+
+    #[test]
+    fn a_transmission_cut_off_between_the_central_nodes_is_integrated_right() {
+        // The model behind `adaptive_quadrature_integrates_a_step_between_the_central_nodes`: a GGX
+        // roughdielectric of η = 1.8 seen at cos θo = 0.05, whose transmitted pdf steps from 0.75 to 0 at
+        // cos θi ≈ −0.027, between the central nodes of both rules on the row cos θi ∈ [−0.05, 0]. Its
+        // correct sampler failed at p = 10⁻³³ (the row expected 11 % more than the pdf's integral).
+        let bsdf = Bsdf::from_json(r#"{"type": "roughdielectric", "distribution": "ggx", "alpha": 0.3, "int_ior": 1.8}"#).unwrap();
+        let r = chi2_bsdf(&bsdf, crate::verify::energy::direction(0.05, 0.3), &Chi2Config::default());
+        assert!(r.passed, "{r}");
     }
 
     #[test]
