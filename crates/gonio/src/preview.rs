@@ -43,7 +43,7 @@ use crate::light::{ConstantLight, DirectionalLight, EnvMap, Light};
 use crate::math::Transform;
 use crate::render::render;
 use crate::scene::spectral::Dependence;
-use crate::scene::{IntegratorKind, Material, SamplerSpec, Scene, SpectralScene};
+use crate::scene::{IntegratorKind, Material, SamplerSpec, Scene};
 use crate::spectrum::Rgb;
 use glam::Vec3;
 use std::f32::consts::PI;
@@ -186,13 +186,6 @@ pub fn preview_scene(material: Material, lighting: &Lighting, size: u32, spectra
     // The sphere subtends a half-angle asin(1/d); widen the view so that it fills FILL of the frame.
     let fov = 2.0 * ((1.0 / CAMERA_DISTANCE).asin().tan() / FILL).atan().to_degrees();
     let camera = Camera::new(to_world, fov, "x", size, size, 0.01, 1.0e4, "preview")?;
-    if spectral.is_some() {
-        for light in &mut lights {
-            if let Light::EnvMap(env) = light {
-                env.prepare_spectra();
-            }
-        }
-    }
     let mut scene = Scene::assemble(
         vec![Shape::Sphere(sphere)],
         vec![material],
@@ -205,7 +198,7 @@ pub fn preview_scene(material: Material, lighting: &Lighting, size: u32, spectra
         Vec::new(),
     );
     if let Some(dependence) = spectral {
-        scene.spectral = Some(SpectralScene::new(&scene.materials, &scene.lights, vec![dependence], &[]));
+        scene.make_spectral(vec![dependence], &[]);
     }
     Ok(scene)
 }

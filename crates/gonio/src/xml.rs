@@ -339,8 +339,7 @@ pub fn parse_spectrum(node: roxmltree::Node, env: &XmlEnv, source: &XmlSource, w
     };
     let uniform = |v: f64| -> Result<(Rgb, Option<Spectrum>)> {
         if within_emitter {
-            let (rgb, _) = tabulated(vec![CIE_MIN, CIE_MAX], vec![v, v])?;
-            Ok((rgb, Some(Spectrum::Constant(v))))
+            Ok((spectrum_to_rgb(&[CIE_MIN, CIE_MAX], &[v, v]), Some(Spectrum::Constant(v))))
         } else {
             #[allow(clippy::cast_possible_truncation)]
             Ok((Rgb::splat(v as f32), None))

@@ -541,7 +541,7 @@ fn shading<'a>(scene: &'a Scene, p: &Packet, hit: &Surfaces8) -> Shading<'a> {
         let chromatic =
             scene.spectral.as_ref().is_some_and(|s| s.dependence.get(hit.shape[first] as usize).is_some_and(|d| *d != Dependence::None));
         if let Some(r) = material.diffuse_reflectance_lanes(u, v, same) {
-            let r = if p.spectral { p.reflectance(scene, r, same, |_| hit.shape[first] as usize) } else { r };
+            let r = p.reflectance(scene, r, same, |_| hit.shape[first] as usize);
             let m = Mask8::from_bitmask(same);
             rho = std::array::from_fn(|c| Float8::select(m, r[c], rho[c]));
             diffuse |= same;
@@ -590,7 +590,7 @@ fn shading<'a>(scene: &'a Scene, p: &Packet, hit: &Surfaces8) -> Shading<'a> {
     }
     if diffuse_rows != 0 {
         let r = load_rgb(&rho_rows);
-        let r = if p.spectral { p.reflectance(scene, r, diffuse_rows, |l| hit.shape[l] as usize) } else { r };
+        let r = p.reflectance(scene, r, diffuse_rows, |l| hit.shape[l] as usize);
         let m = Mask8::from_bitmask(diffuse_rows);
         rho = std::array::from_fn(|c| Float8::select(m, r[c], rho[c]));
         diffuse |= diffuse_rows;

@@ -3,7 +3,7 @@
 //! know is an error naming the place in the file.
 
 use super::mitsuba_xml::SceneDescription;
-use super::spectral::{check_bsdf, Dependence, Mode, SpectralScene};
+use super::spectral::{check_bsdf, Dependence, Mode};
 use super::{Aov, AovKind, IntegratorKind, Material, SamplerSpec, Scene};
 use crate::bsdf::{Bsdf, Diffuse};
 use crate::camera::Camera;
@@ -72,13 +72,6 @@ impl Scene {
             lights.push(light);
             light_spectra.push(EMISSION.iter().find_map(|name| e.spectrum(name)));
         }
-        if mode == Mode::Spectral {
-            for light in &mut lights {
-                if let Light::EnvMap(env) = light {
-                    env.prepare_spectra();
-                }
-            }
-        }
         let sensor = desc.sensor.as_ref().ok_or_else(|| Error::spec(&desc.source, "the scene has no <sensor>"))?;
         let film = match sensor.nested_of("film").as_slice() {
             [] => FilmSpec::mitsuba_default(),
@@ -115,9 +108,7 @@ impl Scene {
             if matches!(scene.integrator, IntegratorKind::Aov { .. }) {
                 return Err(Error::spec(&desc.source, "spectral mode renders the `path` and `direct` integrators; `aov` needs --mode rgb"));
             }
-            // The table RGB values are taken to spectra with, built now rather than by the first path.
-            let _ = crate::spectrum::upsample::srgb_table();
-            scene.spectral = Some(SpectralScene::new(&scene.materials, &scene.lights, dependence, &light_spectra));
+            scene.make_spectral(dependence, &light_spectra);
         }
         Ok(scene)
     }

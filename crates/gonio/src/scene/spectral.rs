@@ -142,6 +142,22 @@ impl SpectralScene {
     }
 }
 
+impl super::Scene {
+    /// Make this scene render in spectral mode: its environment maps' texels taken to spectra, the table
+    /// RGB values are taken to spectra with built now rather than by the first path, and its
+    /// [`SpectralScene`] (`dependence` per shape, as [`check_bsdf`] found it; `given` per light, the
+    /// spectrum its emission was given as, if it was).
+    pub(crate) fn make_spectral(&mut self, dependence: Vec<Dependence>, given: &[Option<Arc<Spectrum>>]) {
+        for light in &mut self.lights {
+            if let Light::EnvMap(env) = light {
+                env.prepare_spectra();
+            }
+        }
+        let _ = srgb_table();
+        self.spectral = Some(SpectralScene::new(&self.materials, &self.lights, dependence, given));
+    }
+}
+
 /// The colour parameters spectral mode converts per lane, where the model holds them as they are
 /// ([`Bsdf::reflectance_slot`]).
 const CONVERTED: &[&str] =
