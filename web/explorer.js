@@ -87,6 +87,8 @@ class Explorer {
     this.models = [];
     this.files = [];
     this.tokens = { plots: 0, sphere: 0, verify: 0 };
+    // Names this page to the server, whose lit sphere renders are ordered per client by `seq` (the token).
+    this.client = Math.random().toString(36).slice(2);
     this.view = { yaw: -0.6, pitch: 0.5 };
     this.state = structuredClone(DEFAULT_STATE);
     this.data = {}; // per panel: the models shown and their numbers
@@ -391,7 +393,7 @@ class Explorer {
   async refreshSphere() {
     const token = ++this.tokens.sphere;
     const st = this.state;
-    const base = { spec: JSON.stringify(this.layer.spec), light: st.light, dir: st.dir.join(',') };
+    const base = { spec: JSON.stringify(this.layer.spec), light: st.light, dir: st.dir.join(','), client: this.client, seq: token };
     // Progressive: a small, fast first image, then finer ones, each replacing the last.
     const passes = [{ size: 128, spp: 1 }, { size: 256, spp: 4 }, { size: 256, spp: 16 }, { size: 256, spp: 64 }];
     const started = performance.now();

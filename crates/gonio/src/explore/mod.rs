@@ -8,7 +8,7 @@
 //! |---|---|
 //! | `/api/models` | every plugin with its parameter table ([`params`]), the measured files offered, the initial models |
 //! | `/api/plot?spec=…&kind=polar\|lobe\|slice\|albedo&theta_o=…&channel=…` | the numbers of [`crate::plot`] for one model |
-//! | `/api/sphere?spec=…&light=env\|sky\|furnace\|dir&dir=x,y,z&size=…&spp=…&seed=…` | the lit sphere of [`crate::preview`], PNG |
+//! | `/api/sphere?spec=…&light=env\|sky\|furnace\|dir&dir=x,y,z&size=…&spp=…&seed=…&client=…&seq=…` | the lit sphere of [`crate::preview`], PNG |
 //! | `/api/verify?spec=…` | the verdict of [`crate::verify::check_named`] at [`CheckConfig::quick`] |
 //! | `/api/export?spec=…&format=xml\|json` | the model as a Mitsuba `<bsdf>` or as JSON |
 //! | `/api/fit?spec=…&model=…` | [`crate::fit`] of an analytic model to this one: the fitted spec |
@@ -97,9 +97,21 @@ pub struct Explorer {
     initial: Vec<String>,
     /// Models built from recent specs (measured data takes long to read): (spec, model), newest last.
     cache: Mutex<Vec<(String, Arc<Bsdf>)>>,
-    /// The cancel flag of the lit sphere being rendered: a new one stops it.
-    sphere: Mutex<Option<Arc<AtomicBool>>>,
+    /// The lit spheres asked for, per client: a newer one stops the one being rendered.
+    spheres: Mutex<Vec<SphereRequest>>,
 }
+
+/// The newest lit sphere a client (`client=…`, one per page) asked for: its number (`seq=…`, increasing) and
+/// the flag that stops its render. Requests travel on several connections, so an older one can arrive after a
+/// newer one; it is refused rather than allowed to stop the newer one (the page would be left with neither).
+struct SphereRequest {
+    client: String,
+    seq: u64,
+    cancel: Arc<AtomicBool>,
+}
+
+/// Clients whose newest lit sphere is remembered (the oldest are forgotten).
+const SPHERE_CLIENTS: usize = 64;
 
 /// Models kept built.
 const CACHE_SIZE: usize = 16;
@@ -117,7 +129,7 @@ impl Explorer {
             environment_image: OnceLock::new(),
             initial,
             cache: Mutex::new(Vec::new()),
-            sphere: Mutex::new(None),
+            spheres: Mutex::new(Vec::new()),
         }
     }
 
@@ -152,10 +164,9 @@ impl Explorer {
             }
             "/api/sphere" => {
                 let bsdf = self.bsdf(q)?;
-                let cancel = Arc::new(AtomicBool::new(false));
-                if let Some(previous) = self.sphere.lock().unwrap_or_else(|e| e.into_inner()).replace(cancel.clone()) {
-                    previous.store(true, Ordering::Relaxed);
-                }
+                let Some(cancel) = self.start_sphere(q)? else {
+                    return Ok(Reply::json(409, &json!({"error": "superseded by a newer render"})));
+                };
                 let env = if q.get("light").map_or(true, |l| l == "env") { self.environment_lighting()? } else { Lighting::GradientSky };
                 let png = views::sphere(&bsdf, q, env, &cancel)?;
                 if cancel.load(Ordering::Relaxed) {
@@ -189,6 +200,40 @@ impl Explorer {
             }
             _ => Reply::json(404, &json!({"error": format!("no such page: {path}")})),
         })
+    }
+
+    /// Register the lit sphere `q` asks for as its client's newest, stopping the client's render under way;
+    /// `None` if the client has already asked for a newer one. Without `client` every request is one
+    /// client's; without `seq` a request is the newest.
+    fn start_sphere(&self, q: &HashMap<String, String>) -> Result<Option<Arc<AtomicBool>>> {
+        let client = q.get("client").cloned().unwrap_or_default();
+        let seq = match q.get("seq") {
+            None => None,
+            Some(text) => {
+                Some(text.trim().parse::<u64>().map_err(|_| Error::spec("seq", format!("must be a whole number ≥ 0, got `{text}`")))?)
+            }
+        };
+        let mut spheres = self.spheres.lock().unwrap_or_else(|e| e.into_inner());
+        let cancel = Arc::new(AtomicBool::new(false));
+        let request = |seq| SphereRequest { client: client.clone(), seq, cancel: cancel.clone() };
+        match spheres.iter().position(|r| r.client == client) {
+            Some(i) => {
+                let newest = spheres[i].seq;
+                let seq = seq.unwrap_or(newest);
+                if seq < newest {
+                    return Ok(None);
+                }
+                spheres.remove(i).cancel.store(true, Ordering::Relaxed);
+                spheres.push(request(seq));
+            }
+            None => {
+                spheres.push(request(seq.unwrap_or(0)));
+                if spheres.len() > SPHERE_CLIENTS {
+                    spheres.remove(0);
+                }
+            }
+        }
+        Ok(Some(cancel))
     }
 
     /// The lighting of `light=env`: the environment map, read once (else the built-in sky).
@@ -367,6 +412,35 @@ mod tests {
         let reply = e.handle("/api/plot", "spec={\"type\":\"merl\",\"filename\":\"/etc/passwd\"}&kind=polar");
         assert_eq!(reply.status, 400);
         assert!(String::from_utf8(reply.body).unwrap().contains("not a measured file this explorer offers"));
+    }
+
+    #[test]
+    fn an_older_lit_sphere_arriving_late_is_refused_and_stops_nothing() {
+        // The page's requests travel on several connections: its sphere number 3 can reach the server after
+        // its number 4. Before, whichever arrived last stopped the other, and the page was left with no image.
+        let e = Explorer::new(None, Vec::new(), None, Vec::new());
+        let q = |client: &str, seq: &str| parse_query(&format!("client={client}&seq={seq}"));
+        let four = e.start_sphere(&q("a", "4")).unwrap().expect("the newest is rendered");
+        assert!(e.start_sphere(&q("a", "3")).unwrap().is_none(), "an older request is refused");
+        assert!(!four.load(Ordering::Relaxed), "and does not stop the newer render");
+        // Another page's requests are its own; the same number (the next pass of one image) and a newer one
+        // stop the render under way.
+        let other = e.start_sphere(&q("b", "1")).unwrap().expect("another client");
+        let four_again = e.start_sphere(&q("a", "4")).unwrap().expect("the next pass of the same image");
+        assert!(four.load(Ordering::Relaxed) && !other.load(Ordering::Relaxed));
+        e.start_sphere(&q("a", "5")).unwrap().expect("a newer image");
+        assert!(four_again.load(Ordering::Relaxed));
+        // Without `client` and `seq` (a user's own request), the newest arrival wins, as before.
+        let first = e.start_sphere(&HashMap::new()).unwrap().unwrap();
+        e.start_sphere(&HashMap::new()).unwrap().unwrap();
+        assert!(first.load(Ordering::Relaxed));
+        // Over HTTP: the stale request is answered 409, a bad number 400 naming `seq`.
+        let spec = "spec=%7B%22type%22%3A%22diffuse%22%7D&light=sky&size=8&spp=1";
+        assert_eq!(e.handle("/api/sphere", &format!("{spec}&client=a&seq=2")).status, 409);
+        assert_eq!(e.handle("/api/sphere", &format!("{spec}&client=a&seq=5")).status, 200);
+        let bad = e.handle("/api/sphere", &format!("{spec}&client=a&seq=-1"));
+        assert_eq!(bad.status, 400);
+        assert!(String::from_utf8(bad.body).unwrap().contains("seq"));
     }
 
     #[test]
