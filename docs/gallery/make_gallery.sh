@@ -240,6 +240,13 @@ md "## 13. Dispersion: a prism spreads white light into its spectrum" ""
 pic 13_dispersion_prism.png "The lecture asks whether BRDFs can model dispersion (rainbows). In spectral mode they can: a narrow white slit seen through an SF11 prism (apex 60°; Schott's Sellmeier law, n = 1.85 at 400 nm and 1.77 at 700 nm) spreads into its spectrum, violet bent most. Each path follows its hero wavelength through the glass. The band's position per wavelength is checked against Snell's law in crates/gonio/tests/dispersion.rs. In RGB mode the same file shows the slit white, at the one index n_d. Scene: [scenes/prism.xml](../../scenes/prism.xml)." \
     "$GONIO" render scenes/prism.xml --mode spectral -D spp=1024 -o $OUT/13_dispersion_prism.png
 
+# 14 -----------------------------------------------------------------------------------------------------------
+md "## 14. Metals and a dyed paper under a light of three lines: RGB against spectral" ""
+pic 14_metals_lines_rgb.png "RGB mode. Gold, copper, rough chromium and a dyed paper under a sky of three narrow emission lines (450, 550 and 610 nm), near white in RGB. RGB mode multiplies the colours: the paper, whose reflectance dips to 0.05 exactly at the three lines, is the olive its spectrum has under daylight (D65). Scene: [scenes/metals_lines.xml](scenes/metals_lines.xml)." \
+    "$GONIO" render docs/gallery/scenes/metals_lines.xml --mode rgb -D spp=256 -o $OUT/14_metals_lines_rgb.png
+pic 14_metals_lines_spectral.png "Spectral mode, the same file: each path carries wavelengths, the metals' indices are their measured spectra and the paper's reflectance the table the file gives. Under these lines the paper turns dark (its reflectance is lowest exactly where the light is; RGB mode cannot know that from its colour), and gold turns greener. Checked against Mitsuba 3's scalar_spectral and against the closed form ∫ρL x̄ȳz̄ in crates/gonio/tests/spectral_tables.rs." \
+    "$GONIO" render docs/gallery/scenes/metals_lines.xml --mode spectral -D spp=512 -o $OUT/14_metals_lines_spectral.png
+
 mv "$README" "$OUT/README.md"
 ELAPSED=$(($(date +%s) - START))
 echo "make_gallery: done in ${ELAPSED} s" >&2

@@ -13,7 +13,7 @@ use batch::{broadcast, finish, for_chunks, output, Arg, Out};
 use gonio::bsdf::{Bsdf, BsdfFlags, BsdfModel, RowCheck, SampleColumns, PLUGINS};
 use gonio::math::{Vec2, Vec3};
 use gonio::props::Props;
-use gonio::scene::spectral::{check_bsdf, reflectances_at, Dependence};
+use gonio::scene::spectral::{check_bsdf, given_spectra, reflectances_at, Dependence, GivenSpectra};
 use gonio::spectrum::wavelengths::{LAMBDA_MAX, LAMBDA_MIN};
 use gonio::Rgb;
 use numpy::{PyArray1, PyArrayDyn, PyUntypedArrayMethods};
@@ -218,13 +218,15 @@ pub(crate) struct PyBsdf {
     /// How it depends on wavelength, as spectral mode reads it, or why spectral mode does not take it
     /// (`scene::spectral::check_bsdf`): what `wavelengths=` of `f`, `pdf` and `sample` needs.
     pub(crate) spectral: Result<Dependence, String>,
+    /// The colours it was given as tables, which `wavelengths=` reads as given (`scene::spectral::given_spectra`).
+    pub(crate) given: GivenSpectra,
 }
 
 impl PyBsdf {
     /// The model built from `props` (a description `spec`), with its spectral reading.
     pub(crate) fn new(props: &Props, spec: String) -> gonio::Result<Self> {
         let bsdf = Bsdf::from_props(props)?;
-        Ok(PyBsdf { bsdf, spec, spectral: check_bsdf(props).map_err(|e| e.to_string()) })
+        Ok(PyBsdf { bsdf, spec, spectral: check_bsdf(props).map_err(|e| e.to_string()), given: given_spectra(props) })
     }
 
     /// The model at each row's wavelength (nm, column `lambda` of `n` rows), for `wavelengths=`: each
@@ -252,14 +254,15 @@ impl PyBsdf {
             });
             groups[g].1.push(i);
         }
-        Ok(groups
-            .into_iter()
-            .map(|(l, rows)| {
-                let mut model = self.bsdf.clone();
-                reflectances_at(&mut model, [l; 3]);
-                (model, rows)
-            })
-            .collect())
+        Ok(groups.into_iter().map(|(l, rows)| (self.model_at(l), rows)).collect())
+    }
+
+    /// The model with every channel at wavelength `l` nm, as spectral mode sets a path's
+    /// (`scene::spectral::reflectances_at`); `self.spectral` checked by the caller.
+    fn model_at(&self, l: f32) -> Bsdf {
+        let mut model = self.bsdf.clone();
+        reflectances_at(&mut model, [l; 3], &self.given);
+        model
     }
 }
 
@@ -505,6 +508,28 @@ impl PyBsdf {
     #[getter]
     fn spec(&self) -> &str {
         &self.spec
+    }
+
+    /// This model at one wavelength (nm, in [360, 830]) as spectral mode renders it there — its colours'
+    /// spectra, a metal's η and k, a dispersive glass's index at that wavelength, in all three channels —
+    /// for `gonio.verify` (its functions take it as any model; `verify.check(..., wavelengths=...)` runs
+    /// them per wavelength). Raises `SpecError` for a model spectral mode does not take, naming the
+    /// parameter, and for a model already at one wavelength.
+    fn at_wavelength(&self, nm: f64) -> PyResult<PyBsdf> {
+        if let Err(e) = &self.spectral {
+            return Err(SpecError::new_err(format!("at_wavelength: {e}")));
+        }
+        if !(f64::from(LAMBDA_MIN)..=f64::from(LAMBDA_MAX)).contains(&nm) {
+            return Err(PyValueError::new_err(format!("at_wavelength({nm}): expected a wavelength in [{LAMBDA_MIN}, {LAMBDA_MAX}] nm")));
+        }
+        #[allow(clippy::cast_possible_truncation)]
+        let l = nm as f32;
+        Ok(PyBsdf {
+            bsdf: self.model_at(l),
+            spec: format!("{} @ {l} nm", self.spec),
+            spectral: Err(format!("the model is already at {l} nm")),
+            given: GivenSpectra::NONE,
+        })
     }
 
     fn __repr__(&self) -> String {

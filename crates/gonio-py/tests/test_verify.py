@@ -133,6 +133,30 @@ def test_energy_of_a_violation():
     assert e.max_albedo > 1.001 and (e.white_furnace > 1.001).all()
 
 
+def test_the_harness_per_wavelength():
+    # A model at one wavelength is any model to the harness (issue 30): `at_wavelength`, and `check`'s
+    # `wavelengths=` (one report each, as `gonio check --wavelengths`).
+    table = '<bsdf type="diffuse"><spectrum name="reflectance" value="400:0.2, 700:0.9"/></bsdf>'
+    paper = gonio.load_bsdf(table)
+    for nm, rho in [(400.0, 0.2), (550.0, 0.55), (650.0, 0.2 + 0.7 * 250 / 300)]:
+        at = paper.at_wavelength(nm)
+        assert at.spec.endswith(f"@ {nm:g} nm")
+        e = verify.energy(at, angles=4, samples=256)
+        np.testing.assert_allclose(e.albedo, rho, rtol=1e-5)  # the table's value, not its colour's spectrum
+        assert at.f([0, 0, 1], [0, 0, 1])[0] == paper.f([0, 0, 1], [0, 0, 1], wavelengths=nm)
+    sf11 = gonio.load_bsdf({"type": "roughdielectric", "int_ior": "sf11", "alpha": 0.3, "distribution": "ggx"})
+    reports = verify.check(sf11, samples=100_000, sweep=10_000, wavelengths=[400, 650])
+    assert [r.name.endswith(f"@ {nm} nm") for r, nm in zip(reports, (400, 650))] == [True, True]
+    assert all(reports), [str(r) for r in reports]
+    assert isinstance(verify.check(sf11, samples=10_000, sweep=1_000), verify.Report)
+    with pytest.raises(gonio.SpecError, match="at_wavelength: .*`diffuse_reflectance` of `phong`"):
+        gonio.load_bsdf({"type": "phong", "diffuse_reflectance": [0.8, 0.2, 0.1]}).at_wavelength(550)
+    with pytest.raises(gonio.SpecError, match="already at 550 nm"):
+        paper.at_wavelength(550).at_wavelength(600)
+    with pytest.raises(ValueError, match=r"at_wavelength\(900.*\[360, 830\] nm"):
+        paper.at_wavelength(900)
+
+
 def test_sweep(diffuse):
     s = verify.sweep(diffuse, queries=20_000, seed=5)
     assert isinstance(s, verify.SweepResult)

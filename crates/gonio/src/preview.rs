@@ -198,7 +198,7 @@ pub fn preview_scene(material: Material, lighting: &Lighting, size: u32, spectra
         Vec::new(),
     );
     if let Some(dependence) = spectral {
-        scene.make_spectral(vec![dependence], &[]);
+        scene.make_spectral(vec![dependence], Vec::new(), &[]);
     }
     Ok(scene)
 }

@@ -15,6 +15,7 @@
 
 use crate::error::{Error, Result};
 use crate::spectrum::illuminant::Spectrum;
+use crate::spectrum::piecewise::PiecewiseLinear;
 use crate::spectrum::Rgb;
 use crate::xml::{parse_numbers, parse_spectrum, parse_transform, parse_vector, xml_at, XmlEnv, XmlSource};
 use std::cell::{Cell, RefCell};
@@ -77,7 +78,8 @@ struct Entry {
     /// A texture's value at a hit ([`Props::set_texture_value`]): the range-checked readers clamp it into
     /// their range instead of rejecting it.
     clamped: bool,
-    /// The spectrum an emitter's `<spectrum>` gave (`value` is its RGB reduction), for spectral mode.
+    /// The spectrum a `<spectrum>` gave (`value` is its RGB reduction), for spectral mode
+    /// ([`crate::xml::parse_spectrum`]).
     spectrum: Option<Arc<Spectrum>>,
 }
 
@@ -230,7 +232,11 @@ impl Props {
             }
             _ => return Err(self.wrong(e, "a colour (a number or three numbers)")),
         };
-        let c = if e.clamped { c.map(|v| if v.is_finite() { v.clamp(f64::from(lo), f64::from(hi)) } else { v }) } else { c };
+        // A table whose every value is in range reduces to a colour that may not be (a saturated spectrum
+        // is outside the sRGB gamut): clamped into the range, as Mitsuba 3 clamps it.
+        let in_gamut = |t: &PiecewiseLinear| t.values().iter().all(|v| (f64::from(lo)..=f64::from(hi)).contains(v));
+        let clamp = e.clamped || matches!(e.spectrum.as_deref(), Some(Spectrum::Tabulated(t)) if in_gamut(t));
+        let c = if clamp { c.map(|v| if v.is_finite() { v.clamp(f64::from(lo), f64::from(hi)) } else { v }) } else { c };
         if c.iter().any(|v| !(*v >= lo as f64 && *v <= hi as f64)) {
             return Err(Error::spec(
                 &e.at,
@@ -366,11 +372,22 @@ impl Props {
         }
     }
 
-    /// The spectrum parameter `name` was given as, where an emitter's `<spectrum>` gave one (its value, as
-    /// the other getters read it, is the spectrum's RGB reduction).
+    /// The spectrum parameter `name` was given as, where a `<spectrum>` gave one (its value, as the other
+    /// getters read it, is the spectrum's RGB reduction).
     #[must_use]
     pub fn spectrum(&self, name: &str) -> Option<Arc<Spectrum>> {
         self.entries.iter().find(|e| e.name == name).and_then(|e| e.spectrum.clone())
+    }
+
+    /// The table parameter `name` was given as (a `<spectrum>` of `λ:value` pairs or an `.spd` file), marking
+    /// it read.
+    #[must_use]
+    pub fn spectrum_table(&self, name: &'static str) -> Option<PiecewiseLinear> {
+        let e = self.entry(name)?;
+        match e.spectrum.as_deref() {
+            Some(Spectrum::Tabulated(table)) => Some(table.clone()),
+            _ => None,
+        }
     }
 
     /// A boolean, or `default` when absent.

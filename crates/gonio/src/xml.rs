@@ -314,26 +314,24 @@ pub fn parse_vector(node: roxmltree::Node, env: &XmlEnv, source: &XmlSource, def
 
 /// `<spectrum value="0.5"/>` (uniform), `value="400:0.1, 500:0.3, …"` or `filename="x.spd"`, and the
 /// spectrum plugins `<spectrum type="d65">` (optional `scale`), `type="blackbody"` (`temperature` in K) and
-/// `type="uniform"` (`value`): reduced to linear sRGB as Mitsuba's RGB variants do, and, inside an
-/// `<emitter>`, kept as the spectrum too, for spectral mode (docs/spectral.md).
+/// `type="uniform"` (`value`): reduced to linear sRGB as Mitsuba's RGB variants do, and kept as the
+/// spectrum too, for spectral mode (docs/spectral.md): inside an `<emitter>` every spectrum but a grey one,
+/// elsewhere a table (a reflectance, a conductor's `eta`/`k`, a dielectric's `int_ior`/`ext_ior`).
 ///
 /// Inside an `<emitter>` the spectrum is radiance: [`spectrum_to_rgb`] (no illuminant). A uniform value v
 /// there is the equal-energy spectrum v, linear sRGB v·(1.2049, 0.9482, 0.9093), as in Mitsuba 3 (its RGB
 /// and spectral variants alike, checked on 3.9.1 on 2026-12-06: (1.2048, 0.9483, 0.9089); gonio read it as
 /// (v, v, v) before); `d65` is D65 of luminance `scale`, (1, 1, 1) × `scale`; a `blackbody` is Planck's
 /// law in W·m⁻²·sr⁻¹·nm⁻¹ over [360, 830] nm (Mitsuba 3 renders it in its spectral variants only; gonio's
-/// RGB mode takes its reduction). Elsewhere a spectrum is a reflectance, which Mitsuba weights by D65 so
-/// that a flat spectrum stays grey; gonio approximates that by dividing each channel by the response to the
-/// equal-energy white ([`reflectance_to_rgb`], the one reduction of reflectance spectra, also used by
-/// spectral RGL files; exact for flat spectra: a flat 0.78 over 400–700 nm gives (0.777, 0.781, 0.775)
-/// here and (0.776, 0.780, 0.776) in Mitsuba 3.9.1; 2026-11).
+/// RGB mode takes its reduction). Elsewhere a spectrum is reduced as Mitsuba does, as seen under D65, so
+/// that a flat spectrum stays grey ([`reflectance_to_rgb`], the one reduction of reflectance spectra, also
+/// used by spectral RGL files; also for a conductor's `eta` and `k`, which Mitsuba reduces the same way,
+/// unclamped: Cu's `.spd` files give η = (0.105, 0.977, 1.203) there, where `material="Cu"` gives
+/// (0.201, 0.924, 1.102)).
 pub fn parse_spectrum(node: roxmltree::Node, env: &XmlEnv, source: &XmlSource, within_emitter: bool) -> Result<(Rgb, Option<Spectrum>)> {
     let at = xml_at(source, node);
     let tabulated = |w: Vec<f64>, v: Vec<f64>| -> Result<(Rgb, Option<Spectrum>)> {
-        if !within_emitter {
-            return Ok((reflectance_to_rgb(&w, &v), None));
-        }
-        let rgb = spectrum_to_rgb(&w, &v);
+        let rgb = if within_emitter { spectrum_to_rgb(&w, &v) } else { reflectance_to_rgb(&w, &v) };
         let table = PiecewiseLinear::new(w, v).map_err(|e| Error::spec(&at, format!("<spectrum>: {e}")))?;
         Ok((rgb, Some(Spectrum::Tabulated(table))))
     };
@@ -616,8 +614,16 @@ mod tests {
         assert!(env.substitute("$nope", "f.xml:3:4").unwrap_err().to_string().starts_with("f.xml:3:4: `$nope` is not defined"));
         let doc = roxmltree::Document::parse("<spectrum name=\"r\" value=\"400:0.78, 500:0.78, 600:0.78, 700:0.78\"/>").unwrap();
         let c = parse_spectrum(first(&doc), &env, &XmlSource::new("s.xml", doc.input_text()), false).unwrap().0;
-        // Mitsuba 3.9.1 (scalar_rgb) loads this reflectance as (0.776367, 0.77981, 0.776029).
-        assert!((c.r() - 0.776).abs() < 2e-3 && (c.g() - 0.780).abs() < 2e-3 && (c.b() - 0.776).abs() < 2e-3, "{c}");
+        // Mitsuba 3.9.1 (scalar_rgb) loads these reflectances as (0.776367, 0.77981, 0.776029) and, three dips
+        // to 0.05, (0.3456, 0.4363, 0.2434) (2026-12-06; before then gonio gave the second 0.4358 in red).
+        let close = |c: Rgb, m: [f32; 3]| (0..3).all(|k| (c.0[k] / m[k] - 1.0).abs() < 1e-3);
+        assert!(close(c, [0.776_367, 0.779_81, 0.776_029]), "{c}");
+        let dips = "360:0.8, 450:0.05, 500:0.8, 550:0.05, 580:0.8, 610:0.05, 660:0.8, 830:0.8";
+        let text = format!("<spectrum name=\"r\" value=\"{dips}\"/>");
+        let doc = roxmltree::Document::parse(&text).unwrap();
+        let (c, table) = parse_spectrum(first(&doc), &env, &XmlSource::new("s.xml", doc.input_text()), false).unwrap();
+        assert!(close(c, [0.345_6, 0.436_3, 0.243_4]), "{c}");
+        assert!(matches!(table, Some(Spectrum::Tabulated(t)) if t.eval(550.0) == 0.05), "the table is kept for spectral mode");
         let doc = roxmltree::Document::parse("<spectrum name=\"radiance\" value=\"400:0, 500:8, 600:15.6, 700:18.4\"/>").unwrap();
         let c = parse_spectrum(first(&doc), &env, &XmlSource::new("s.xml", doc.input_text()), true).unwrap().0;
         // Mitsuba 3.9.1 loads this area-light radiance as (20.7108, 10.8546, 2.77115).

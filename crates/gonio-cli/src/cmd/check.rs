@@ -2,7 +2,7 @@
 
 use crate::spec::{in_json_file, load_props};
 use crate::stdout::{out, outln};
-use gonio::scene::spectral::{check_bsdf, reflectances_at};
+use gonio::scene::spectral::{check_bsdf, given_spectra, reflectances_at};
 use gonio::spectrum::wavelengths::{LAMBDA_MAX, LAMBDA_MIN};
 use gonio::verify::{check_named, expect_violation, sweep::sweep, test_directions, CheckConfig, Report};
 use gonio::{Bsdf, Error};
@@ -57,6 +57,7 @@ fn at_wavelengths(arg: &str, wavelengths: &[f32]) -> Result<Vec<(String, Bsdf)>,
         return Ok(vec![(arg.to_string(), bsdf)]);
     }
     check_bsdf(&props).map_err(|e| in_json_file(arg, e))?;
+    let given = given_spectra(&props);
     wavelengths
         .iter()
         .map(|&l| {
@@ -67,7 +68,7 @@ fn at_wavelengths(arg: &str, wavelengths: &[f32]) -> Result<Vec<(String, Bsdf)>,
                 });
             }
             let mut model = bsdf.clone();
-            reflectances_at(&mut model, [l; 3]);
+            reflectances_at(&mut model, [l; 3], &given);
             Ok((format!("{arg} @ {l} nm"), model))
         })
         .collect()

@@ -68,6 +68,9 @@ class Bsdf:
     def sample(self, wo: ArrayLike, uc: ArrayLike, u: ArrayLike, *, normalize: bool = False, wavelengths: Optional[ArrayLike] = None) -> BsdfSample:
         """Sample wi given wo ((3,) or (N, 3)), uc (scalar or (N,)) and u ((2,) or (N, 2)) in [0, 1]; with
         `wavelengths`, each row at its wavelength (f and weight then one number per row)."""
+    def at_wavelength(self, nm: float) -> "Bsdf":
+        """The model at one wavelength (nm, in [360, 830]) as spectral mode renders it there (all three
+        channels at it), for `gonio.verify`; SpecError where spectral mode refuses the model."""
     def albedo(self, wo: ArrayLike, *, samples: int = 100_000, seed: int = 0, normalize: bool = False) -> npt.NDArray[np.float32]:
         """Directional albedo by Monte Carlo: shape (N, 3), or (3,) for a single wo."""
     def __eq__(self, other: object) -> bool: ...

@@ -41,7 +41,17 @@ reciprocity = _verify.reciprocity
 energy = _verify.energy
 scatters_from_below = _verify.scatters_from_below
 sweep = _verify.sweep
-check = _verify.check
+
+
+def check(bsdf, samples=1_000_000, sweep=1_000_000, seed=0, family=None, wavelengths=None):
+    """Run every check of ``gonio check`` on ``bsdf`` (see ``_gonio.verify.check``) and return its
+    ``Report``; with ``wavelengths`` (nm), run them on the model at each wavelength as spectral mode renders
+    it (``bsdf.at_wavelength(nm)``, as ``gonio check --wavelengths``) and return one ``Report`` per
+    wavelength, in order."""
+    if wavelengths is None:
+        return _verify.check(bsdf, samples, sweep, seed, family)
+    return [_verify.check(bsdf.at_wavelength(float(nm)), samples, sweep, seed, family) for nm in wavelengths]
+
 chi2_tests = _verify.chi2_tests
 expect_violation = _verify.expect_violation
 violations = _verify.violations

@@ -1,6 +1,6 @@
 """Type stub of gonio.verify: chi-square, reciprocity, energy, NaN/Inf sweep and the `gonio check` report."""
 
-from typing import Any, Dict, List, Literal, Optional, Tuple
+from typing import Any, Dict, List, Literal, Optional, Sequence, Tuple, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -129,9 +129,13 @@ def scatters_from_below(bsdf: Bsdf) -> bool:
 def sweep(bsdf: Bsdf, queries: int = 1_000_000, seed: int = 0) -> SweepResult:
     """Query f, pdf and sample with random and degenerate inputs; count non-finite or negative outputs."""
 
-def check(bsdf: Bsdf, samples: int = 1_000_000, sweep: int = 1_000_000, seed: int = 0, family: Optional[int] = None) -> Report:
+@overload
+def check(bsdf: Bsdf, samples: int = 1_000_000, sweep: int = 1_000_000, seed: int = 0, family: Optional[int] = None, wavelengths: None = None) -> Report: ...
+@overload
+def check(bsdf: Bsdf, samples: int = 1_000_000, sweep: int = 1_000_000, seed: int = 0, family: Optional[int] = None, *, wavelengths: Sequence[float]) -> List[Report]:
     """Every check of `gonio check`, with the same figures for the same seed; `family`: the chi-square
-    tests sharing the significance (Šidák; default: this model's, `chi2_tests(bsdf)`)."""
+    tests sharing the significance (Šidák; default: this model's, `chi2_tests(bsdf)`). With `wavelengths`
+    (nm), one report per wavelength, on `bsdf.at_wavelength(nm)` (as `gonio check --wavelengths`)."""
 
 def chi2_tests(bsdf: Bsdf) -> int:
     """How many chi-square tests `check` runs on `bsdf`."""

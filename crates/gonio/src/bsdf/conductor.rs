@@ -27,8 +27,10 @@ use crate::fresnel::{fresnel_conductor_rgb, fresnel_conductor_rgb_lanes, reflect
 use crate::math::lanes::{channels, Real, V3};
 use crate::math::{Vec2, Vec3};
 use crate::props::Props;
+use crate::spectrum::piecewise::PiecewiseLinear;
 use crate::spectrum::sampled::unbounded_at;
 use crate::spectrum::{named, Rgb};
+use std::sync::Arc;
 
 /// A smooth conductor.
 #[derive(Clone, Debug, PartialEq)]
@@ -39,19 +41,22 @@ pub struct Conductor {
     /// The named metal `eta_k` was reduced from (`material`), whose spectra spectral mode reads
     /// ([`named::conductor_spectra`]); `None` for an index given as `eta`/`k` and for the mirror.
     pub metal: Option<&'static str>,
+    /// `eta` and `k` where they were given as tables (`<spectrum>` pairs or `.spd` files; `eta_k` holds
+    /// their RGB reductions), which spectral mode reads.
+    pub tables: [Option<Arc<PiecewiseLinear>>; 2],
 }
 
 impl Conductor {
     /// A conductor with complex index `eta + i k`.
     #[must_use]
     pub fn new(eta: Rgb, k: Rgb) -> Self {
-        Conductor { eta_k: Some((eta, k)), specular_reflectance: Rgb::ONE, metal: None }
+        Conductor { eta_k: Some((eta, k)), specular_reflectance: Rgb::ONE, metal: None, tables: [None, None] }
     }
 
     /// The perfect mirror (`material = "none"`).
     #[must_use]
     pub fn mirror() -> Self {
-        Conductor { eta_k: None, specular_reflectance: Rgb::ONE, metal: None }
+        Conductor { eta_k: None, specular_reflectance: Rgb::ONE, metal: None, tables: [None, None] }
     }
 
     /// Read `material` or `eta`/`k`, and `specular_reflectance`. Rough conductors read their Fresnel term
@@ -79,18 +84,24 @@ impl Conductor {
                 Error::spec(p.at(), format!("unknown conductor material `{m}`; expected one of: {}", named::CONDUCTORS.join(", ")))
             })?),
         };
-        Ok(Conductor { eta_k, specular_reflectance, metal })
+        let tables = index_tables(p, eta, k)?;
+        Ok(Conductor { eta_k, specular_reflectance, metal, tables })
     }
 
     /// This conductor at the wavelengths `lambda` (nm) in its three channels (spectral mode;
-    /// `scene::spectral`): a named metal's η and k from its spectra, an index given as colours `eta`, `k` by
-    /// their unbounded spectra ([`unbounded_at`]).
+    /// `scene::spectral`): a named metal's η and k from its spectra, `eta` and `k` from their tables where
+    /// they were given as tables, else from their colours' unbounded spectra ([`unbounded_at`]).
     pub fn set_wavelengths(&mut self, lambda: [f32; 3]) {
         #[allow(clippy::cast_possible_truncation)]
         let at = |s: &crate::spectrum::piecewise::PiecewiseLinear| Rgb(lambda.map(|l| s.eval_clamped(f64::from(l)) as f32));
         self.eta_k = match (self.metal.and_then(named::conductor_spectra), self.eta_k) {
             (Some(spectra), _) => Some((at(&spectra.0), at(&spectra.1))),
-            (None, Some((eta, k))) => Some((Rgb(unbounded_at(eta.0, lambda)), Rgb(unbounded_at(k.0, lambda)))),
+            (None, Some((eta, k))) => {
+                let [eta_table, k_table] = &self.tables;
+                let one =
+                    |table: &Option<Arc<PiecewiseLinear>>, rgb: Rgb| table.as_deref().map_or_else(|| Rgb(unbounded_at(rgb.0, lambda)), at);
+                Some((one(eta_table, eta), one(k_table, k)))
+            }
             (None, None) => None,
         };
     }
@@ -105,6 +116,38 @@ impl Conductor {
         };
         fresnel * self.specular_reflectance
     }
+}
+
+/// `eta` and `k` where they were given as tables, checked: every value ≥ 0, and η + k > 0 at every nm of
+/// the visible range (360–830) as spectral mode reads them (the colour `eta`, `k` where not a table), as
+/// the colours must be in every channel.
+fn index_tables(p: &Props, eta_rgb: Rgb, k_rgb: Rgb) -> Result<[Option<Arc<PiecewiseLinear>>; 2]> {
+    let tables = [p.spectrum_table("eta"), p.spectrum_table("k")];
+    if tables.iter().all(Option::is_none) {
+        return Ok([None, None]);
+    }
+    for (table, name) in tables.iter().zip(["eta", "k"]) {
+        if let Some(t) = table {
+            if t.values().iter().any(|v| *v < 0.0) {
+                return Err(Error::spec(p.at_param(name), format!("`{name}` of `{}`: a table with a value < 0", p.plugin_type())));
+            }
+        }
+    }
+    let [eta, k] = &tables;
+    #[allow(clippy::cast_precision_loss)]
+    for nm in 360..=830_u16 {
+        let l = f32::from(nm);
+        let value = |t: &Option<PiecewiseLinear>, rgb: Rgb| {
+            t.as_ref().map_or(f64::from(unbounded_at(rgb.0, [l; 3])[0]), |t| t.eval_clamped(f64::from(l)))
+        };
+        if value(eta, eta_rgb) + value(k, k_rgb) <= 0.0 {
+            return Err(Error::spec(
+                p.at(),
+                format!("`{}` needs eta + k > 0 at every wavelength; the tables give 0 at {nm} nm", p.plugin_type()),
+            ));
+        }
+    }
+    Ok(tables.map(|t| t.map(Arc::new)))
 }
 
 impl crate::bsdf::Examples for Conductor {

@@ -4,8 +4,8 @@
 //!
 //! | parameter                | type            | default | meaning                                         |
 //! |--------------------------|-----------------|---------|-------------------------------------------------|
-//! | `int_ior`                | float, name or law | `bk7` (1.5046) | index of the inside (below the surface, z < 0) |
-//! | `ext_ior`                | float, name or law | `air` (1.000277) | index of the outside (z > 0)            |
+//! | `int_ior`                | float, name, law or table | `bk7` (1.5046) | index of the inside (below the surface, z < 0) |
+//! | `ext_ior`                | float, name, law or table | `air` (1.000277) | index of the outside (z > 0)     |
 //! | `dispersive`             | bool            | false   | read `int_ior`/`ext_ior` names as gonio's dispersive glasses ([`Dispersion`]) |
 //! | `abbe`                   | float > 0       | —       | Abbe number V_d: `int_ior` (a number or name) becomes its value at 587.56 nm of a dispersive Cauchy law |
 //! | `specular_reflectance`   | rgb [0,1]       | 1       | multiplier on reflection (not physical)         |
@@ -38,6 +38,7 @@ use crate::math::lanes::{channels, Real, V3};
 use crate::math::{Vec2, Vec3};
 use crate::props::{NumberOrName, Props};
 use crate::spectrum::dispersion::{Cauchy, Ior, Sellmeier, LAMBDA_D, NAMED_GLASSES};
+use crate::spectrum::piecewise::PiecewiseLinear;
 use crate::spectrum::wavelengths::{LAMBDA_MAX, LAMBDA_MIN};
 use crate::spectrum::{named, Rgb};
 use std::sync::Arc;
@@ -119,25 +120,44 @@ fn check_relative(p: &Props, eta: f32, ratio: &str) -> Result<f32> {
 
 /// An index of refraction given as a number in (0, 10000) or a name from Mitsuba's table.
 fn constant_ior(p: &Props, name: &'static str, default: f32) -> Result<f32> {
+    let varies = |at: &str| {
+        Error::spec(
+            at,
+            format!(
+                "parameter `{name}` of `{}`: an index that varies with wavelength is taken by `dielectric`, \
+                 `roughdielectric` and `thindielectric` only; give a number or one of: {}",
+                p.plugin_type(),
+                named::DIELECTRICS.join(", ")
+            ),
+        )
+    };
+    if let Some(table) = p.spectrum_table(name) {
+        return match flat(&table) {
+            Some(v) => number_ior(p, name, v, p.at_param(name)),
+            None => Err(varies(p.at_param(name))),
+        };
+    }
     match p.number_or_name(name)? {
         None => Ok(default),
         Some(NumberOrName::Number(v, at)) => number_ior(p, name, v, &at),
         Some(NumberOrName::Name(n, at)) => named::dielectric_ior(&n).ok_or_else(|| {
-            let law = law_ior(&n, true).is_ok();
-            Error::spec(
-                at,
-                if law {
-                    format!(
-                        "parameter `{name}` of `{}`: an index that varies with wavelength is taken by `dielectric`, \
-                         `roughdielectric` and `thindielectric` only; give a number or one of: {}",
-                        p.plugin_type(),
-                        named::DIELECTRICS.join(", ")
-                    )
-                } else {
-                    format!("parameter `{name}`: unknown material `{n}`; expected a number or one of: {}", named::DIELECTRICS.join(", "))
-                },
-            )
+            if law_ior(&n, true).is_ok() {
+                varies(&at)
+            } else {
+                Error::spec(
+                    at,
+                    format!("parameter `{name}`: unknown material `{n}`; expected a number or one of: {}", named::DIELECTRICS.join(", ")),
+                )
+            }
         }),
+    }
+}
+
+/// The value of a table that is the same at every node (an index that does not vary).
+fn flat(table: &PiecewiseLinear) -> Option<f64> {
+    match table.values() {
+        [v, rest @ ..] if rest.iter().all(|r| r == v) => Some(*v),
+        _ => None,
     }
 }
 
@@ -162,6 +182,7 @@ fn number_ior(p: &Props, name: &str, v: f64, at: &str) -> Result<f32> {
 /// | `"sellmeier(B1, …, Bn, C1, …, Cn)"` | n² = 1 + Σ Bᵢ λ² / (λ² − Cᵢ), λ in µm, Cᵢ in µm², 1 ≤ n ≤ 4 |
 /// | `"cauchy(A, B)"`, `"cauchy(A, B, C)"` | n = A + B / λ² + C / λ⁴, λ in µm |
 /// | a name of [`NAMED_GLASSES`] | that glass (`fused silica`, `baf10`, `f2`, `sf11`, pbrt-v4's `glass-*`) |
+/// | a table: `<spectrum name="int_ior" value="λ:n, …"/>` or `filename="….spd"` | linear between its nodes, its end values outside |
 ///
 /// Mitsuba's names keep Mitsuba's constants (`bk7` is 1.5046, `water` 1.333, `diamond` 2.419), so that its
 /// scenes render as there; with `dispersive` = true a name is read from [`NAMED_GLASSES`] instead
@@ -224,6 +245,12 @@ pub(crate) fn interface_ior(p: &Props) -> Result<(f32, Option<Arc<Dispersion>>)>
 
 /// One index of a dielectric interface (see [`Dispersion`]).
 fn index(p: &Props, name: &'static str, default: f32, dispersive: bool) -> Result<Ior> {
+    if let Some(table) = p.spectrum_table(name) {
+        return match flat(&table) {
+            Some(v) => number_ior(p, name, v, p.at_param(name)).map(|n| Ior::Constant(f64::from(n))),
+            None => Ok(Ior::Tabulated(table)),
+        };
+    }
     match p.number_or_name(name)? {
         None => Ok(Ior::Constant(f64::from(default))),
         Some(NumberOrName::Number(v, at)) => number_ior(p, name, v, &at).map(|n| Ior::Constant(f64::from(n))),

@@ -43,9 +43,9 @@
 //! The RGL database also ships spectral files, whose reflectance is `spectra` at `wavelengths` (the
 //! spectrum of each cell of the reflectance square) instead of `rgb`. gonio renders in
 //! RGB, so at load each cell's spectrum — piecewise linear between the wavelengths, 0 outside them — is
-//! reduced to linear sRGB by [`SpectrumToRgb::reflectance_rgb`], the same reduction of reflectance
-//! spectra as the XML `<spectrum>` of a BSDF ([`crate::spectrum::named::reflectance_to_rgb`]: the CIE 1931
-//! integral, divided by the response to the equal-energy white so that a flat spectrum stays grey). The
+//! reduced to linear sRGB by [`SpectrumToRgb::under_d65`], the same reduction of reflectance spectra as
+//! the XML `<spectrum>` of a BSDF ([`crate::spectrum::named::reflectance_to_rgb`]: the colour under D65,
+//! so that a flat spectrum stays grey). The
 //! reduction is linear, so the table then behaves exactly as an RGB table would (it is not clamped per
 //! cell; f clamps after interpolation, as for RGB files). A file with both fields uses `rgb`, as
 //! Mitsuba's RGB variants do. Wavelengths that do not increase, fewer than two of them, none in the
@@ -389,7 +389,7 @@ impl RglTables {
 }
 
 /// The RGB reflectance table of a spectral RGL file: `spectra` [nφ, nθ, nλ, m, m] at `wavelengths` [nλ]
-/// (nm, ascending) reduced cell by cell to linear sRGB by [`SpectrumToRgb::reflectance_rgb`], the reduction
+/// (nm, ascending) reduced cell by cell to linear sRGB by [`SpectrumToRgb::under_d65`], the reduction
 /// of reflectance spectra that gonio's XML `<spectrum>` uses. The reduction is linear and left unclamped,
 /// like the `rgb` tables of the RGB files (which hold small negative entries); `f` clamps at 0 after
 /// interpolation, for both kinds of file alike.
@@ -407,7 +407,7 @@ fn rgb_from_spectra(file: &TensorFile, n_phi: usize, n_theta: usize) -> Result<F
         ));
     }
     let lambda: Vec<f64> = wavelengths.data.iter().map(|&l| f64::from(l)).collect();
-    let reduction = SpectrumToRgb::new(&lambda);
+    let reduction = SpectrumToRgb::under_d65(&lambda);
     if reduction.is_black() {
         return Err(file.error(
             "wavelengths",
@@ -439,7 +439,7 @@ fn rgb_from_spectra(file: &TensorFile, n_phi: usize, n_theta: usize) -> Result<F
             for (k, v) in values.iter_mut().enumerate() {
                 *v = f64::from(src[k * cells + cell]);
             }
-            let c = reduction.reflectance_rgb(&values);
+            let c = reduction.linear_rgb(&values);
             for (channel, value) in c.iter().enumerate() {
                 #[allow(clippy::cast_possible_truncation)] // the tables are f32
                 {
@@ -734,8 +734,8 @@ mod tests {
             lambda.iter().map(|&l| f64::from(l <= 490.0)).collect(),
         ];
         // M: column c is the reduction of basis spectrum c; a cell of RGB ρ gets the weights M⁻¹ ρ.
-        let reduction = SpectrumToRgb::new(&lambda);
-        let cols = basis.clone().map(|b| glam::DVec3::from(reduction.reflectance_rgb(&b)));
+        let reduction = SpectrumToRgb::under_d65(&lambda);
+        let cols = basis.clone().map(|b| glam::DVec3::from(reduction.linear_rgb(&b)));
         let m = glam::DMat3::from_cols(cols[0], cols[1], cols[2]);
         eprintln!("reduction of the basis spectra (columns): {m:?}");
         assert!(m.determinant().abs() > 0.1, "the basis must span RGB");
@@ -763,20 +763,26 @@ mod tests {
         assert!(pairs.iter().take(500).all(|&(wo, wi)| c.f(wo, wi) == a.f(wo, wi)));
     }
 
-    /// The reduction itself, independently of gonio's weights: a flat spectrum of value v over the whole
-    /// visible range is grey, (v, v, v), so a spectral file whose every cell is flat at the cell's green
-    /// value gives the f of an RGB file holding (g, g, g).
+    /// The reduction itself: a flat spectrum of value v over the whole visible range is v times the colour
+    /// of D65, sRGB's white, (1, 1, 1) to the rounding of the XYZ → sRGB matrix (Mitsuba 3 rounds alike),
+    /// so a spectral file whose every cell is flat at the cell's green value g gives the f of an RGB file
+    /// holding g times that white.
     #[test]
     fn flat_spectra_reduce_to_grey() {
+        let lambda: Vec<f64> = wavelengths().iter().map(|&l| f64::from(l)).collect();
+        let white = crate::spectrum::named::reflectance_to_rgb(&lambda, &[1.0; 48]);
+        assert!(white.0.iter().all(|c| (c - 1.0).abs() < 2e-3), "a flat 1 reduces to {white:?}");
         let source = Fields::read("paper_white_rgb.bsdf");
         let flat = spectral_twin(&source, |rho| vec![rho[1]; 48]);
         let (shape, rgb) = source.f32("rgb");
         let cells = shape[3] * shape[4];
         let mut grey_rgb = rgb.clone();
         for slice in 0..shape[0] * shape[1] {
-            for ch in [0, 2] {
-                let (dst, src) = ((slice * 3 + ch) * cells, (slice * 3 + 1) * cells);
-                grey_rgb.copy_within(src..src + cells, dst);
+            let green = (slice * 3 + 1) * cells;
+            for ch in 0..3 {
+                for k in 0..cells {
+                    grey_rgb[(slice * 3 + ch) * cells + k] = rgb[green + k] * white.0[ch];
+                }
             }
         }
         let mut grey = source.clone();
@@ -787,7 +793,7 @@ mod tests {
         eprintln!("flat spectra: worst |Δf| / max f = {worst:.2e} over {lit} lit pairs");
         assert!(lit > 9_000 && worst < 1e-5, "{worst} over {lit}");
         let f = b.f(Vec3::new(0.0, 0.6, 0.8), Vec3::Z);
-        assert!(f.r() == f.g() || (f.r() - f.g()).abs() < 1e-6 * f.g(), "{f:?}");
+        assert!((f.r() / f.g() - white.r() / white.g()).abs() < 1e-5, "{f:?}");
     }
 
     #[test]

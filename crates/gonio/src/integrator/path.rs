@@ -42,7 +42,7 @@ use crate::math::{Vec2, Vec3};
 use crate::sampling::mis::power_heuristic_lanes;
 use crate::sampling::warp::uniform_sphere;
 use crate::sampling::Pcg32x8;
-use crate::scene::spectral::{reflectances_at, Dependence};
+use crate::scene::spectral::{reflectances_at, Dependence, GivenSpectra};
 use crate::scene::surfaces::{Rows3, Surfaces8};
 use crate::scene::Scene;
 use crate::spectrum::sampled::{path_to_linear_srgb, sample_path_wavelengths, PATH_WAVELENGTHS};
@@ -579,7 +579,8 @@ fn shading<'a>(scene: &'a Scene, p: &Packet, hit: &Surfaces8) -> Shading<'a> {
                     let model = if material.reads_surface() { scene.bsdf_at(&hit.interaction(lane, 0.0)) } else { material.at(uv) };
                     models[lane] = Some(if chromatic {
                         let mut model = model.into_owned();
-                        reflectances_at(&mut model, p.lambda(lane));
+                        let given = scene.spectral.as_ref().and_then(|s| s.given.get(hit.shape[lane] as usize));
+                        reflectances_at(&mut model, p.lambda(lane), given.unwrap_or(&GivenSpectra::NONE));
                         Cow::Owned(model)
                     } else {
                         model

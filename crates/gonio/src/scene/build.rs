@@ -3,7 +3,7 @@
 //! know is an error naming the place in the file.
 
 use super::mitsuba_xml::SceneDescription;
-use super::spectral::{check_bsdf, Dependence, Mode};
+use super::spectral::{check_bsdf, given_spectra, Dependence, GivenSpectra, Mode};
 use super::{Aov, AovKind, IntegratorKind, Material, SamplerSpec, Scene};
 use crate::bsdf::{Bsdf, Diffuse};
 use crate::camera::Camera;
@@ -63,7 +63,7 @@ impl Scene {
                 _ => built.add(p, &Transform::IDENTITY)?,
             }
         }
-        let Built { shapes, materials, shape_lights, mut lights, dependence, mut light_spectra, .. } = built;
+        let Built { shapes, materials, shape_lights, mut lights, dependence, colours, mut light_spectra, .. } = built;
         for e in &desc.emitters {
             let light = light_from_props(e)?;
             if light.is_environment() && lights.iter().any(Light::is_environment) {
@@ -108,7 +108,7 @@ impl Scene {
             if matches!(scene.integrator, IntegratorKind::Aov { .. }) {
                 return Err(Error::spec(&desc.source, "spectral mode renders the `path` and `direct` integrators; `aov` needs --mode rgb"));
             }
-            scene.make_spectral(dependence, &light_spectra);
+            scene.make_spectral(dependence, colours, &light_spectra);
         }
         Ok(scene)
     }
@@ -125,6 +125,8 @@ struct Built {
     mode: Mode,
     /// In spectral mode, how each material depends on wavelength ([`super::spectral::check_bsdf`]).
     dependence: Vec<Dependence>,
+    /// In spectral mode, the colours each material was given as tables ([`super::spectral::given_spectra`]).
+    colours: Vec<GivenSpectra>,
     /// Per light, the spectrum its emission was given as, where an `<emitter>`'s `<spectrum>` gave one.
     light_spectra: Vec<Option<Arc<Spectrum>>>,
 }
@@ -151,6 +153,10 @@ impl Built {
             self.dependence.push(match nested.as_slice() {
                 [one] => check_bsdf(one)?,
                 _ => Dependence::None,
+            });
+            self.colours.push(match nested.as_slice() {
+                [one] => given_spectra(one),
+                _ => GivenSpectra::NONE,
             });
         }
         if let (Some(material), Some(shape)) = (self.materials.last(), self.shapes.last()) {

@@ -105,7 +105,7 @@ pub struct Slot {
 
 impl Slot {
     /// The slot of the texture at `path` (from `Props::take_textures`) in a model built from `template`.
-    fn of(template: &Props, path: &[String]) -> Option<Slot> {
+    pub(crate) fn of(template: &Props, path: &[String]) -> Option<Slot> {
         let (name, parents) = path.split_last()?;
         let mut props = template;
         let mut route = Vec::with_capacity(parents.len());
@@ -118,10 +118,15 @@ impl Slot {
         Some(Slot { route, name: name.clone() })
     }
 
+    /// Whether this is parameter `name` of the material's own model.
+    pub(crate) fn is_top(&self, name: &str) -> bool {
+        self.route.is_empty() && self.name == name
+    }
+
     /// Write `value` into every model the route reaches (a float with [`Bsdf::set_float`], a colour into
     /// [`Bsdf::reflectance_slot`] clamped to [0, 1]: both clamped as the rebuilt model's readers clamp a
     /// texture's value, [`Props::set_texture_value`]): whether it reached one and each took the value.
-    fn write(&self, model: &mut Bsdf, value: &TextureValue) -> bool {
+    pub(crate) fn write(&self, model: &mut Bsdf, value: &TextureValue) -> bool {
         fn visit(model: &mut Bsdf, route: &[(usize, usize)], name: &str, value: &TextureValue) -> bool {
             match (route, value) {
                 ([], TextureValue::Scalar(v)) => model.set_float(name, *v),
@@ -491,7 +496,7 @@ impl Material {
 }
 
 /// A texture's value at a hit: a float for the parameters in `SCALAR_PARAMETERS`, else a colour.
-enum TextureValue {
+pub(crate) enum TextureValue {
     Scalar(f32),
     Colour(crate::spectrum::Rgb),
 }

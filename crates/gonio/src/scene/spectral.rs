@@ -13,12 +13,15 @@
 //! (every colour grey, as a `dielectric`'s defaults) is the same at every wavelength and runs as in RGB
 //! mode.
 
+use super::material::{Slot, TextureValue};
 use super::Material;
+use crate::bsdf::textured_reflectance;
 use crate::bsdf::Bsdf;
 use crate::error::{Error, Result};
 use crate::light::Light;
 use crate::props::{Props, Value};
 use crate::spectrum::illuminant::Spectrum;
+use crate::spectrum::piecewise::PiecewiseLinear;
 use crate::spectrum::sampled::{emission_at, reflectance_at, PATH_WAVELENGTHS};
 use crate::spectrum::upsample::{srgb_table, RgbIlluminantSpectrum, SigmoidPolynomial};
 use crate::spectrum::Rgb;
@@ -81,22 +84,91 @@ pub struct SpectralScene {
     /// Per shape, how its material depends on wavelength ([`check_bsdf`]).
     pub dependence: Vec<Dependence>,
     /// Per shape, the reflectance spectrum of a `diffuse` material of one colour.
-    diffuse: Vec<Option<SigmoidPolynomial>>,
+    diffuse: Vec<Option<DiffuseSpectrum>>,
+    /// Per shape, the colours its material was given as tables ([`given_spectra`]).
+    pub given: Vec<GivenSpectra>,
     /// Per light of one colour ([`Light::constant_colour`]): that colour's largest component, and its
     /// spectrum — as the scene gave it (an emitter's `<spectrum>`), else the colour's RGB illuminant
     /// spectrum.
     lights: Vec<Option<(f32, Arc<Spectrum>)>>,
 }
 
+/// A constant `diffuse` reflectance's spectrum.
+#[derive(Clone, Debug)]
+enum DiffuseSpectrum {
+    /// Upsampled from its colour.
+    Fitted(SigmoidPolynomial),
+    /// The table the scene gave ([`given_spectra`]).
+    Given(Arc<PiecewiseLinear>),
+}
+
+/// The colours of a material that were given as tables (a `<spectrum>` of `λ:value` pairs or an `.spd`
+/// file), which spectral mode renders as given instead of upsampling their RGB reductions: each with its
+/// place in the model ([`Slot`]: the models the material holds, and the parameter).
+#[derive(Clone, Debug, Default)]
+pub struct GivenSpectra(Vec<(Slot, Arc<PiecewiseLinear>)>);
+
+impl GivenSpectra {
+    /// No colour given as a table.
+    pub const NONE: GivenSpectra = GivenSpectra(Vec::new());
+
+    /// The table given for parameter `name` of the material's own model.
+    fn table(&self, name: &str) -> Option<&Arc<PiecewiseLinear>> {
+        self.0.iter().find(|(slot, _)| slot.is_top(name)).map(|(_, t)| t)
+    }
+}
+
+/// The colours of `<bsdf>` `p` given as tables, where spectral mode converts colours ([`CONVERTED`] in the
+/// model or in the models it holds through [`CONTAINERS`]; [`check_bsdf`] refuses the others).
+#[must_use]
+pub fn given_spectra(p: &Props) -> GivenSpectra {
+    fn visit(root: &Props, p: &Props, path: &mut Vec<String>, out: &mut Vec<(Slot, Arc<PiecewiseLinear>)>) {
+        for (name, value, _) in p.values() {
+            if let Value::Nested(m) = value {
+                if is_model(m) && CONTAINERS.contains(&p.plugin_type()) {
+                    path.push(name.to_string());
+                    visit(root, m, path, out);
+                    path.pop();
+                }
+                continue;
+            }
+            let spectrum = p.spectrum(name);
+            let Some(Spectrum::Tabulated(table)) = spectrum.as_deref() else { continue };
+            if !CONVERTED.contains(&name) {
+                continue;
+            }
+            path.push(name.to_string());
+            if let Some(slot) = Slot::of(root, path) {
+                out.push((slot, Arc::new(table.clone())));
+            }
+            path.pop();
+        }
+    }
+    let mut out = Vec::new();
+    visit(p, p, &mut Vec::new(), &mut out);
+    GivenSpectra(out)
+}
+
 impl SpectralScene {
-    /// The spectra of `materials` (one per shape, `dependence` as [`check_bsdf`] found it) and `lights`
-    /// (`given`: per light, the spectrum its emission was given as, if it was).
+    /// The spectra of `materials` (one per shape: `dependence` as [`check_bsdf`] found it, `colours` as
+    /// [`given_spectra`] did; empty for none) and `lights` (`given`: per light, the spectrum its emission was
+    /// given as, if it was).
     #[must_use]
-    pub fn new(materials: &[Material], lights: &[Light], dependence: Vec<Dependence>, given: &[Option<Arc<Spectrum>>]) -> Self {
+    pub fn new(
+        materials: &[Material],
+        lights: &[Light],
+        dependence: Vec<Dependence>,
+        colours: Vec<GivenSpectra>,
+        given: &[Option<Arc<Spectrum>>],
+    ) -> Self {
         let diffuse = materials
             .iter()
-            .map(|m| match m {
-                Material::Fixed(Bsdf::Diffuse(d)) => Some(srgb_table().fit(d.reflectance)),
+            .enumerate()
+            .map(|(i, m)| match m {
+                Material::Fixed(Bsdf::Diffuse(d)) => Some(match colours.get(i).and_then(|g| g.table("reflectance")) {
+                    Some(table) => DiffuseSpectrum::Given(table.clone()),
+                    None => DiffuseSpectrum::Fitted(srgb_table().fit(d.reflectance)),
+                }),
                 _ => None,
             })
             .collect();
@@ -110,16 +182,19 @@ impl SpectralScene {
                 Some((c.max_component(), spectrum))
             })
             .collect();
-        SpectralScene { dependence, diffuse, lights }
+        SpectralScene { dependence, diffuse, given: colours, lights }
     }
 
-    /// The reflectance `rgb` of shape `shape`'s diffuse material at the wavelengths `lambda`: from its
-    /// fitted spectrum where its colour is constant, else (a texture's texel) by [`reflectance_at`].
+    /// The reflectance `rgb` of shape `shape`'s diffuse material at the wavelengths `lambda`: from the table
+    /// it was given as, else its fitted spectrum where its colour is constant, else (a texture's texel) by
+    /// [`reflectance_at`].
     #[inline]
     #[must_use]
     pub fn reflectance(&self, shape: usize, rgb: [f32; 3], lambda: [f32; PATH_WAVELENGTHS]) -> [f32; PATH_WAVELENGTHS] {
         match self.diffuse.get(shape) {
-            Some(Some(p)) => lambda.map(|l| p.eval(l)),
+            Some(Some(DiffuseSpectrum::Fitted(p))) => lambda.map(|l| p.eval(l)),
+            #[allow(clippy::cast_possible_truncation)]
+            Some(Some(DiffuseSpectrum::Given(table))) => lambda.map(|l| textured_reflectance(table.eval(f64::from(l)) as f32)),
             _ => reflectance_at(rgb, lambda),
         }
     }
@@ -145,16 +220,16 @@ impl SpectralScene {
 impl super::Scene {
     /// Make this scene render in spectral mode: its environment maps' texels taken to spectra, the table
     /// RGB values are taken to spectra with built now rather than by the first path, and its
-    /// [`SpectralScene`] (`dependence` per shape, as [`check_bsdf`] found it; `given` per light, the
-    /// spectrum its emission was given as, if it was).
-    pub(crate) fn make_spectral(&mut self, dependence: Vec<Dependence>, given: &[Option<Arc<Spectrum>>]) {
+    /// [`SpectralScene`] (`dependence` and `colours` per shape, as [`check_bsdf`] and [`given_spectra`]
+    /// found them; `given` per light, the spectrum its emission was given as, if it was).
+    pub(crate) fn make_spectral(&mut self, dependence: Vec<Dependence>, colours: Vec<GivenSpectra>, given: &[Option<Arc<Spectrum>>]) {
         for light in &mut self.lights {
             if let Light::EnvMap(env) = light {
                 env.prepare_spectra();
             }
         }
         let _ = srgb_table();
-        self.spectral = Some(SpectralScene::new(&self.materials, &self.lights, dependence, given));
+        self.spectral = Some(SpectralScene::new(&self.materials, &self.lights, dependence, colours, given));
     }
 }
 
@@ -215,8 +290,13 @@ fn check_model(p: &Props, convertible: bool) -> Result<Dependence> {
             ))
         };
         let what = if compensated { "a colour of an energy-compensated model" } else { "this colour" };
+        // A colour: three numbers not all equal, or a table that is not flat (whose reduction may be grey).
+        let colour = matches!(value, Value::List(l) if l.len() == 3 && name != "normalmap" && !(l[0] == l[1] && l[1] == l[2]))
+            || matches!(p.spectrum(name).as_deref(), Some(Spectrum::Tabulated(t)) if t.values().windows(2).any(|w| w[0] != w[1]));
         match value {
-            Value::List(l) if l.len() == 3 && name != "normalmap" && !(l[0] == l[1] && l[1] == l[2]) => {
+            // A dispersive index is taken above.
+            _ if matches!(name, "int_ior" | "ext_ior") => {}
+            _ if colour => {
                 let index = matches!(name, "eta" | "k") && built()?.conductor_fresnel().is_some();
                 if !(convertible && (index || CONVERTED.contains(&name) && built()?.reflectance_slot(name).is_some())) {
                     return refuse(what);
@@ -263,9 +343,20 @@ fn is_model(p: &Props) -> bool {
 
 /// Model `b` at the wavelengths `lambda`, in `b` and in the models it holds ([`Bsdf::for_each_nested`]):
 /// each colour parameter of `CONVERTED` (those [`check_bsdf`] takes) replaced by its reflectance spectrum's
-/// values at `lambda`, a conductor's index by its spectra's ([`crate::bsdf::Conductor::set_wavelengths`]),
+/// values at `lambda` (the table it was given as, in `given`, clamped to [0, 1] as a texture's value; else
+/// its colour's upsampled spectrum), a conductor's index by its spectra's ([`crate::bsdf::Conductor::set_wavelengths`]),
 /// and a dispersive dielectric's by its value at the hero wavelength `lambda[0]`.
-pub fn reflectances_at(b: &mut Bsdf, lambda: [f32; PATH_WAVELENGTHS]) {
+pub fn reflectances_at(b: &mut Bsdf, lambda: [f32; PATH_WAVELENGTHS], given: &GivenSpectra) {
+    convert(b, lambda);
+    for (slot, table) in &given.0 {
+        #[allow(clippy::cast_possible_truncation)]
+        let value = Rgb(lambda.map(|l| table.eval(f64::from(l)) as f32));
+        slot.write(b, &TextureValue::Colour(value));
+    }
+}
+
+/// [`reflectances_at`] without the tables.
+fn convert(b: &mut Bsdf, lambda: [f32; PATH_WAVELENGTHS]) {
     if let Some(c) = b.conductor_fresnel() {
         c.set_wavelengths(lambda);
     }
@@ -277,5 +368,5 @@ pub fn reflectances_at(b: &mut Bsdf, lambda: [f32; PATH_WAVELENGTHS]) {
             *r = Rgb(reflectance_at(r.0, lambda));
         }
     }
-    b.for_each_nested(&mut |m| reflectances_at(m, lambda));
+    b.for_each_nested(&mut |m| convert(m, lambda));
 }

@@ -28,6 +28,7 @@
 use std::sync::OnceLock;
 
 use super::cie::{cie1931_xyz, CIE_MAX, CIE_MIN, CIE_Y_NORMALIZATION};
+use super::illuminant::d65;
 use super::piecewise::PiecewiseLinear;
 use super::Rgb;
 
@@ -166,15 +167,18 @@ pub fn spectrum_to_rgb(wavelengths: &[f64], values: &[f64]) -> Rgb {
     clamped_rgb(SpectrumToRgb::new(&wavelengths[..n]).linear_rgb(&values[..n]))
 }
 
-/// Reduces a *reflectance* spectrum to linear sRGB: [`spectrum_to_rgb`] divided, channel by channel, by
-/// the response to the equal-energy white (1 over [`CIE_MIN`], [`CIE_MAX`]), so that a flat spectrum stays
-/// grey: 1 everywhere gives (1, 1, 1). Mitsuba's RGB variants weight reflectances by D65 for the same
-/// purpose; this is gonio's approximation of it (exact for flat spectra; see `xml::parse_spectrum`, the
-/// `<spectrum>` of a BSDF, and [`crate::bsdf::measured`], the spectral RGL files, which both use it).
+/// Reduces a *reflectance* spectrum to linear sRGB as Mitsuba 3's RGB variants reduce the `<spectrum>` of
+/// a BSDF parameter: the colour it has under D65, the white of sRGB — [`spectrum_to_rgb`] of the spectrum
+/// times [`d65`] (of luminance 1), so that 1 everywhere gives (1, 1, 1) — with negative components clamped
+/// to 0 (a parameter with a range clamps the rest: [`crate::props::Props::rgb_in`]). Measured on Mitsuba
+/// 3.9.1 `scalar_rgb` (2026-12-06, the reflectance of a `diffuse`): a flat 0.78 over 400–700 nm gives
+/// (0.7764, 0.7798, 0.7760) there; a spectrum of three dips to 0.05 (at 450, 550 and 610 nm) gives
+/// (0.3456, 0.4363, 0.2434), where gonio's reduction before, by the response to the equal-energy white,
+/// gave 26 % more red. Also the reduction of the spectral RGL files ([`crate::bsdf::measured`]).
 #[must_use]
 pub fn reflectance_to_rgb(wavelengths: &[f64], values: &[f64]) -> Rgb {
     let n = wavelengths.len().min(values.len());
-    clamped_rgb(SpectrumToRgb::new(&wavelengths[..n]).reflectance_rgb(&values[..n]))
+    clamped_rgb(SpectrumToRgb::under_d65(&wavelengths[..n]).linear_rgb(&values[..n]))
 }
 
 #[allow(clippy::cast_possible_truncation)] // gonio renders in f32
@@ -198,6 +202,17 @@ impl SpectrumToRgb {
     /// or none inside [[`CIE_MIN`], [`CIE_MAX`]], give a reduction to black.
     #[must_use]
     pub fn new(wavelengths: &[f64]) -> Self {
+        Self::weighted(wavelengths, |_| 1.0)
+    }
+
+    /// The reduction of reflectances seen under D65 ([`reflectance_to_rgb`]): each spectrum times [`d65`].
+    #[must_use]
+    pub fn under_d65(wavelengths: &[f64]) -> Self {
+        Self::weighted(wavelengths, d65)
+    }
+
+    /// The reduction of spectra times `weight(λ)`.
+    fn weighted(wavelengths: &[f64], weight: impl Fn(f64) -> f64) -> Self {
         debug_assert!(wavelengths.windows(2).all(|w| w[0] <= w[1]), "wavelengths must ascend");
         let n = wavelengths.len();
         let mut xyz = vec![[0.0_f64; 3]; n];
@@ -215,7 +230,7 @@ impl SpectrumToRgb {
                 let i0 = (wavelengths.partition_point(|&w| w <= lambda).saturating_sub(1)).min(n - 2);
                 let (x0, x1) = (wavelengths[i0], wavelengths[i0 + 1]);
                 let t = if x1 > x0 { (lambda - x0) / (x1 - x0) } else { 1.0 };
-                let cmf = cie1931_xyz(lambda);
+                let cmf = cie1931_xyz(lambda).map(|v| v * weight(lambda));
                 for c in 0..3 {
                     xyz[i0][c] += (1.0 - t) * cmf[c];
                     xyz[i0 + 1][c] += t * cmf[c];
@@ -258,21 +273,6 @@ impl SpectrumToRgb {
         }
         rgb
     }
-
-    /// [`Self::linear_rgb`] of a reflectance spectrum, divided by the response to the equal-energy white
-    /// (see [`reflectance_to_rgb`]), unclamped.
-    #[must_use]
-    pub fn reflectance_rgb(&self, values: &[f64]) -> [f64; 3] {
-        let white = equal_energy_white();
-        let rgb = self.linear_rgb(values);
-        std::array::from_fn(|c| rgb[c] / white[c])
-    }
-}
-
-/// The unclamped linear sRGB of 1 over [[`CIE_MIN`], [`CIE_MAX`]]: ≈ (1.2049, 0.9482, 0.9093).
-fn equal_energy_white() -> [f64; 3] {
-    static WHITE: OnceLock<[f64; 3]> = OnceLock::new();
-    *WHITE.get_or_init(|| SpectrumToRgb::new(&[CIE_MIN, CIE_MAX]).linear_rgb(&[1.0, 1.0]))
 }
 
 /// CIE XYZ → linear sRGB (Rec. 709 primaries, D65 white), with the coefficients Mitsuba 3 uses
