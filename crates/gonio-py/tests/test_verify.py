@@ -144,6 +144,9 @@ def test_the_harness_per_wavelength():
         e = verify.energy(at, angles=4, samples=256)
         np.testing.assert_allclose(e.albedo, rho, rtol=1e-5)  # the table's value, not its colour's spectrum
         assert at.f([0, 0, 1], [0, 0, 1])[0] == paper.f([0, 0, 1], [0, 0, 1], wavelengths=nm)
+    # The same table in Mitsuba's dictionary form.
+    as_dict = gonio.load_bsdf({"type": "diffuse", "reflectance": {"type": "spectrum", "value": [(400, 0.2), (700, 0.9)]}})
+    assert as_dict.at_wavelength(650).f([0, 0, 1], [0, 0, 1])[0] == paper.at_wavelength(650).f([0, 0, 1], [0, 0, 1])[0]
     sf11 = gonio.load_bsdf({"type": "roughdielectric", "int_ior": "sf11", "alpha": 0.3, "distribution": "ggx"})
     reports = verify.check(sf11, samples=100_000, sweep=10_000, wavelengths=[400, 650])
     assert [r.name.endswith(f"@ {nm} nm") for r, nm in zip(reports, (400, 650))] == [True, True]

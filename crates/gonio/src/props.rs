@@ -10,7 +10,8 @@
 //! | `true`                                      | `<boolean name=… value="true"/>`     | bool             |
 //! | `"Au"`                                      | `<string name=… value="Au"/>`        | string           |
 //! | `[0.1, 0.2, 0.3]`, `{"type": "rgb", "value": …}` | `<rgb name=… value="0.1, 0.2, 0.3"/>` | colour (a number is grey) |
-//! | `{"type": "spectrum", "value": 0.5}`        | `<spectrum name=… value="0.5"/>`     | number (uniform spectrum) |
+//! | `{"type": "spectrum", "value": 0.5}`        | `<spectrum name=… value="0.5"/>`     | number (uniform spectrum; in an emission, the equal-energy one) |
+//! | `{"type": "spectrum", "value": [[400, 0.1], [700, 0.3]]}`, `{"type": "spectrum", "filename": "x.spd"}` | `<spectrum name=… value="400:0.1, 700:0.3"/>`, `filename="x.spd"` | its RGB reduction, and the table ([`Props::spectrum`]) |
 //! | `{"type": "diffuse", …}` under any key      | nested `<bsdf type="diffuse">`       | nested plugin    |
 
 use crate::error::{Error, Result};
@@ -573,6 +574,13 @@ impl Props {
                     _ => return Err(Error::spec(at, "\"id\" must be a string")),
                 },
                 _ => {
+                    if let Some((c, spectrum)) = json_spectrum(key, v, &at)? {
+                        props.set_checked(key, colour_value(c), &at)?;
+                        if let (Some(spectrum), Some(e)) = (spectrum, props.entries.last_mut()) {
+                            e.spectrum = Some(Arc::new(spectrum));
+                        }
+                        continue;
+                    }
                     let value = json_value(v, &at, scope)?;
                     props.set_checked(key, value, &at)?;
                 }
@@ -583,7 +591,8 @@ impl Props {
 
     /// The description in Mitsuba's dictionary form, which [`Props::from_json`] reads back to the same
     /// parameters: numbers, booleans, strings, lists (colours), points and vectors as three numbers,
-    /// transforms as their 4 × 4 row-major matrix, nested plugins as objects with their `type` (and `id`).
+    /// transforms as their 4 × 4 row-major matrix, nested plugins as objects with their `type` (and `id`),
+    /// tables and uniform emission spectra as `{"type": "spectrum"}` (other spectrum plugins as their RGB).
     #[must_use]
     pub fn to_json(&self) -> serde_json::Value {
         use serde_json::{json, Value as J};
@@ -593,14 +602,12 @@ impl Props {
             map.insert("id".into(), J::String(id.clone()));
         }
         for e in &self.entries {
-            let v = match &e.value {
-                Value::Number(x) => json!(x),
-                Value::Bool(b) => J::Bool(*b),
-                Value::String(s) => J::String(s.clone()),
-                Value::List(l) => json!(l),
-                Value::Vector(v) => json!([v.x, v.y, v.z]),
-                Value::Transform(t) => J::Array(t.matrix.transpose().to_cols_array_2d().iter().map(|row| json!(row)).collect()),
-                Value::Nested(p) => p.to_json(),
+            let v = match (&e.value, e.spectrum.as_deref()) {
+                (_, Some(Spectrum::Tabulated(t))) => {
+                    json!({"type": "spectrum", "value": t.wavelengths().iter().zip(t.values()).map(|(l, v)| [*l, *v]).collect::<Vec<_>>()})
+                }
+                (_, Some(Spectrum::Constant(v))) => json!({"type": "spectrum", "value": v}),
+                (value, _) => value_json(value),
             };
             map.insert(e.name.clone(), v);
         }
@@ -700,9 +707,7 @@ impl Props {
                 "transform" => Value::Transform(parse_transform(child, env, source)?),
                 "spectrum" => {
                     let (c, spectrum) = parse_spectrum(child, env, source, tag == "emitter")?;
-                    let value =
-                        if c.r() == c.g() && c.g() == c.b() { Value::Number(f64::from(c.r())) } else { Value::List(c.to_f64().to_vec()) };
-                    props.set_checked(&name, value, &cat)?;
+                    props.set_checked(&name, colour_value(c), &cat)?;
                     if let (Some(spectrum), Some(e)) = (spectrum, props.entries.last_mut()) {
                         e.spectrum = Some(Arc::new(spectrum));
                     }
@@ -798,6 +803,76 @@ fn json_matrix(rows: &[serde_json::Value], at: &str) -> Result<Value> {
     Ok(Value::Transform(t.then_after(crate::math::Transform::IDENTITY)))
 }
 
+/// A value in Mitsuba's dictionary form (see [`Props::to_json`]).
+fn value_json(value: &Value) -> serde_json::Value {
+    use serde_json::{json, Value as J};
+    match value {
+        Value::Number(x) => json!(x),
+        Value::Bool(b) => J::Bool(*b),
+        Value::String(s) => J::String(s.clone()),
+        Value::List(l) => json!(l),
+        Value::Vector(v) => json!([v.x, v.y, v.z]),
+        Value::Transform(t) => J::Array(t.matrix.transpose().to_cols_array_2d().iter().map(|row| json!(row)).collect()),
+        Value::Nested(p) => p.to_json(),
+    }
+}
+
+/// A colour as a parameter value: a number where it is grey, else three numbers.
+fn colour_value(c: Rgb) -> Value {
+    if c.r() == c.g() && c.g() == c.b() {
+        Value::Number(f64::from(c.r()))
+    } else {
+        Value::List(c.to_f64().to_vec())
+    }
+}
+
+/// The parameters that hold an emitter's emission: a spectrum given to them is radiance (an emitter's
+/// `<spectrum>` in XML), reduced without an illuminant, and a uniform one is the equal-energy spectrum.
+pub const EMISSION: [&str; 3] = ["radiance", "intensity", "irradiance"];
+
+/// Parameter `name`'s `{"type": "spectrum"}` given as a table — `"value"` a list of [λ nm, value] pairs,
+/// or `"filename"` an `.spd` file — or, for an emission ([`EMISSION`]), as a number: its RGB reduction and
+/// spectrum, as the XML `<spectrum>` gives them ([`crate::xml::tabulated_spectrum`]). `None` for any other
+/// value (a colour's number, read by [`json_value`]).
+fn json_spectrum(name: &str, v: &serde_json::Value, at: &str) -> Result<Option<(Rgb, Option<Spectrum>)>> {
+    use serde_json::Value as J;
+    let J::Object(map) = v else { return Ok(None) };
+    if map.get("type").and_then(J::as_str) != Some("spectrum") {
+        return Ok(None);
+    }
+    let emission = EMISSION.contains(&name);
+    if let Some(extra) = map.keys().find(|k| !matches!(k.as_str(), "type" | "value" | "filename")) {
+        return Err(Error::spec(at, format!("unknown key `{extra}` in a spectrum (it takes \"value\" or \"filename\")")));
+    }
+    let table = |w, v| crate::xml::tabulated_spectrum(w, v, emission).map_err(|e| Error::spec(at, format!("spectrum: {e}")));
+    match (map.get("value"), map.get("filename")) {
+        (Some(_), Some(_)) => Err(Error::spec(at, "a spectrum takes \"value\" or \"filename\", not both")),
+        (None, Some(J::String(file))) => {
+            let path = std::path::PathBuf::from(file);
+            let text = std::fs::read_to_string(&path).map_err(|source| Error::Io { path: path.clone(), source })?;
+            let (w, v) = crate::spectrum::named::parse_spd(&text).map_err(|e| Error::spec(at, format!("{}: {e}", path.display())))?;
+            table(w, v).map(Some)
+        }
+        (None, _) => Err(Error::spec(at, "a spectrum needs \"value\" (a number or [λ, value] pairs) or \"filename\" (an .spd file)")),
+        (Some(J::Number(n)), None) if emission => Ok(Some(crate::xml::uniform_spectrum(n.as_f64().unwrap_or(f64::NAN), true))),
+        (Some(J::Array(pairs)), None) if pairs.first().is_some_and(J::is_array) => {
+            let bad = || Error::spec(at, "a spectrum's \"value\" pairs must be [wavelength nm, value], two numbers each");
+            let (mut w, mut v) = (Vec::with_capacity(pairs.len()), Vec::with_capacity(pairs.len()));
+            for pair in pairs {
+                match pair.as_array().map(Vec::as_slice) {
+                    Some([l, x]) => {
+                        w.push(l.as_f64().ok_or_else(bad)?);
+                        v.push(x.as_f64().ok_or_else(bad)?);
+                    }
+                    _ => return Err(bad()),
+                }
+            }
+            table(w, v).map(Some)
+        }
+        _ => Ok(None),
+    }
+}
+
 fn json_value(v: &serde_json::Value, at: &str, scope: Option<&dyn JsonScope>) -> Result<Value> {
     use serde_json::Value as J;
     Ok(match v {
@@ -840,6 +915,42 @@ fn json_value(v: &serde_json::Value, at: &str, scope: Option<&dyn JsonScope>) ->
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn dictionary_spectra_are_the_xml_ones() {
+        // A table in a dictionary is the XML <spectrum>'s: the same RGB reduction and the same table, and
+        // it survives the round trip through `to_json`; a uniform emission is the equal-energy spectrum.
+        let xml = Props::from_xml_bsdf(
+            r#"<bsdf type="diffuse"><spectrum name="reflectance" value="400:0.2, 500:0.7, 700:0.9"/></bsdf>"#,
+            "t.xml",
+        )
+        .unwrap();
+        let dict =
+            Props::from_json(r#"{"type": "diffuse", "reflectance": {"type": "spectrum", "value": [[400, 0.2], [500, 0.7], [700, 0.9]]}}"#)
+                .unwrap();
+        assert_eq!(dict.rgb_in("reflectance", Rgb::ZERO, 0.0, 1.0).unwrap(), xml.rgb_in("reflectance", Rgb::ZERO, 0.0, 1.0).unwrap());
+        assert_eq!(dict.spectrum_table("reflectance"), xml.spectrum_table("reflectance"));
+        assert!(dict.spectrum_table("reflectance").is_some());
+        let back = Props::from_json(&dict.to_json().to_string()).unwrap();
+        assert_eq!(back.spectrum_table("reflectance"), xml.spectrum_table("reflectance"));
+        let light = Props::from_json(r#"{"type": "area", "radiance": {"type": "spectrum", "value": 2}}"#).unwrap();
+        let c = light.rgb_in("radiance", Rgb::ZERO, 0.0, f32::MAX).unwrap();
+        assert!((c.r() / 2.0 - 1.2049).abs() < 1e-3 && (c.b() / 2.0 - 0.9093).abs() < 1e-3, "{c:?}");
+        assert!(matches!(light.spectrum("radiance").as_deref(), Some(Spectrum::Constant(v)) if *v == 2.0));
+        let grey = Props::from_json(r#"{"type": "diffuse", "reflectance": {"type": "spectrum", "value": 0.3}}"#).unwrap();
+        assert_eq!(grey.rgb_in("reflectance", Rgb::ZERO, 0.0, 1.0).unwrap(), Rgb::splat(0.3));
+        for (json, expect) in [
+            (r#"{"type": "spectrum", "value": [[400, 0.2], [400, 0.3]]}"#, "$.reflectance: spectrum: line 2"),
+            (r#"{"type": "spectrum", "value": [[400, 0.2, 1], [500, 0.3]]}"#, "two numbers each"),
+            (r#"{"type": "spectrum", "value": [[400, 0.2]]}"#, "at least two points"),
+            (r#"{"type": "spectrum", "filename": "/nonexistent/x.spd"}"#, "/nonexistent/x.spd"),
+            (r#"{"type": "spectrum", "value": 1, "filename": "x.spd"}"#, "not both"),
+            (r#"{"type": "spectrum", "values": 1}"#, "unknown key `values`"),
+        ] {
+            let e = Props::from_json(&format!(r#"{{"type": "diffuse", "reflectance": {json}}}"#)).unwrap_err().to_string();
+            assert!(e.contains(expect), "{json}: {e}");
+        }
+    }
 
     #[test]
     fn xml_descriptions_read_back_from_their_json() {

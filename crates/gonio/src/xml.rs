@@ -7,7 +7,7 @@ use crate::math::Transform;
 use crate::props::Props;
 use crate::spectrum::cie::{CIE_MAX, CIE_MIN};
 use crate::spectrum::illuminant::{Blackbody, BlackbodyNormalization, Spectrum};
-use crate::spectrum::named::{parse_spd, reflectance_to_rgb, spectrum_to_rgb};
+use crate::spectrum::named::{parse_spd, reflectance_to_rgb, spectrum_to_rgb, SpdError};
 use crate::spectrum::piecewise::PiecewiseLinear;
 use crate::spectrum::Rgb;
 use glam::Vec3;
@@ -331,18 +331,9 @@ pub fn parse_vector(node: roxmltree::Node, env: &XmlEnv, source: &XmlSource, def
 pub fn parse_spectrum(node: roxmltree::Node, env: &XmlEnv, source: &XmlSource, within_emitter: bool) -> Result<(Rgb, Option<Spectrum>)> {
     let at = xml_at(source, node);
     let tabulated = |w: Vec<f64>, v: Vec<f64>| -> Result<(Rgb, Option<Spectrum>)> {
-        let rgb = if within_emitter { spectrum_to_rgb(&w, &v) } else { reflectance_to_rgb(&w, &v) };
-        let table = PiecewiseLinear::new(w, v).map_err(|e| Error::spec(&at, format!("<spectrum>: {e}")))?;
-        Ok((rgb, Some(Spectrum::Tabulated(table))))
+        tabulated_spectrum(w, v, within_emitter).map_err(|e| Error::spec(&at, format!("<spectrum>: {e}")))
     };
-    let uniform = |v: f64| -> Result<(Rgb, Option<Spectrum>)> {
-        if within_emitter {
-            Ok((spectrum_to_rgb(&[CIE_MIN, CIE_MAX], &[v, v]), Some(Spectrum::Constant(v))))
-        } else {
-            #[allow(clippy::cast_possible_truncation)]
-            Ok((Rgb::splat(v as f32), None))
-        }
-    };
+    let uniform = |v: f64| -> Result<(Rgb, Option<Spectrum>)> { Ok(uniform_spectrum(v, within_emitter)) };
     if let Some(kind) = env.attr(node, "type", source)? {
         return spectrum_plugin(node, env, source, &kind, within_emitter, &uniform);
     }
@@ -379,6 +370,31 @@ pub fn parse_spectrum(node: roxmltree::Node, env: &XmlEnv, source: &XmlSource, w
         return Err(Error::spec(at, "<spectrum>: a wavelength list needs at least two entries"));
     }
     tabulated(wavelengths, values)
+}
+
+/// A spectrum given as `values` at ascending `wavelengths` (nm): its RGB reduction — radiance inside an
+/// emitter ([`spectrum_to_rgb`]), else the colour under D65 ([`reflectance_to_rgb`]) — and the table, which
+/// spectral mode renders. The XML `<spectrum>` and the dictionary `{"type": "spectrum"}` both read through it.
+pub(crate) fn tabulated_spectrum(
+    wavelengths: Vec<f64>,
+    values: Vec<f64>,
+    within_emitter: bool,
+) -> std::result::Result<(Rgb, Option<Spectrum>), SpdError> {
+    let table = PiecewiseLinear::new(wavelengths, values)?;
+    let (w, v) = (table.wavelengths(), table.values());
+    let rgb = if within_emitter { spectrum_to_rgb(w, v) } else { reflectance_to_rgb(w, v) };
+    Ok((rgb, Some(Spectrum::Tabulated(table))))
+}
+
+/// A uniform spectrum of value `v`: inside an emitter the equal-energy spectrum (kept, for spectral mode),
+/// elsewhere the grey `v` (see [`parse_spectrum`]).
+pub(crate) fn uniform_spectrum(v: f64, within_emitter: bool) -> (Rgb, Option<Spectrum>) {
+    if within_emitter {
+        (spectrum_to_rgb(&[CIE_MIN, CIE_MAX], &[v, v]), Some(Spectrum::Constant(v)))
+    } else {
+        #[allow(clippy::cast_possible_truncation)]
+        (Rgb::splat(v as f32), None)
+    }
 }
 
 /// `<spectrum type="…">` (see [`parse_spectrum`]): its `<float>` parameters, each taken once.

@@ -17,7 +17,7 @@ use crate::geometry::sphere::Sphere;
 use crate::geometry::{Mesh, Shape};
 use crate::light::{AreaLight, ConstantLight, DirectionalLight, EnvMap, Light, PointLight, ProjectorLight, SpotLight};
 use crate::math::Transform;
-use crate::props::Props;
+use crate::props::{Props, EMISSION};
 use crate::spectrum::illuminant::Spectrum;
 use crate::spectrum::Rgb;
 use glam::Vec3;
@@ -130,9 +130,6 @@ struct Built {
     /// Per light, the spectrum its emission was given as, where an `<emitter>`'s `<spectrum>` gave one.
     light_spectra: Vec<Option<Arc<Spectrum>>>,
 }
-
-/// The parameters that hold a light's emission (`radiance`, `intensity`, `irradiance`).
-const EMISSION: [&str; 3] = ["radiance", "intensity", "irradiance"];
 
 impl Built {
     /// Add shape `p`, placed by `outer` after its own `to_world` (an instance's transform, or the identity).
