@@ -38,7 +38,6 @@ use crate::math::lanes::{channels, Real, V3};
 use crate::math::{Vec2, Vec3};
 use crate::props::{NumberOrName, Props};
 use crate::spectrum::dispersion::{Cauchy, Ior, Sellmeier, LAMBDA_D, NAMED_GLASSES};
-use crate::spectrum::piecewise::PiecewiseLinear;
 use crate::spectrum::wavelengths::{LAMBDA_MAX, LAMBDA_MIN};
 use crate::spectrum::{named, Rgb};
 use std::sync::Arc;
@@ -132,7 +131,7 @@ fn constant_ior(p: &Props, name: &'static str, default: f32) -> Result<f32> {
         )
     };
     if let Some(table) = p.spectrum_table(name) {
-        return match flat(&table) {
+        return match table.flat_value() {
             Some(v) => number_ior(p, name, v, p.at_param(name)),
             None => Err(varies(p.at_param(name))),
         };
@@ -150,14 +149,6 @@ fn constant_ior(p: &Props, name: &'static str, default: f32) -> Result<f32> {
                 )
             }
         }),
-    }
-}
-
-/// The value of a table that is the same at every node (an index that does not vary).
-fn flat(table: &PiecewiseLinear) -> Option<f64> {
-    match table.values() {
-        [v, rest @ ..] if rest.iter().all(|r| r == v) => Some(*v),
-        _ => None,
     }
 }
 
@@ -246,7 +237,7 @@ pub(crate) fn interface_ior(p: &Props) -> Result<(f32, Option<Arc<Dispersion>>)>
 /// One index of a dielectric interface (see [`Dispersion`]).
 fn index(p: &Props, name: &'static str, default: f32, dispersive: bool) -> Result<Ior> {
     if let Some(table) = p.spectrum_table(name) {
-        return match flat(&table) {
+        return match table.flat_value() {
             Some(v) => number_ior(p, name, v, p.at_param(name)).map(|n| Ior::Constant(f64::from(n))),
             None => Ok(Ior::Tabulated(table)),
         };

@@ -292,7 +292,7 @@ fn check_model(p: &Props, convertible: bool) -> Result<Dependence> {
         let what = if compensated { "a colour of an energy-compensated model" } else { "this colour" };
         // A colour: three numbers not all equal, or a table that is not flat (whose reduction may be grey).
         let colour = matches!(value, Value::List(l) if l.len() == 3 && name != "normalmap" && !(l[0] == l[1] && l[1] == l[2]))
-            || matches!(p.spectrum(name).as_deref(), Some(Spectrum::Tabulated(t)) if t.values().windows(2).any(|w| w[0] != w[1]));
+            || matches!(p.spectrum(name).as_deref(), Some(Spectrum::Tabulated(t)) if t.flat_value().is_none());
         match value {
             // A dispersive index is taken above.
             _ if matches!(name, "int_ior" | "ext_ior") => {}

@@ -66,6 +66,15 @@ impl PiecewiseLinear {
         &self.value
     }
 
+    /// The value of every node, where they are all equal (a table that does not vary).
+    #[must_use]
+    pub fn flat_value(&self) -> Option<f64> {
+        match self.value.as_slice() {
+            [v, rest @ ..] if rest.iter().all(|r| r == v) => Some(*v),
+            _ => None,
+        }
+    }
+
     /// The interpolated value at `lambda` nm; 0 outside [first, last] node (and for NaN).
     #[must_use]
     pub fn eval(&self, lambda: f64) -> f64 {
