@@ -8,6 +8,7 @@ mod common;
 
 use common::{mean_and_se, xyz_of};
 use gonio::bsdf::Bsdf;
+use gonio::measured::tensor_file::{encode, f32_bytes, DType, TensorFile};
 use gonio::props::Props;
 use gonio::render::{render, RenderOutput};
 use gonio::scene::spectral::{given_spectra, reflectances_at};
@@ -29,13 +30,18 @@ fn ior_dir() -> std::path::PathBuf {
 /// A plane filling the view of a camera looking straight at it, under a constant sky of [`LINES`]; one
 /// bounce, so a pixel is the surface's reflectance of the sky.
 fn render_plane(bsdf: &str, mode: Mode, spp: u32) -> RenderOutput {
+    render_plane_under(&format!(r#"<emitter type="constant"><spectrum name="radiance" value="{LINES}"/></emitter>"#), bsdf, mode, spp)
+}
+
+/// [`render_plane`] under the constant emitter `sky`.
+fn render_plane_under(sky: &str, bsdf: &str, mode: Mode, spp: u32) -> RenderOutput {
     let xml = format!(
         r#"<scene version="3.0.0"><integrator type="path"><integer name="max_depth" value="2"/></integrator>
         <sensor type="perspective"><float name="fov" value="4"/>
         <transform name="to_world"><lookat origin="0,0,5" target="0,0,0" up="0,1,0"/></transform>
         <sampler type="independent"><integer name="sample_count" value="{spp}"/></sampler>
         <film type="hdrfilm"><integer name="width" value="4"/><integer name="height" value="4"/><rfilter type="box"/></film></sensor>
-        <emitter type="constant"><spectrum name="radiance" value="{LINES}"/></emitter>
+        {sky}
         <shape type="rectangle"><transform name="to_world"><scale value="10"/></transform>{bsdf}</shape></scene>"#
     );
     let scene = Scene::build_in(mitsuba_xml::load_str(&xml, "test.xml", &ior_dir(), &[]).unwrap(), mode).unwrap();
@@ -182,4 +188,77 @@ fn tables_are_checked() {
         panic!("a diffuse")
     };
     assert!(d.reflectance.r() == 1.0 && (d.reflectance.g() - 0.9008).abs() < 1e-3 && d.reflectance.b() == 0.0, "{:?}", d.reflectance);
+}
+
+/// A measured RGL file in its spectral form (`spectra` at `wavelengths`): Mitsuba 3's spectral variants
+/// read it, its RGB variants refuse it (and spectral variants refuse RGB files). The file is made here
+/// from `cc_ibiza_sunset_rgb`: each cell's spectrum at 360, 370, …, 830 nm is the RGB file's r at λ ≥ 580
+/// nm, g at 500–570 nm, b at λ ≤ 490 nm and 0 between, copied exactly, so that the file Mitsuba rendered
+/// (written by a script with the same rule) and this one are the same bytes of data. Mitsuba
+/// 3.9.1 `scalar_spectral`, 2²⁰ spp on 4 × 4 pixels (2026-12-07), under the sky of three lines: (0.461258,
+/// 0.096889, 0.219852), and under a white sky (`<rgb value="1, 1, 1">`, D65 in a spectral variant):
+/// (0.291797, 0.121250, 0.177636). Spectral mode renders both; RGB mode, which reduces each cell's
+/// spectrum under D65, renders the white sky alike (one bounce, so the reduction is exact there).
+#[test]
+fn a_spectral_measured_file_renders_as_in_mitsuba() {
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/rgl");
+    let file =
+        TensorFile::open(&data.join("cc_ibiza_sunset_rgb.bsdf")).unwrap_or_else(|e| panic!("the shared RGL data must be present: {e}"));
+    let rgb = file.f32_field("rgb", 5).unwrap();
+    let shape = &rgb.shape;
+    let cells = shape[3] * shape[4];
+    let lambda: Vec<f32> = (0..48).map(|k| 360.0 + 10.0 * k as f32).collect();
+    let mut spectra = Vec::with_capacity(shape[0] * shape[1] * lambda.len() * cells);
+    for slice in 0..shape[0] * shape[1] {
+        let channel = |c: usize| &rgb.data[(slice * 3 + c) * cells..(slice * 3 + c + 1) * cells];
+        for &l in &lambda {
+            let c = if l >= 580.0 {
+                Some(0)
+            } else if (500.0..=570.0).contains(&l) {
+                Some(1)
+            } else if l <= 490.0 {
+                Some(2)
+            } else {
+                None
+            };
+            spectra.extend(c.map_or_else(|| vec![0.0; cells], |c| channel(c).to_vec()));
+        }
+    }
+    let spectra_shape = [shape[0], shape[1], lambda.len(), shape[3], shape[4]];
+    let (lambda_bytes, spectra_bytes) = (f32_bytes(&lambda), f32_bytes(&spectra));
+    let mut fields: Vec<(&str, DType, &[usize], &[u8])> = file
+        .fields()
+        .iter()
+        .filter(|f| f.name != "rgb")
+        .map(|f| (f.name.as_str(), f.dtype, f.shape.as_slice(), file.field_bytes(&f.name).unwrap()))
+        .collect();
+    let lambda_shape = [lambda.len()];
+    fields.push(("wavelengths", DType::F32, &lambda_shape, &lambda_bytes));
+    fields.push(("spectra", DType::F32, &spectra_shape, &spectra_bytes));
+    let path = std::env::temp_dir().join(format!("gonio-spectral-tables-{}-ibiza_spectral.bsdf", std::process::id()));
+    std::fs::write(&path, encode(&fields)).unwrap();
+
+    let bsdf = format!(r#"<bsdf type="measured"><string name="filename" value="{}"/></bsdf>"#, path.display());
+    let white = r#"<emitter type="constant"><rgb name="radiance" value="1, 1, 1"/></emitter>"#;
+    let renders = [
+        ("spectral, lines", render_plane(&bsdf, Mode::Spectral, 16384), [0.461_258, 0.096_889, 0.219_852]),
+        ("spectral, white", render_plane_under(white, &bsdf, Mode::Spectral, 16384), [0.291_797, 0.121_250, 0.177_636]),
+        ("RGB, white", render_plane_under(white, &bsdf, Mode::Rgb, 1024), [0.291_797, 0.121_250, 0.177_636]),
+    ];
+    let _ = std::fs::remove_file(&path);
+    for (what, img, mitsuba) in renders {
+        let img = mean_and_se(&img);
+        for c in 0..3 {
+            let ((mean, se), m) = (img[c], mitsuba[c]);
+            eprintln!("{what}: channel {c}: {mean:.5} ± {se:.5}, Mitsuba {m:.5}");
+            assert!((mean - m).abs() < 5.0 * se + 5e-3 * m, "{what}: channel {c}: {mean} ± {se}, Mitsuba {m}");
+        }
+    }
+
+    // The RGB file in spectral mode is refused, naming the plugin and what it lacks.
+    let rgb_bsdf =
+        format!(r#"<bsdf type="measured"><string name="filename" value="{}"/></bsdf>"#, data.join("cc_ibiza_sunset_rgb.bsdf").display());
+    let xml = format!(r#"<scene version="3.0.0"><shape type="rectangle">{rgb_bsdf}</shape></scene>"#);
+    let e = Scene::build_in(mitsuba_xml::load_str(&xml, "rgb.xml", &ior_dir(), &[]).unwrap(), Mode::Spectral).unwrap_err().to_string();
+    assert!(e.contains("rgb.xml") && e.contains("`measured`") && e.contains("RGB data only"), "{e}");
 }

@@ -955,6 +955,15 @@ impl Bsdf {
         }
     }
 
+    /// A `measured` model whose file holds spectra ([`Measured::has_spectra`]), to set at a path's
+    /// wavelengths in spectral mode.
+    pub fn measured_spectra(&mut self) -> Option<&mut Measured> {
+        match self {
+            Bsdf::Measured(m) if m.has_spectra() => Some(m),
+            _ => None,
+        }
+    }
+
     /// The field that holds this model's colour parameter `name`, where a texture can set it at a hit
     /// without building the model again: a reflectance in [0, 1] per channel (`Props::reflectance`) that
     /// the model reads as it is, deriving nothing from it when built. `None` where the model must be

@@ -7,8 +7,9 @@
 //! those a model reads as they are ([`Bsdf::reflectance_slot`]) and a conductor's index (a named metal's
 //! spectra, as Mitsuba 3's spectral variants read them, or `eta`/`k` given as colours), in the model itself
 //! or in the models it holds as they are ([`Bsdf::for_each_nested`]: a `twosided`, `blendbsdf`, `sum`,
-//! `mask`, `normalmap` or `bumpmap`). Everything else a model derives from a colour when it is built (an
-//! energy-compensated lobe, the colours of models that precompute from them, measured data, …) is refused
+//! `mask`, `normalmap` or `bumpmap`), and a `measured` file's spectra. Everything else a model derives
+//! from a colour when it is built (an energy-compensated lobe, the colours of models that precompute from
+//! them, RGB measured data, …) is refused
 //! at load by [`check_bsdf`], naming the parameter, rather than rendered wrongly. A model without colours
 //! (every colour grey, as a `dielectric`'s defaults) is the same at every wavelength and runs as in RGB
 //! mode.
@@ -330,8 +331,20 @@ fn check_model(p: &Props, convertible: bool) -> Result<Dependence> {
             _ => {}
         }
     }
-    if matches!(plugin, "measured" | "merl") {
-        return Err(Error::spec(p.at(), format!("spectral mode does not take `{plugin}` (its RGB data) yet; render it with --mode rgb")));
+    if plugin == "measured" {
+        if built()?.measured_spectra().is_none() {
+            return Err(Error::spec(
+                p.at(),
+                "spectral mode takes a `measured` file's spectra (fields `spectra` and `wavelengths`), and this file has RGB data only; render it with --mode rgb",
+            ));
+        }
+        if !convertible {
+            return Err(Error::spec(p.at(), "spectral mode does not take a `measured` model here yet; render it with --mode rgb"));
+        }
+        dependence = dependence.max(Dependence::Colours);
+    }
+    if plugin == "merl" {
+        return Err(Error::spec(p.at(), "spectral mode does not take `merl` (its RGB data); render it with --mode rgb"));
     }
     Ok(dependence)
 }
@@ -345,7 +358,8 @@ fn is_model(p: &Props) -> bool {
 /// each colour parameter of `CONVERTED` (those [`check_bsdf`] takes) replaced by its reflectance spectrum's
 /// values at `lambda` (the table it was given as, in `given`, clamped to [0, 1] as a texture's value; else
 /// its colour's upsampled spectrum), a conductor's index by its spectra's ([`crate::bsdf::Conductor::set_wavelengths`]),
-/// and a dispersive dielectric's by its value at the hero wavelength `lambda[0]`.
+/// a dispersive dielectric's by its value at the hero wavelength `lambda[0]`, and a `measured` file's
+/// spectra read at `lambda` ([`crate::bsdf::Measured::set_wavelengths`]).
 pub fn reflectances_at(b: &mut Bsdf, lambda: [f32; PATH_WAVELENGTHS], given: &GivenSpectra) {
     convert(b, lambda);
     for (slot, table) in &given.0 {
@@ -362,6 +376,9 @@ fn convert(b: &mut Bsdf, lambda: [f32; PATH_WAVELENGTHS]) {
     }
     if let Some((law, eta)) = b.dispersion_mut() {
         *eta = law.eta(lambda[0]);
+    }
+    if let Some(m) = b.measured_spectra() {
+        m.set_wavelengths(lambda);
     }
     for name in CONVERTED {
         if let Some(r) = b.reflectance_slot(name) {
