@@ -592,7 +592,8 @@ impl Props {
     /// The description in Mitsuba's dictionary form, which [`Props::from_json`] reads back to the same
     /// parameters: numbers, booleans, strings, lists (colours), points and vectors as three numbers,
     /// transforms as their 4 × 4 row-major matrix, nested plugins as objects with their `type` (and `id`),
-    /// tables and uniform emission spectra as `{"type": "spectrum"}` (other spectrum plugins as their RGB).
+    /// tables and uniform emission spectra as `{"type": "spectrum"}`, an emitter's `d65` and `blackbody` as
+    /// those plugins.
     #[must_use]
     pub fn to_json(&self) -> serde_json::Value {
         use serde_json::{json, Value as J};
@@ -607,6 +608,8 @@ impl Props {
                     json!({"type": "spectrum", "value": t.wavelengths().iter().zip(t.values()).map(|(l, v)| [*l, *v]).collect::<Vec<_>>()})
                 }
                 (_, Some(Spectrum::Constant(v))) => json!({"type": "spectrum", "value": v}),
+                (_, Some(Spectrum::D65 { scale })) => json!({"type": "d65", "scale": scale}),
+                (_, Some(Spectrum::Blackbody(b))) => json!({"type": "blackbody", "temperature": b.temperature()}),
                 (value, _) => value_json(value),
             };
             map.insert(e.name.clone(), v);
@@ -831,16 +834,43 @@ fn colour_value(c: Rgb) -> Value {
 pub const EMISSION: [&str; 3] = ["radiance", "intensity", "irradiance"];
 
 /// Parameter `name`'s `{"type": "spectrum"}` given as a table — `"value"` a list of [λ nm, value] pairs,
-/// or `"filename"` an `.spd` file — or, for an emission ([`EMISSION`]), as a number: its RGB reduction and
-/// spectrum, as the XML `<spectrum>` gives them ([`crate::xml::tabulated_spectrum`]). `None` for any other
-/// value (a colour's number, read by [`json_value`]).
+/// or `"filename"` an `.spd` file — or, for an emission ([`EMISSION`]), as a number, or a spectrum plugin
+/// (`{"type": "d65", "scale": …}`, `{"type": "blackbody", "temperature": …}`, `{"type": "uniform", "value":
+/// …}`): its RGB reduction and spectrum, as the XML `<spectrum>` gives them
+/// ([`crate::xml::tabulated_spectrum`], [`crate::xml::spectrum_of_plugin`]). `None` for any other value (a
+/// colour's number, read by [`json_value`]).
 fn json_spectrum(name: &str, v: &serde_json::Value, at: &str) -> Result<Option<(Rgb, Option<Spectrum>)>> {
     use serde_json::Value as J;
     let J::Object(map) = v else { return Ok(None) };
-    if map.get("type").and_then(J::as_str) != Some("spectrum") {
+    let emission = EMISSION.contains(&name);
+    let kind = map.get("type").and_then(J::as_str).unwrap_or_default();
+    if let Some(accepted) = crate::xml::spectrum_plugin_parameters(kind) {
+        // A spectrum plugin, {"type": "d65", "scale": 2}, {"type": "blackbody", "temperature": 5000} or
+        // {"type": "uniform", "value": 0.5}: the XML <spectrum type=…>'s.
+        let mut parameters = Vec::new();
+        for (key, value) in map.iter().filter(|(k, _)| *k != "type") {
+            let number = value.as_f64().filter(|v| v.is_finite());
+            match number {
+                Some(x) if accepted.contains(&key.as_str()) => parameters.push((key.clone(), x)),
+                _ => {
+                    return Err(Error::spec(
+                        at,
+                        format!("`{key}` in a `{kind}` spectrum: it takes a number for each of: {}", accepted.join(", ")),
+                    ))
+                }
+            }
+        }
+        if kind == "uniform" {
+            let v = parameters.first().map(|(_, v)| *v).ok_or_else(|| Error::spec(at, "a `uniform` spectrum needs a \"value\""))?;
+            return Ok(Some(crate::xml::uniform_spectrum(v, emission)));
+        }
+        return crate::xml::spectrum_of_plugin(kind, &parameters, emission)
+            .map(Some)
+            .map_err(|e| Error::spec(at, format!("`{kind}` spectrum: {e}")));
+    }
+    if kind != "spectrum" {
         return Ok(None);
     }
-    let emission = EMISSION.contains(&name);
     if let Some(extra) = map.keys().find(|k| !matches!(k.as_str(), "type" | "value" | "filename")) {
         return Err(Error::spec(at, format!("unknown key `{extra}` in a spectrum (it takes \"value\" or \"filename\")")));
     }
@@ -937,6 +967,45 @@ mod tests {
         let c = light.rgb_in("radiance", Rgb::ZERO, 0.0, f32::MAX).unwrap();
         assert!((c.r() / 2.0 - 1.2049).abs() < 1e-3 && (c.b() / 2.0 - 0.9093).abs() < 1e-3, "{c:?}");
         assert!(matches!(light.spectrum("radiance").as_deref(), Some(Spectrum::Constant(v)) if *v == 2.0));
+        // The spectrum plugins, as the XML <spectrum type=…> reads them, and back through `to_json`.
+        for (json, xml) in [
+            (r#"{"type": "d65", "scale": 2.5}"#, r#"<spectrum name="radiance" type="d65"><float name="scale" value="2.5"/></spectrum>"#),
+            (
+                r#"{"type": "blackbody", "temperature": 4000}"#,
+                r#"<spectrum name="radiance" type="blackbody"><float name="temperature" value="4000"/></spectrum>"#,
+            ),
+            (
+                r#"{"type": "uniform", "value": 3}"#,
+                r#"<spectrum name="radiance" type="uniform"><float name="value" value="3"/></spectrum>"#,
+            ),
+        ] {
+            let dict = Props::from_json(&format!(r#"{{"type": "area", "radiance": {json}}}"#)).unwrap();
+            let xml = Props::from_xml_element(
+                roxmltree::Document::parse(&format!(r#"<emitter type="area">{xml}</emitter>"#)).unwrap().root_element(),
+                &XmlSource::new("t.xml", ""),
+            )
+            .unwrap();
+            let rgb = |p: &Props| p.rgb_in("radiance", Rgb::ZERO, 0.0, f32::MAX).unwrap();
+            assert_eq!(rgb(&dict), rgb(&xml), "{json}");
+            assert_eq!(dict.spectrum("radiance"), xml.spectrum("radiance"), "{json}");
+            let back = Props::from_json(&dict.to_json().to_string()).unwrap();
+            assert_eq!((rgb(&back), back.spectrum("radiance")), (rgb(&dict), dict.spectrum("radiance")), "{json}");
+        }
+        let d65 = Props::from_json(r#"{"type": "area", "radiance": {"type": "d65", "scale": 2}}"#).unwrap();
+        assert_eq!(d65.rgb_in("radiance", Rgb::ZERO, 0.0, f32::MAX).unwrap(), Rgb::splat(2.0));
+        for (json, expect) in [
+            (r#"{"type": "blackbody"}"#, "$.radiance: `blackbody` spectrum: needs a `temperature` (K)"),
+            (r#"{"type": "blackbody", "temperature": -5}"#, "temperature > 0 K"),
+            (r#"{"type": "d65", "scale": "2"}"#, "`scale` in a `d65` spectrum: it takes a number for each of: scale"),
+            (r#"{"type": "d65", "temperature": 5000}"#, "`temperature` in a `d65` spectrum"),
+            (r#"{"type": "uniform"}"#, "a `uniform` spectrum needs a \"value\""),
+        ] {
+            let e = Props::from_json(&format!(r#"{{"type": "area", "radiance": {json}}}"#)).unwrap_err().to_string();
+            assert!(e.contains(expect), "{json}: {e}");
+        }
+        let e =
+            Props::from_json(r#"{"type": "diffuse", "reflectance": {"type": "blackbody", "temperature": 5000}}"#).unwrap_err().to_string();
+        assert!(e.contains("an emitter's spectrum"), "{e}");
         let grey = Props::from_json(r#"{"type": "diffuse", "reflectance": {"type": "spectrum", "value": 0.3}}"#).unwrap();
         assert_eq!(grey.rgb_in("reflectance", Rgb::ZERO, 0.0, 1.0).unwrap(), Rgb::splat(0.3));
         for (json, expect) in [

@@ -407,16 +407,11 @@ fn spectrum_plugin(
     uniform: &dyn Fn(f64) -> Result<(Rgb, Option<Spectrum>)>,
 ) -> Result<(Rgb, Option<Spectrum>)> {
     let at = xml_at(source, node);
-    let accepted: &[&str] = match kind {
-        "d65" => &["scale"],
-        "blackbody" => &["temperature"],
-        "uniform" => &["value"],
-        _ => {
-            return Err(Error::spec(
-                at,
-                format!("<spectrum type=\"{kind}\">: gonio reads the spectrum types d65, blackbody and uniform, and <spectrum value=…> or filename=…"),
-            ))
-        }
+    let Some(accepted) = spectrum_plugin_parameters(kind) else {
+        return Err(Error::spec(
+            at,
+            format!("<spectrum type=\"{kind}\">: gonio reads the spectrum types d65, blackbody and uniform, and <spectrum value=…> or filename=…"),
+        ));
     };
     let mut floats: Vec<(String, f64)> = Vec::new();
     for child in node.children().filter(roxmltree::Node::is_element) {
@@ -434,7 +429,33 @@ fn spectrum_plugin(
             .ok_or_else(|| Error::spec(&cat, format!("`{name}`: expected a number, got \"{raw}\"")))?;
         floats.push((name, v));
     }
-    let get = |name: &str| floats.iter().find(|(n, _)| n == name).map(|(_, v)| *v);
+    if kind == "uniform" {
+        let value = floats.first().map(|(_, v)| *v);
+        return uniform(value.ok_or_else(|| Error::spec(&at, "<spectrum type=\"uniform\"> needs <float name=\"value\">"))?);
+    }
+    spectrum_of_plugin(kind, &floats, within_emitter).map_err(|e| Error::spec(at, format!("<spectrum type=\"{kind}\">: {e}")))
+}
+
+/// The parameters of the spectrum plugin `kind` (`d65`, `blackbody`, `uniform`), `None` for another.
+pub(crate) fn spectrum_plugin_parameters(kind: &str) -> Option<&'static [&'static str]> {
+    match kind {
+        "d65" => Some(&["scale"]),
+        "blackbody" => Some(&["temperature"]),
+        "uniform" => Some(&["value"]),
+        _ => None,
+    }
+}
+
+/// The spectrum plugin `d65` or `blackbody` with its numeric `parameters` (checked by the caller against
+/// [`spectrum_plugin_parameters`]): its RGB reduction and, inside an emitter, its spectrum (see
+/// [`parse_spectrum`]). The XML `<spectrum type=…>` and the dictionary `{"type": "d65"}` read through it; the
+/// error is the problem alone, for the caller to place.
+pub(crate) fn spectrum_of_plugin(
+    kind: &str,
+    parameters: &[(String, f64)],
+    within_emitter: bool,
+) -> std::result::Result<(Rgb, Option<Spectrum>), String> {
+    let get = |name: &str| parameters.iter().find(|(n, _)| n == name).map(|(_, v)| *v);
     match kind {
         "d65" => {
             let scale = get("scale").unwrap_or(1.0);
@@ -442,17 +463,16 @@ fn spectrum_plugin(
             Ok((Rgb::splat(scale as f32), within_emitter.then_some(Spectrum::D65 { scale })))
         }
         "blackbody" => {
-            let temperature = get("temperature")
-                .ok_or_else(|| Error::spec(&at, "<spectrum type=\"blackbody\"> needs <float name=\"temperature\"> (K)"))?;
+            let temperature = get("temperature").ok_or("needs a `temperature` (K)")?;
             if !within_emitter || !(temperature > 0.0) {
-                return Err(Error::spec(at, "<spectrum type=\"blackbody\">: an emitter's spectrum, with a temperature > 0 K"));
+                return Err("an emitter's spectrum, with a temperature > 0 K".into());
             }
             let body = Blackbody::new(temperature, BlackbodyNormalization::Radiance);
             let w: Vec<f64> = (0..=470).map(|i| CIE_MIN + f64::from(i)).collect();
             let v: Vec<f64> = w.iter().map(|&l| body.eval(l)).collect();
             Ok((spectrum_to_rgb(&w, &v), Some(Spectrum::Blackbody(body))))
         }
-        _ => uniform(get("value").ok_or_else(|| Error::spec(&at, "<spectrum type=\"uniform\"> needs <float name=\"value\">"))?),
+        _ => Err(format!("not a spectrum plugin gonio reads: `{kind}`")),
     }
 }
 

@@ -58,7 +58,7 @@ fn emission_spectra_render_as_in_mitsuba() {
 #[test]
 fn spectrum_plugins_are_checked() {
     for (spectrum, expect) in [
-        (r#"<spectrum name="radiance" type="blackbody"/>"#, "needs <float name=\"temperature\">"),
+        (r#"<spectrum name="radiance" type="blackbody"/>"#, "needs a `temperature` (K)"),
         (r#"<spectrum name="radiance" type="blackbody"><float name="temperature" value="-3"/></spectrum>"#, "temperature > 0 K"),
         (
             r#"<spectrum name="radiance" type="d65"><float name="temperature" value="3"/></spectrum>"#,
