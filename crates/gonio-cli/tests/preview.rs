@@ -145,7 +145,6 @@ fn bad_input_is_one_line_and_exit_code_two() {
         (&["preview", d, "-o", "/tmp/sphere.jpg"], ".png, .exr or .hdr"),
         (&["preview", d, "--spp", "0", "-o", p], "--spp"),
         (&["preview", "/no/such/material.xml", "-o", p], "/no/such/material.xml"),
-        (&["preview", d, "--mode", "spectral", "--ray", "auto", "-o", p], "--ray renders in RGB mode only"),
         (
             &["preview", r#"{"type": "phong", "diffuse_reflectance": [0.8, 0.2, 0.1]}"#, "--mode", "spectral", "-o", p],
             "`diffuse_reflectance` of `phong`",

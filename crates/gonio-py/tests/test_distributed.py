@@ -109,6 +109,30 @@ def test_render_of_a_dict_with_a_gaussian_filter(cluster):
     assert np.array_equal(again.image, r.image)
 
 
+def test_spectral_render_equals_the_single_machine(cluster, tmp_path):
+    # Every task renders in the mode asked for (issue 30): a spectral dict render and a spectral file
+    # render (with `<spectrum>` tables, which must reach the workers) equal the local spectral renders as
+    # RGB renders equal theirs, and differ from RGB mode.
+    scene = gaussian_dict()
+    single = gonio.load_dict(scene, mode="spectral").render(spp=8, seed=2, progress=False)
+    r = distributed.render(scene, spp=8, seed=2, chunk_spp=3, progress=False, mode="spectral")
+    assert ulps(r.image, single).max() <= 1
+    rgb = gonio.load_dict(scene).render(spp=8, seed=2, progress=False)
+    assert not np.allclose(rgb, single, rtol=1e-3)
+    xml = tmp_path / "lines.xml"
+    xml.write_text("""<scene version="3.0.0"><sensor type="perspective"><float name="fov" value="30"/>
+        <transform name="to_world"><lookat origin="0,0,4" target="0,0,0" up="0,1,0"/></transform>
+        <film type="hdrfilm"><integer name="width" value="24"/><integer name="height" value="18"/></film></sensor>
+        <emitter type="constant"><spectrum name="radiance" value="400:0, 450:3, 500:0, 600:0, 650:3, 700:0"/></emitter>
+        <shape type="sphere"><bsdf type="diffuse"><spectrum name="reflectance" value="400:0.9, 550:0.1, 700:0.9"/></bsdf></shape>
+        </scene>""")
+    single = gonio.load_scene(str(xml), mode="spectral").render(spp=6, seed=1, progress=False)
+    whole = distributed.render(xml, spp=6, seed=1, chunk_spp=6, progress=False, mode="spectral")
+    assert np.array_equal(whole.image, single)
+    with pytest.raises(Exception, match="spectral"):
+        distributed.render(scene, spp=1, progress=False, mode="spectrum")
+
+
 def _render_workers() -> list:
     """Worker processes running a render task (Ray titles a worker `ray::<task>` while it runs one)."""
     pids = []
@@ -194,6 +218,14 @@ def test_cli_render_on_ray(cluster, tmp_path):
     assert p.returncode == 0, p.stderr
     single = gonio.load_scene(str(SCENE), **SMALL).render(spp=8, seed=4, progress=False)
     assert ulps(gonio.read_image(str(out)), single).max() <= 1
+    # --mode spectral reaches the tasks (a scene spectral mode takes: no measured RGB data).
+    scene = ROOT / "bench" / "scenes" / "plastics-point-spot.xml"
+    p = subprocess.run([str(CLI), "render", str(scene), "--ray", cluster.address, "-o", str(out), "--spp", "4", "--seed", "4",
+                        "-D", "width=40", "-D", "height=30", "--chunk-spp", "4", "--mode", "spectral", "-q"],
+                       capture_output=True, text=True, env=env, timeout=120)
+    assert p.returncode == 0, p.stderr
+    single = gonio.load_scene(str(scene), mode="spectral", width=40, height=30).render(spp=4, seed=4, progress=False)
+    assert np.array_equal(gonio.read_image(str(out)), single)
     # Without a Python that has gonio and Ray: one clear error, exit code 2.
     bad = {**os.environ, "GONIO_PYTHON": str(tmp_path / "no-python")}
     p = subprocess.run([str(CLI), "render", str(SCENE), "--ray", "auto"], capture_output=True, text=True, env=bad)
@@ -228,6 +260,16 @@ def test_preview_sweep_equals_the_local_preview(cluster, tmp_path):
     assert files == ["000_alpha=0.05_material=Au.exr", "001_alpha=0.05_material=Cu.exr",
                      "002_alpha=0.3_material=Au.exr", "003_alpha=0.3_material=Cu.exr"]
     assert np.array_equal(gonio.read_image(str(tmp_path / "spheres" / files[2])), r.images[2])
+
+
+def test_spectral_preview_equals_the_local_preview(cluster):
+    local = gonio.preview(CONDUCTOR, {"material": ["Au", "Cu"]}, light=(1, 1, 1), mode="spectral", **SPHERE)
+    r = distributed.preview(CONDUCTOR, {"material": ["Au", "Cu"]}, light=(1, 1, 1), mode="spectral", **SPHERE, progress=False)
+    assert all(np.array_equal(a, b) for a, b in zip(r.images, local.images))
+    rgb = gonio.preview(CONDUCTOR, {"material": ["Au"]}, light=(1, 1, 1), **SPHERE)
+    assert not np.array_equal(rgb.images[0], r.images[0])
+    with pytest.raises(ValueError, match="`mode` must be"):
+        distributed.preview(CONDUCTOR, mode="spectrum", progress=False)
 
 
 def test_preview_with_an_environment_file(cluster, tmp_path):

@@ -153,6 +153,9 @@ fn on_ray(address: &str, args: &Args) -> Result<ExitCode, Error> {
         a.extend([name.into(), value.into()]);
     }
     a.extend(["--exposure".into(), args.exposure.to_string().into()]);
+    if args.mode != "rgb" {
+        a.extend(["--mode".into(), args.mode.clone().into()]);
+    }
     if let Some(n) = args.threads {
         a.extend(["--cpus-per-task".into(), n.to_string().into()]);
     }
@@ -178,9 +181,6 @@ pub fn run(args: Args) -> Result<ExitCode, Error> {
     }
     let mode = Mode::parse(&args.mode)?;
     if let Some(address) = &args.ray {
-        if mode != Mode::Rgb {
-            return Err(arg_error("--ray renders in RGB mode only (yet); drop --mode spectral or --ray".into()));
-        }
         return on_ray(address, &args);
     }
     let lighting = lighting(&args)?;

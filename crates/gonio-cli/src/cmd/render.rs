@@ -76,6 +76,7 @@ fn on_ray(address: &str, args: &Args) -> Result<ExitCode, Error> {
     opt("--seed", args.seed.map(|v| v.to_string()));
     opt("--chunk-spp", args.chunk_spp.map(|v| v.to_string()));
     opt("--cpus-per-task", args.threads.map(|v| v.to_string()));
+    opt("--mode", (args.mode != "rgb").then(|| args.mode.clone()));
     for d in &args.define {
         a.push("-D".into());
         a.push(d.into());
@@ -93,9 +94,6 @@ fn arg_error(message: String) -> Error {
 pub fn run(args: Args) -> Result<ExitCode, Error> {
     let mode = Mode::parse(&args.mode)?;
     if let Some(address) = &args.ray {
-        if mode != Mode::Rgb {
-            return Err(arg_error("--ray renders in RGB mode only (yet); drop --mode spectral or --ray".into()));
-        }
         return on_ray(address, &args);
     }
     let overrides = args

@@ -161,11 +161,12 @@ def _scene(boxed: List[Any]) -> Any:
     key = ref.hex()
     if key not in _SCENES:
         bundle = ray.get(ref)
+        mode = bundle.get("mode", "rgb")
         if bundle["kind"] == "dict":
-            _SCENES[key] = load_dict(bundle["scene"])
+            _SCENES[key] = load_dict(bundle["scene"], mode=mode)
         else:
             root = _unpack(key, lambda: bundle["files"])
-            _SCENES[key] = load_scene(str(root / bundle["scene"]), **bundle["defines"])
+            _SCENES[key] = load_scene(str(root / bundle["scene"]), mode=mode, **bundle["defines"])
     return _SCENES[key]
 
 
@@ -230,6 +231,7 @@ def render(
     num_cpus: int = 1,
     progress: bool = True,
     defines: Optional[Mapping[str, Any]] = None,
+    mode: str = "rgb",
 ) -> RenderResult:
     """Render `scene` (a Mitsuba 3 XML file or a scene dictionary) on a Ray cluster.
 
@@ -237,13 +239,19 @@ def render(
     tasks per CPU of the cluster) with ``num_cpus`` threads; parts are merged in sample order as they
     finish (``ray.wait``), so the image does not depend on which tasks finished first or were retried.
     ``spp`` and ``seed`` default to the scene's sampler; ``defines`` are the scene's ``<default>``
-    overrides (as ``load_scene``'s keywords). Ctrl-C cancels the tasks still running and returns what was
+    overrides (as ``load_scene``'s keywords); ``mode`` is ``"rgb"`` or ``"spectral"`` (as ``load_scene``'s
+    and ``gonio render --mode``: every task renders in it). Ctrl-C cancels the tasks still running and returns what was
     merged (``cancelled=True``). A task that fails raises ``TaskError`` naming the scene and its samples.
     """
     defines = dict(defines or {})
     # Loaded here too: errors show before anything is sent, and the defaults come from the scene.
-    local = load_dict(dict(scene)) if isinstance(scene, Mapping) else load_scene(str(scene), **defines) if isinstance(scene, (str, os.PathLike)) else None
+    local = (
+        load_dict(dict(scene), mode=mode)
+        if isinstance(scene, Mapping)
+        else load_scene(str(scene), mode=mode, **defines) if isinstance(scene, (str, os.PathLike)) else None
+    )
     bundle, name = _bundle(scene, defines)
+    bundle["mode"] = mode
     spp = local.spp if spp is None else int(spp)
     seed = local.seed if seed is None else int(seed)
     if spp < 1:
@@ -522,9 +530,9 @@ def check_all(samples: int = 1_000_000, sweep: int = 1_000_000, seed: int = 0, a
 
 @ray.remote(max_retries=3, retry_exceptions=False)
 def _preview_task(boxed: List[Any], point: int) -> Dict[str, Any]:
-    sweep, lighting, settings = ray.get(boxed[0])
+    sweep, lighting, settings, mode = ray.get(boxed[0])
     start = time.perf_counter()
-    image, nonfinite = sweep.render(point, lighting, settings, threads=_threads())
+    image, nonfinite = sweep.render(point, lighting, settings, threads=_threads(), mode=mode)
     return {"image": image, "nonfinite": nonfinite, "seconds": time.perf_counter() - start,
             "node": ray.get_runtime_context().get_node_id()}
 
@@ -545,9 +553,11 @@ def preview(
     address: Optional[str] = None,
     num_cpus: int = 1,
     progress: bool = True,
+    mode: str = "rgb",
 ) -> PreviewResult:
     """``gonio.preview`` on a Ray cluster: one task per grid point (sphere), with ``num_cpus`` threads
-    each; the arguments and the result are ``gonio.preview``'s, and so are the images, bit for bit.
+    each; the arguments (``mode`` too) and the result are ``gonio.preview``'s, and so are the images, bit
+    for bit.
 
     The spec, grid and lighting are checked here (every point's material is built: a bad grid raises
     ``SpecError`` or ``TypeError`` naming the parameter before anything is sent) and put in the object
@@ -560,8 +570,10 @@ def preview(
     lighting = _gonio.PreviewLighting(env, None if light is None else tuple(light))
     if num_cpus < 1:
         raise ValueError(f"`num_cpus` must be at least 1, got {num_cpus}")
+    if mode not in ("rgb", "spectral"):
+        raise ValueError(f"`mode` must be \"rgb\" or \"spectral\", got {mode!r}")
     connect(address)
-    ref = ray.put((sweep, lighting, settings))
+    ref = ray.put((sweep, lighting, settings, mode))
     refs = [_preview_task.options(**_spread(num_cpus)).remote([ref], i) for i in range(len(sweep.labels))]
     labels = [f"{source}, grid point {label}" if label else source for label in sweep.labels]
     results = _run_batch(labels, refs, f"gonio preview (Ray, {len(refs)} tasks)", progress)

@@ -33,7 +33,7 @@ def _defines(pairs: List[str]) -> dict:
 def _render(a: argparse.Namespace) -> int:
     output = Path(a.output) if a.output else Path(a.scene).with_suffix(".exr")
     r = render(a.scene, spp=a.spp, seed=a.seed, address=a.address, chunk_spp=a.chunk_spp, num_cpus=a.cpus_per_task,
-               progress=not a.quiet, defines=_defines(a.define))
+               progress=not a.quiet, defines=_defines(a.define), mode=a.mode)
     if r.nonfinite:
         print(f"gonio: warning: {r.nonfinite} non-finite samples dropped (counted as black)", file=sys.stderr)
     if r.image is None:
@@ -120,7 +120,8 @@ def _preview(a: argparse.Namespace) -> int:
             raise ValueError(f"--light expects a direction X,Y,Z of three numbers, got `{a.light}`") from None
     spec, source = _spec_arg(a.bsdf)
     r = preview(spec, grid, env=a.env, light=light, size=a.size, spp=a.spp, seed=a.seed, output=a.output,
-                exposure=a.exposure, source=source, address=a.address, num_cpus=a.cpus_per_task, progress=not a.quiet)
+                exposure=a.exposure, source=source, address=a.address, num_cpus=a.cpus_per_task, progress=not a.quiet,
+                mode=a.mode)
     if r.nonfinite:
         print(f"gonio: warning: dropped {r.nonfinite} non-finite samples (counted as black)", file=sys.stderr)
     if not a.quiet:
@@ -141,6 +142,7 @@ def main(argv: Optional[List[str]] = None) -> int:
     r.add_argument("-D", dest="define", action="append", default=[], metavar="NAME=VALUE")
     r.add_argument("--chunk-spp", type=int, help="samples per pixel in each task (default: ~4 tasks per CPU)")
     r.add_argument("--cpus-per-task", type=int, default=1, help="CPUs (render threads) per task")
+    r.add_argument("--mode", choices=["rgb", "spectral"], default="rgb", help="how light is carried (as gonio render --mode)")
     r.add_argument("-q", "--quiet", action="store_true")
     f = sub.add_parser("fit", help="fit models to measured files, one task per file and model")
     f.add_argument("files", nargs="+")
@@ -168,6 +170,7 @@ def main(argv: Optional[List[str]] = None) -> int:
     v.add_argument("--seed", type=int, default=0)
     v.add_argument("--exposure", type=float, default=0.0)
     v.add_argument("--cpus-per-task", type=int, default=1)
+    v.add_argument("--mode", choices=["rgb", "spectral"], default="rgb", help="how light is carried (as gonio preview --mode)")
     v.add_argument("-q", "--quiet", action="store_true")
     for s in (r, f, c, v):
         s.add_argument("--address", default=argparse.SUPPRESS, help=argparse.SUPPRESS)
