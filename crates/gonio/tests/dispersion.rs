@@ -325,7 +325,9 @@ fn furnace(bsdf: &str) -> [(f64, f64); 3] {
 /// A white furnace through dispersive smooth interfaces: spheres of SF11 (`dielectric`) and of a Cauchy
 /// glass (`thindielectric`) under a constant white sky reflect or transmit everything, whatever each path's
 /// wavelength does at them, so the image is white (1, 1, 1) within noise. Terminating the secondary
-/// wavelengths without counting the hero for them would darken the spheres to about a third.
+/// wavelengths at the `dielectric` without counting the hero for them would darken it to about a third; the
+/// `thindielectric` keeps every wavelength, each channel weighted by its own reflectance over the chosen
+/// split's probability, which must average to 1 per channel.
 #[test]
 fn dispersive_interfaces_keep_a_white_furnace_white() {
     for bsdf in [
@@ -395,6 +397,11 @@ fn dispersive_indices_spectral_mode_cannot_follow_are_refused_at_load() {
     );
     let s = load(&blend, Mode::Spectral);
     assert_eq!(s.spectral.as_ref().map(|s| s.dependence.clone()), Some(vec![gonio::scene::spectral::Dependence::Dispersion]));
+    // A dispersive slab's directions do not depend on the index: its paths keep every wavelength (an index
+    // per channel, `ThinDielectric::set_wavelengths`), and are not terminated.
+    let slab = scene(r#"<bsdf type="thindielectric"><string name="int_ior" value="sf11"/></bsdf>"#);
+    let s = load(&slab, Mode::Spectral);
+    assert_eq!(s.spectral.as_ref().map(|s| s.dependence.clone()), Some(vec![gonio::scene::spectral::Dependence::Colours]));
 }
 
 /// The primary rainbow (Descartes): a ray entering a sphere of index n at incidence i, reflected once

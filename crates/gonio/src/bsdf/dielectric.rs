@@ -312,18 +312,37 @@ pub(crate) fn reflect_or_transmit<R: Real>(
     eta: R,
     transmits: R::Mask,
 ) -> LaneSample<R> {
+    let scale = (R::splat(1.0) - r) / (eta * eta);
+    let reflected = channels!(|c| r * reflectance.0[c]);
+    let transmitted = channels!(|c| scale * transmittance.0[c]);
+    split_sample(wo, uc, r, reflected, transmitted, wt, eta, transmits)
+}
+
+/// A delta sample that reflects `wo` about the normal with probability `p` (where `uc` < `p`), its value
+/// per channel `reflected`, and else goes to `wt` with value `transmitted` and relative index `eta` (valid
+/// where `transmits`): [`reflect_or_transmit`] with the values given per channel.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn split_sample<R: Real>(
+    wo: V3<R>,
+    uc: R,
+    p: R,
+    reflected: [R; 3],
+    transmitted: [R; 3],
+    wt: V3<R>,
+    eta: R,
+    transmits: R::Mask,
+) -> LaneSample<R> {
     let one = R::splat(1.0);
-    let reflected = uc.lt(r);
-    let t = one - r;
-    let scale = t / (eta * eta);
-    let value = channels!(|c| R::select(reflected, r * reflectance.0[c], scale * transmittance.0[c]));
-    let wi = V3::select(reflected, reflect_lanes(wo, V3::splat(Vec3::Z)), wt);
+    let chosen = uc.lt(p);
+    let value = channels!(|c| R::select(chosen, reflected[c], transmitted[c]));
+    let wi = V3::select(chosen, reflect_lanes(wo, V3::splat(Vec3::Z)), wt);
     let flags = R::select(
-        reflected,
+        chosen,
         flag_lanes(BsdfFlags::DELTA_REFLECTION | BsdfFlags::DELTA),
         flag_lanes(BsdfFlags::DELTA_TRANSMISSION | BsdfFlags::DELTA),
     );
-    LaneSample::delta(wi, value, R::select(reflected, r, t), flags, R::select(reflected, one, eta), reflected | transmits)
+    LaneSample::delta(wi, value, R::select(chosen, p, one - p), flags, R::select(chosen, one, eta), chosen | transmits)
 }
 
 impl crate::bsdf::Examples for Dielectric {

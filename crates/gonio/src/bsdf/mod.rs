@@ -922,15 +922,26 @@ impl Bsdf {
         }
     }
 
-    /// A dispersive dielectric interface's law and its relative index η, to set at a path's wavelength in
-    /// spectral mode (`dielectric`, `thindielectric`, and `roughdielectric` without energy compensation,
-    /// whose lobes are built from η; [`Self::is_dispersive`] tells those apart).
+    /// A dispersive dielectric interface's law and its relative index η, to set at a path's hero
+    /// wavelength in spectral mode (`dielectric`, and `roughdielectric` without energy compensation, whose
+    /// lobes are built from η; [`Self::is_dispersive`] tells those apart). A `thindielectric` takes every
+    /// wavelength instead ([`Self::set_wavelengths`]).
     pub fn dispersion_mut(&mut self) -> Option<(&dielectric::Dispersion, &mut f32)> {
         match self {
             Bsdf::Dielectric(d) => Some((d.dispersion.as_deref()?, &mut d.eta)),
-            Bsdf::ThinDielectric(d) => Some((d.dispersion.as_deref()?, &mut d.eta)),
             Bsdf::RoughDielectric(d) if d.compensation.is_none() => Some((d.dispersion.as_deref()?, &mut d.eta)),
             _ => None,
+        }
+    }
+
+    /// Set the models that read a path's wavelengths themselves to `lambda` (nm, one per channel): a
+    /// `measured` file's spectra ([`Measured::set_wavelengths`]) and a dispersive `thindielectric`'s index
+    /// per channel ([`ThinDielectric::set_wavelengths`]); other models are unchanged.
+    pub fn set_wavelengths(&mut self, lambda: [f32; 3]) {
+        match self {
+            Bsdf::Measured(m) => m.set_wavelengths(lambda),
+            Bsdf::ThinDielectric(t) => t.set_wavelengths(lambda),
+            _ => {}
         }
     }
 
@@ -951,15 +962,6 @@ impl Bsdf {
         match self {
             Bsdf::Conductor(c) => Some(c),
             Bsdf::RoughConductor(RoughConductor(c)) if c.compensation.is_none() => Some(&mut c.fresnel),
-            _ => None,
-        }
-    }
-
-    /// A `measured` model whose file holds spectra ([`Measured::has_spectra`]), to set at a path's
-    /// wavelengths in spectral mode.
-    pub fn measured_spectra(&mut self) -> Option<&mut Measured> {
-        match self {
-            Bsdf::Measured(m) if m.has_spectra() => Some(m),
             _ => None,
         }
     }

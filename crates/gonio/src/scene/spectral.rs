@@ -68,10 +68,11 @@ pub enum Dependence {
     /// The same at every wavelength (every colour grey): it runs as in RGB mode.
     #[default]
     None,
-    /// It has colours: each lane runs a copy of its model set to the lane's wavelengths
-    /// ([`reflectances_at`]).
+    /// It has colours (or a model that reads the wavelengths itself, [`Bsdf::set_wavelengths`]): each lane
+    /// runs a copy of its model set to the lane's wavelengths ([`reflectances_at`]).
     Colours,
-    /// Its index of refraction varies with wavelength ([`crate::bsdf::dielectric::Dispersion`]): each lane
+    /// Its index of refraction varies with wavelength ([`crate::bsdf::dielectric::Dispersion`]) and its
+    /// directions with it (a `dielectric` or `roughdielectric`; a `thindielectric`'s do not): each lane
     /// runs a copy of its model at the lane's hero wavelength, and the path follows that wavelength alone
     /// from there (the others are terminated: pbrt-v4's rule, docs/spectral.md).
     Dispersion,
@@ -254,7 +255,7 @@ pub fn check_bsdf(p: &Props) -> Result<Dependence> {
 /// [`check_bsdf`] for a model reached through [`CONTAINERS`] only (`convertible`) or not. A colour is taken
 /// where [`reflectances_at`] sets it: the model built from `p` (its textures left at their defaults) holds
 /// it in a [`Bsdf::reflectance_slot`], or it is a conductor's named metal ([`Bsdf::conductor_fresnel`]). A
-/// dispersive index is taken where [`Bsdf::dispersion_mut`] sets it.
+/// dispersive index is taken where [`Bsdf::dispersion_mut`] or [`Bsdf::set_wavelengths`] sets it.
 fn check_model(p: &Props, convertible: bool) -> Result<Dependence> {
     let plugin = p.plugin_type();
     let compensated = p.values().any(|(name, v, _)| name == "energy_compensation" && matches!(v, Value::Bool(true)));
@@ -268,7 +269,16 @@ fn check_model(p: &Props, convertible: bool) -> Result<Dependence> {
         Ok(model.clone().unwrap_or_else(|| unreachable!("built above")))
     };
     let mut dependence = Dependence::None;
-    if matches!(plugin, "dielectric" | "thindielectric" | "roughdielectric") && built()?.is_dispersive() {
+    if plugin == "thindielectric" && built()?.is_dispersive() {
+        // Its directions do not depend on the index: it takes every wavelength (`ThinDielectric::set_wavelengths`).
+        if !convertible {
+            return Err(Error::spec(
+                p.at(),
+                "spectral mode does not take a dispersive index here (`int_ior`/`ext_ior` of `thindielectric`) yet; render it with --mode rgb",
+            ));
+        }
+        dependence = Dependence::Colours;
+    } else if matches!(plugin, "dielectric" | "roughdielectric") && built()?.is_dispersive() {
         let refuse = |what: &str| {
             Err(Error::spec(
                 p.at(),
@@ -332,7 +342,7 @@ fn check_model(p: &Props, convertible: bool) -> Result<Dependence> {
         }
     }
     if plugin == "measured" {
-        if built()?.measured_spectra().is_none() {
+        if !matches!(built()?, Bsdf::Measured(m) if m.has_spectra()) {
             return Err(Error::spec(
                 p.at(),
                 "spectral mode takes a `measured` file's spectra (fields `spectra` and `wavelengths`), and this file has RGB data only; render it with --mode rgb",
@@ -358,8 +368,9 @@ fn is_model(p: &Props) -> bool {
 /// each colour parameter of `CONVERTED` (those [`check_bsdf`] takes) replaced by its reflectance spectrum's
 /// values at `lambda` (the table it was given as, in `given`, clamped to [0, 1] as a texture's value; else
 /// its colour's upsampled spectrum), a conductor's index by its spectra's ([`crate::bsdf::Conductor::set_wavelengths`]),
-/// a dispersive dielectric's by its value at the hero wavelength `lambda[0]`, and a `measured` file's
-/// spectra read at `lambda` ([`crate::bsdf::Measured::set_wavelengths`]).
+/// a dispersive dielectric's by its value at the hero wavelength `lambda[0]`, and the models that read
+/// `lambda` themselves ([`Bsdf::set_wavelengths`]: a `measured` file's spectra, a dispersive
+/// `thindielectric`'s index per channel).
 pub fn reflectances_at(b: &mut Bsdf, lambda: [f32; PATH_WAVELENGTHS], given: &GivenSpectra) {
     convert(b, lambda);
     for (slot, table) in &given.0 {
@@ -377,9 +388,7 @@ fn convert(b: &mut Bsdf, lambda: [f32; PATH_WAVELENGTHS]) {
     if let Some((law, eta)) = b.dispersion_mut() {
         *eta = law.eta(lambda[0]);
     }
-    if let Some(m) = b.measured_spectra() {
-        m.set_wavelengths(lambda);
-    }
+    b.set_wavelengths(lambda);
     for name in CONVERTED {
         if let Some(r) = b.reflectance_slot(name) {
             *r = Rgb(reflectance_at(r.0, lambda));
