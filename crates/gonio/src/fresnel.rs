@@ -7,6 +7,7 @@
 //! pbrt-v4 §9.3 (the complex-index form for conductors).
 
 use crate::math::lanes::{channels, Real, V3};
+use crate::math::param::{Param, PerLane, PER_LANE};
 use crate::math::Vec3;
 use crate::spectrum::Rgb;
 
@@ -158,15 +159,59 @@ pub fn fresnel_diffuse_reflectance(eta: f32) -> f64 {
 /// conductor kernels are bound by divisions and square roots; the callers' ratios are homogeneous in a
 /// and b, so ℓ cancels). a = b = 0 (η = sin θᵢ, k = 0) comes back as (0, 0, 1).
 #[inline(always)]
-fn conductor_cos_t<R: Real>(eta_k2: f32, eta_k: f32, sin2_i: R) -> (R, R, R) {
-    let t = R::splat(eta_k2) - sin2_i;
-    let m = (t * t + 4.0 * eta_k * eta_k).sqrt();
+fn conductor_cos_t<R: Real, P: Param>(index: &ConductorIndex<P>, sin2_i: R) -> (R, R, R) {
+    let t = index.e.lanes::<R>() - sin2_i;
+    let m = (t * t + index.four_eta_k2.lanes::<R>()).sqrt();
     let larger2 = (m + t.abs()) * 0.5;
     let zero = R::splat(0.0);
     let ell = R::select(larger2.gt(zero), larger2.sqrt(), R::splat(1.0));
-    let smaller = R::splat(eta_k.abs());
+    let smaller = index.abs_eta_k.lanes::<R>();
     let positive = t.ge(zero);
     (R::select(positive, larger2, smaller), R::select(positive, smaller, larger2), ell)
+}
+
+/// What the conductor Fresnel term reads of a complex index η + i k, computed once per index (one value,
+/// or one per lane: [`Param`]): η̃² = e + i f (e = η² − k², f = 2ηk), 4η²k² and |ηk| for
+/// [`conductor_cos_t`], and the scales σₛ = 1/(1 + |η̃|²), σₚ = σₛ/(1 + e² + f²) that keep the Fresnel
+/// term's products from overflow ([`fresnel_conductor`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ConductorIndex<P> {
+    pub e: P,
+    pub f: P,
+    pub four_eta_k2: P,
+    pub abs_eta_k: P,
+    pub sigma_s: P,
+    pub sigma_p: P,
+}
+
+impl ConductorIndex<f32> {
+    /// The index η + i k.
+    #[inline(always)]
+    #[must_use]
+    pub fn new(eta: f32, k: f32) -> Self {
+        // Products of sums rather than differences of squares: exact to a rounding or two near η = k.
+        let (e, f) = ((eta - k) * (eta + k), 2.0 * eta * k);
+        let eta_k = eta * k;
+        let abs2 = (e * e + f * f).sqrt();
+        let (sigma_s, sigma_p) = (1.0 / (1.0 + abs2), 1.0 / ((1.0 + abs2) * (1.0 + e * e + f * f)));
+        ConductorIndex { e, f, four_eta_k2: 4.0 * eta_k * eta_k, abs_eta_k: eta_k.abs(), sigma_s, sigma_p }
+    }
+}
+
+impl ConductorIndex<PerLane> {
+    /// The indices of the lanes of a packet, one per lane ([`PerLane`]).
+    #[must_use]
+    pub fn per_lane(lanes: [ConductorIndex<f32>; PER_LANE]) -> Self {
+        let field = |get: fn(&ConductorIndex<f32>) -> f32| PerLane(lanes.each_ref().map(get));
+        ConductorIndex {
+            e: field(|i| i.e),
+            f: field(|i| i.f),
+            four_eta_k2: field(|i| i.four_eta_k2),
+            abs_eta_k: field(|i| i.abs_eta_k),
+            sigma_s: field(|i| i.sigma_s),
+            sigma_p: field(|i| i.sigma_p),
+        }
+    }
 }
 
 /// Unpolarised Fresnel reflectance of a conductor with complex relative index η + i k, for light arriving
@@ -193,19 +238,24 @@ pub fn fresnel_conductor(cos_theta_i: f32, eta: f32, k: f32) -> f32 {
 #[inline(always)]
 #[must_use]
 pub fn fresnel_conductor_lanes<R: Real>(cos_theta_i: R, eta: f32, k: f32) -> R {
+    fresnel_conductor_at(cos_theta_i, &ConductorIndex::new(eta, k))
+}
+
+/// [`fresnel_conductor_lanes`] of an index computed once ([`ConductorIndex`]: one value, or one per lane).
+#[inline(always)]
+#[must_use]
+pub fn fresnel_conductor_at<R: Real, P: Param>(cos_theta_i: R, index: &ConductorIndex<P>) -> R {
     let c = cos_theta_i.clamp(0.0, 1.0);
-    // Products of sums rather than differences of squares: exact to a rounding or two near c = 1, η = k.
+    // Products of sums rather than differences of squares: exact to a rounding or two near c = 1.
     // (No `mul_add`: without a target FMA it is a library call per use, which would dominate.)
     let sin2_i = (R::splat(1.0) - c) * (c + 1.0);
-    let (e, f) = ((eta - k) * (eta + k), 2.0 * eta * k);
-    let (x, y, ell) = conductor_cos_t(e, eta * k, sin2_i);
+    let (x, y, ell) = conductor_cos_t(index, sin2_i);
     let cl = c * ell;
     // Rₛ's terms grow as |η̃|⁴ (ℓ² ~ |η̃|²) and Rₚ's as |η̃|⁶: scaled by σₛ ≈ 1/|η̃|² and σₚ ≈ 1/|η̃|⁶ (each
     // ratio is unchanged) so that the product of the denominators stays far from overflow.
-    let abs2 = (e * e + f * f).sqrt();
-    let (sigma_s, sigma_p) = (1.0 / (1.0 + abs2), 1.0 / ((1.0 + abs2) * (1.0 + e * e + f * f)));
+    let (sigma_s, sigma_p) = (index.sigma_s.lanes::<R>(), index.sigma_p.lanes::<R>());
     let (ns, ds) = (sum_of_squares(cl - x, y) * sigma_s, sum_of_squares(cl + x, y) * sigma_s);
-    let (ecl, fcl) = (cl * e, cl * f);
+    let (ecl, fcl) = (cl * index.e.lanes::<R>(), cl * index.f.lanes::<R>());
     let (np, dp) = (sum_of_squares(ecl - x, fcl - y) * sigma_p, sum_of_squares(ecl + x, fcl + y) * sigma_p);
     // Rₛ + Rₚ over one denominator; the numerator is a sum of non-negative terms.
     (ns * dp + np * ds) / (ds * dp) * 0.5

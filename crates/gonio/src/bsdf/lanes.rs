@@ -181,6 +181,10 @@ pub enum PerLaneKernel<'a> {
     /// Boxed: its constants per lane (~0.7 KB) would make every kernel that size, and the path tracer keeps
     /// one per group of lanes in each packet's shading.
     Principled(Box<PrincipledLobes<PerLane>>),
+    /// A rough conductor with its roughness and its Fresnel term per lane ([`Bsdf::kernel_of_lanes`]:
+    /// spectral mode's copies of one model at each lane's wavelengths). Boxed, as `Principled`.
+    ConductorLanesGgx(Box<ConductorLobe<Ggx<PerLane>, PerLane>>),
+    ConductorLanesBeckmann(Box<ConductorLobe<Beckmann<PerLane>, PerLane>>),
 }
 
 /// Each kernel of [`PerLaneKernel`], bound to `$k` in `$body`.
@@ -195,6 +199,8 @@ macro_rules! on_per_lane {
             PerLaneKernel::RoughPlasticBeckmann($k) => $body,
             PerLaneKernel::Plastic($k) => $body,
             PerLaneKernel::Principled($k) => $body,
+            PerLaneKernel::ConductorLanesGgx($k) => $body,
+            PerLaneKernel::ConductorLanesBeckmann($k) => $body,
         }
     };
 }

@@ -43,9 +43,10 @@
 //! The RGL database also ships spectral files, whose reflectance is `spectra` at `wavelengths` (the
 //! spectrum of each cell of the reflectance square) instead of `rgb`.
 //! - **RGB mode** reduces each cell's spectrum — piecewise linear between the wavelengths, and outside
-//!   them the value at the nearer end, as Mitsuba 3's spectral variants read it (below) — to linear sRGB at load by [`SpectrumToRgb::under_d65`], the same reduction of reflectance
-//!   spectra as the XML `<spectrum>` of a BSDF ([`crate::spectrum::named::reflectance_to_rgb`]: the colour
-//!   under D65, so that a flat spectrum stays grey). The reduction is linear, so the table then behaves
+//!   them the value at the nearer end, as Mitsuba 3's spectral variants read it (below) — to linear sRGB
+//!   at load by [`SpectrumToRgb::under_d65`], the same reduction of reflectance spectra as the XML
+//!   `<spectrum>` of a BSDF ([`crate::spectrum::named::reflectance_to_rgb`]: the colour under D65, so
+//!   that a flat spectrum stays grey). The reduction is linear, so the table then behaves
 //!   exactly as an RGB table would (it is not clamped per cell; f clamps after interpolation, as for RGB
 //!   files). A file with both fields uses `rgb`, as Mitsuba's RGB variants do.
 //! - **Spectral mode** (issue 30) evaluates the spectra at the path's wavelengths

@@ -863,6 +863,34 @@ impl Bsdf {
         }
     }
 
+    /// One kernel for the lanes of a packet whose models are copies of this one that differ only where
+    /// spectral mode sets each lane's copy at its wavelengths ([`crate::scene::spectral::reflectances_at`]),
+    /// or where a texture sets each lane's roughness: `models[lane]`, `None` for lanes not in the group.
+    /// The rough conductors (`roughconductor`, `torrance_sparrow` with GGX or Beckmann, without energy
+    /// compensation: their roughness and Fresnel term per lane); `None` for other models, which then run
+    /// one lane at a time. Each lane's values are its own model's, bit for bit (test
+    /// `kernels_of_lanes_are_each_lanes_model`).
+    #[must_use]
+    pub fn kernel_of_lanes(&self, models: &[Option<&Bsdf>; PER_LANE]) -> Option<PerLaneKernel<'static>> {
+        fn conductor(b: &Bsdf) -> Option<&MicrofacetConductor> {
+            match b {
+                Bsdf::RoughConductor(RoughConductor(c)) | Bsdf::TorranceSparrow(TorranceSparrow(c)) => Some(c),
+                _ => None,
+            }
+        }
+        let own = conductor(self)?;
+        let mut lanes = [None; PER_LANE];
+        for (lane, model) in lanes.iter_mut().zip(models) {
+            if let Some(m) = model {
+                if std::mem::discriminant(*m) != std::mem::discriminant(self) {
+                    return None;
+                }
+                *lane = Some(conductor(m)?);
+            }
+        }
+        own.kernel_of_lanes(&lanes)
+    }
+
     /// The models this one built from the k-th of its `count` nested descriptions (`Props::nested`'s
     /// order) and holds as they are, where a texture on a parameter of that description can be set at a
     /// hit ([`Self::reflectance_slot`], [`Self::set_float`]) without building this model again:
@@ -1222,6 +1250,93 @@ mod tests {
     /// roughness parameter and the base colours, over roughnesses from 0 (clamped to 10⁻⁴)
     /// to beyond 10 and reflectances beyond [0, 1], every lane a different one. Models and parameters it
     /// does not cover have none.
+    /// Spectral mode's copies of a rough conductor at each lane's wavelengths (and each lane's roughness)
+    /// run as one kernel (`Bsdf::kernel_of_lanes`), each lane's f, pdf and sample its own model's bit for
+    /// bit; models that differ otherwise, or have no such kernel, are refused.
+    #[test]
+    fn kernels_of_lanes_are_each_lanes_model() {
+        use crate::math::lanes::{Real, V3};
+        use crate::math::simd::Float8;
+        use crate::scene::spectral::{reflectances_at, GivenSpectra};
+        use lanes::LaneModel;
+        let cases = [
+            r#"{"type": "roughconductor"}"#,
+            r#"{"type": "roughconductor", "distribution": "ggx", "material": "Cu", "specular_reflectance": [0.9, 0.6, 0.3]}"#,
+            r#"{"type": "roughconductor", "alpha_u": 0.05, "alpha_v": 0.4, "eta": [0.2, 0.9, 1.1], "k": [3.9, 2.4, 2.2]}"#,
+            r#"{"type": "roughconductor", "distribution": "ggx", "sample_visible": false, "material": "Ag"}"#,
+            r#"{"type": "roughconductor", "material": "none"}"#,
+            r#"{"type": "torrance_sparrow", "distribution": "beckmann", "material": "Al"}"#,
+        ];
+        let mut rng = Pcg32::new(23, 0);
+        let dir = |rng: &mut Pcg32| {
+            let v = Vec3::new(2.0 * rng.next_f32() - 1.0, 2.0 * rng.next_f32() - 1.0, 2.0 * rng.next_f32() - 1.0);
+            v.try_normalize().unwrap_or(Vec3::Z)
+        };
+        for json in cases {
+            let model = Bsdf::from_json(json).unwrap();
+            for round in 0..200 {
+                // Lanes 2 and 5 are not in the group (another material's lanes in a packet).
+                let own: Vec<Bsdf> = (0..PER_LANE)
+                    .map(|_| {
+                        let mut m = model.clone();
+                        let lambda = [0, 1, 2].map(|_| 360.0 + 470.0 * rng.next_f32());
+                        reflectances_at(&mut m, lambda, &GivenSpectra::NONE);
+                        if round % 2 == 1 {
+                            assert!(m.set_float("alpha", 10f32.powf(-3.0 + 3.0 * rng.next_f32())));
+                        }
+                        m
+                    })
+                    .collect();
+                let lanes: [Option<&Bsdf>; PER_LANE] = std::array::from_fn(|l| (l != 2 && l != 5).then_some(&own[l]));
+                let kernel = own[0].kernel_of_lanes(&lanes).unwrap_or_else(|| panic!("{json}: a kernel"));
+                let (wo, wi): (Vec<Vec3>, Vec<Vec3>) = (0..PER_LANE).map(|_| (dir(&mut rng), dir(&mut rng))).unzip();
+                let lanes8 = |v: &[Vec3]| V3::new(Float8::from_fn(|i| v[i].x), Float8::from_fn(|i| v[i].y), Float8::from_fn(|i| v[i].z));
+                let (uc, ux, uy) =
+                    (Float8::from_fn(|_| rng.next_f32()), Float8::from_fn(|_| rng.next_f32()), Float8::from_fn(|_| rng.next_f32()));
+                let f = kernel.f_lanes(lanes8(&wo), lanes8(&wi));
+                let pdf = kernel.pdf_lanes(lanes8(&wo), lanes8(&wi));
+                let s = kernel.sample_lanes(lanes8(&wo), uc, ux, uy);
+                let valid = Float8::bitmask(s.valid);
+                for l in (0..PER_LANE).filter(|l| lanes[*l].is_some()) {
+                    let at = format!("{json}, lane {l}, {} → {}", wo[l], wi[l]);
+                    let want = own[l].f(wo[l], wi[l]);
+                    for (got, want) in f.iter().map(|c| c.lane(l)).zip(want.0) {
+                        assert_eq!(got.to_bits(), want.to_bits(), "{at}: f {got} against {want}");
+                    }
+                    assert_eq!(pdf.lane(l).to_bits(), own[l].pdf(wo[l], wi[l]).to_bits(), "{at}: pdf");
+                    match own[l].sample(wo[l], uc.lane(l), Vec2::new(ux.lane(l), uy.lane(l))) {
+                        Some(b) => {
+                            assert!(valid & (1 << l) != 0, "{at}: a sample in the model only");
+                            let a_wi = Vec3::new(s.wi.x.lane(l), s.wi.y.lane(l), s.wi.z.lane(l));
+                            assert_eq!((a_wi, s.pdf.lane(l).to_bits()), (b.wi, b.pdf.to_bits()), "{at}: sample");
+                            for (got, want) in s.weight.iter().map(|c| c.lane(l)).zip(b.weight.0) {
+                                assert_eq!(got.to_bits(), want.to_bits(), "{at}: weight");
+                            }
+                        }
+                        None => assert!(valid & (1 << l) == 0, "{at}: a sample in the kernel only"),
+                    }
+                }
+            }
+        }
+        // Refused: a mirror beside a metal, another model, energy compensation, Blinn, other models.
+        let of = |json: &str| Bsdf::from_json(json).unwrap();
+        let (gold, mirror) =
+            (of(r#"{"type": "roughconductor", "material": "Au"}"#), of(r#"{"type": "roughconductor", "material": "none"}"#));
+        let pair = |a: &Bsdf, b: &Bsdf| {
+            let lanes: [Option<&Bsdf>; PER_LANE] = std::array::from_fn(|l| Some(if l == 3 { b } else { a }));
+            a.kernel_of_lanes(&lanes).is_some()
+        };
+        assert!(pair(&gold, &gold) && !pair(&gold, &mirror));
+        assert!(!pair(&gold, &of(r#"{"type": "roughconductor", "material": "Au", "distribution": "ggx"}"#)));
+        assert!(!pair(&gold, &of(r#"{"type": "torrance_sparrow", "material": "Au", "distribution": "beckmann"}"#)));
+        let compensated = of(r#"{"type": "roughconductor", "energy_compensation": true}"#);
+        assert!(!pair(&compensated, &compensated));
+        let blinn = of(r#"{"type": "torrance_sparrow", "distribution": "blinn"}"#);
+        assert!(!pair(&blinn, &blinn));
+        let plastic = of(r#"{"type": "roughplastic"}"#);
+        assert!(!pair(&plastic, &plastic));
+    }
+
     #[test]
     fn per_lane_parameters_are_each_lanes_model() {
         use crate::math::lanes::{Real, V3};

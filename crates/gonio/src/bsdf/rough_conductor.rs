@@ -49,9 +49,9 @@ use super::energy_compensation::ConductorCompensation;
 use super::lanes::{f_one, flag_lanes, pdf_one, sample_one, LaneModel, LaneSample, PerLaneKernel};
 use super::{BsdfFlags, BsdfModel, BsdfSample, Conductor};
 use crate::error::{Error, Result};
-use crate::fresnel::fresnel_conductor_rgb_lanes;
+use crate::fresnel::{fresnel_conductor_at, ConductorIndex};
 use crate::math::lanes::{channels, Real, V3};
-use crate::math::param::PerLane;
+use crate::math::param::{Param, PerLane, PER_LANE};
 use crate::math::{Vec2, Vec3};
 use crate::microfacet::reflection::ReflectionLobe;
 use crate::microfacet::{alpha_from_blinn_exponent, on_distribution, Distribution, MicrofacetDistribution, MicrofacetKind, Shadowing};
@@ -173,8 +173,46 @@ impl MicrofacetConductor {
     /// The glossy lobe with the distribution `d`: this model's own, or its kind with a roughness per lane.
     #[inline(always)]
     fn lobe<D>(&self, d: D) -> ConductorLobe<D> {
-        let fresnel = ConductorFresnel { eta_k: self.fresnel.eta_k, specular_reflectance: self.fresnel.specular_reflectance };
+        self.lobe_with(d, ConductorFresnel::of(&self.fresnel))
+    }
+
+    /// The glossy lobe with the distribution `d` and the Fresnel term `fresnel` (this model's, or one per lane).
+    #[inline(always)]
+    fn lobe_with<D, P>(&self, d: D, fresnel: ConductorFresnel<P>) -> ConductorLobe<D, P> {
         ConductorLobe { lobe: ReflectionLobe { distribution: d, shadowing: self.shadowing, visible: self.sample_visible }, fresnel }
+    }
+
+    /// The kernel of the lanes `models` (lane → its model; lanes without a model take the first's), each a
+    /// copy of this model that may differ from it in its roughness and its Fresnel term only — as spectral
+    /// mode's copies at each lane's wavelengths do ([`Bsdf::kernel_of_lanes`](super::Bsdf::kernel_of_lanes)):
+    /// one kernel call for the lanes instead of one per lane. `None` with energy compensation, for Blinn,
+    /// or where the lanes differ in anything else (a mirror beside a metal, another distribution).
+    pub(crate) fn kernel_of_lanes(&self, models: &[Option<&MicrofacetConductor>; PER_LANE]) -> Option<PerLaneKernel<'static>> {
+        if self.compensation.is_some() {
+            return None;
+        }
+        let model = |l: usize| models[l].unwrap_or(self);
+        let alike = (0..PER_LANE).all(|l| {
+            let m = model(l);
+            m.compensation.is_none()
+                && m.distribution.kind == self.distribution.kind
+                && m.shadowing == self.shadowing
+                && m.sample_visible == self.sample_visible
+                && m.fresnel.eta_k.is_some() == self.fresnel.eta_k.is_some()
+        });
+        if !alike {
+            return None;
+        }
+        let alphas = (
+            PerLane(std::array::from_fn(|l| model(l).distribution.alpha_x)),
+            PerLane(std::array::from_fn(|l| model(l).distribution.alpha_y)),
+        );
+        let fresnel = ConductorFresnel::per_lane(std::array::from_fn(|l| ConductorFresnel::of(&model(l).fresnel)));
+        self.distribution.per_lane(
+            alphas,
+            |d| PerLaneKernel::ConductorLanesGgx(Box::new(self.lobe_with(d, fresnel))),
+            |d| PerLaneKernel::ConductorLanesBeckmann(Box::new(self.lobe_with(d, fresnel))),
+        )
     }
 
     /// The kernel of this model with the roughness (`ax`, `ay`) of each lane instead of its own (GGX and
@@ -198,34 +236,61 @@ impl MicrofacetConductor {
     }
 }
 
-/// A conductor's Fresnel term: the complex index (`None`: a perfect mirror) and the multiplier.
+/// A conductor's Fresnel term per channel: the complex index, as the Fresnel term reads it (`None`: a
+/// perfect mirror), and the multiplier; one value each (`f32`: a model's) or one per lane ([`PerLane`]:
+/// the lanes of [`MicrofacetConductor::kernel_of_lanes`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ConductorFresnel {
-    pub eta_k: Option<(Rgb, Rgb)>,
-    pub specular_reflectance: Rgb,
+pub struct ConductorFresnel<P = f32> {
+    pub index: Option<[ConductorIndex<P>; 3]>,
+    pub specular_reflectance: [P; 3],
+}
+
+impl ConductorFresnel {
+    /// The Fresnel term of the smooth conductor `c`.
+    #[inline(always)]
+    #[must_use]
+    pub fn of(c: &Conductor) -> Self {
+        let index = c.eta_k.map(|(eta, k)| std::array::from_fn(|i| ConductorIndex::new(eta.0[i], k.0[i])));
+        ConductorFresnel { index, specular_reflectance: c.specular_reflectance.0 }
+    }
+}
+
+impl ConductorFresnel<PerLane> {
+    /// The lanes' terms, one per lane; a lane that is a mirror (no index) where the first is not, or the
+    /// reverse, reads the first's index (the caller checks that they agree).
+    #[must_use]
+    pub fn per_lane(lanes: [ConductorFresnel; PER_LANE]) -> Self {
+        let index = lanes[0].index.map(|first| {
+            std::array::from_fn(|c| ConductorIndex::per_lane(std::array::from_fn(|l| lanes[l].index.map_or(first[c], |i| i[c]))))
+        });
+        ConductorFresnel {
+            index,
+            specular_reflectance: std::array::from_fn(|c| PerLane(lanes.each_ref().map(|l| l.specular_reflectance[c]))),
+        }
+    }
 }
 
 /// The microfacet conductor's glossy lobe for the distribution `D` in lanes ([`LaneModel`]): the Walter
-/// 2007 reflection lobe ([`ReflectionLobe`]) times the conductor's Fresnel term. `f`, `pdf` and `sample`
-/// of [`MicrofacetConductor`] are these, for single calls and batches alike.
+/// 2007 reflection lobe ([`ReflectionLobe`]) times the conductor's Fresnel term (one, or one per lane: `P`).
+/// `f`, `pdf` and `sample` of [`MicrofacetConductor`] are these, for single calls and batches alike.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ConductorLobe<D> {
+pub struct ConductorLobe<D, P = f32> {
     pub lobe: ReflectionLobe<D>,
-    pub fresnel: ConductorFresnel,
+    pub fresnel: ConductorFresnel<P>,
 }
 
-impl<D: Distribution> LaneModel for ConductorLobe<D> {
+impl<D: Distribution, P: Param> LaneModel for ConductorLobe<D, P> {
     /// F(ωo·ωh) D G / (4 cos θo cos θi), 0 where the lobe is (see [`LobeValue`](crate::microfacet::reflection::LobeValue)).
     #[inline(always)]
     fn f_lanes<R: Real>(&self, wo: V3<R>, wi: V3<R>) -> [R; 3] {
         let zero = R::splat(0.0);
         let v = self.lobe.eval(wo, wi);
-        let fresnel = match self.fresnel.eta_k {
-            Some((eta, k)) => fresnel_conductor_rgb_lanes(v.cos_theta_d, eta, k),
+        let fresnel = match &self.fresnel.index {
+            Some(index) => channels!(|c| fresnel_conductor_at(v.cos_theta_d, &index[c])),
             None => [R::splat(1.0); 3],
         };
-        let s = self.fresnel.specular_reflectance.0;
-        channels!(|c| R::select(v.ok, fresnel[c] * s[c] * v.value, zero))
+        let s = self.fresnel.specular_reflectance;
+        channels!(|c| R::select(v.ok, fresnel[c] * s[c].lanes::<R>() * v.value, zero))
     }
 
     #[inline(always)]

@@ -588,6 +588,18 @@ fn shading<'a>(scene: &'a Scene, p: &Packet, hit: &Surfaces8) -> Shading<'a> {
                 }
             }
         }
+        // Spectral mode's copies of one model at each lane's wavelengths: one kernel call for them where the
+        // model has such a kernel (`Bsdf::kernel_of_lanes`), instead of one call per lane.
+        let modelled = if chromatic { bits(same).filter(|&l| models[l].is_some()).fold(0u32, |m, l| m | 1 << l) } else { 0 };
+        if modelled.count_ones() > 1 {
+            let lanes: [Option<&Bsdf>; W] = std::array::from_fn(|l| if modelled & (1 << l) != 0 { models[l].as_deref() } else { None });
+            let first = modelled.trailing_zeros() as usize;
+            if let Some(kernel) = lanes[first].and_then(|m| m.kernel_of_lanes(&lanes)) {
+                (groups_of[n_groups], kernels[n_groups]) = ((modelled, first), Some(kernel));
+                n_groups += 1;
+                grouped |= modelled;
+            }
+        }
     }
     if diffuse_rows != 0 {
         let r = load_rgb(&rho_rows);
