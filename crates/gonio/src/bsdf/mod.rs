@@ -1250,15 +1250,59 @@ mod tests {
     /// roughness parameter and the base colours, over roughnesses from 0 (clamped to 10⁻⁴)
     /// to beyond 10 and reflectances beyond [0, 1], every lane a different one. Models and parameters it
     /// does not cover have none.
+    /// Run `kernel` in eight lanes on random directions and random numbers, and check that each lane `l`
+    /// where `own(l)` is a model gets that model's f, pdf and sample, bit for bit; the samples compared.
+    fn assert_lanes_are_models(
+        kernel: &lanes::PerLaneKernel<'_>,
+        own: &dyn Fn(usize) -> Option<Bsdf>,
+        rng: &mut Pcg32,
+        label: &str,
+    ) -> usize {
+        use crate::math::lanes::{Real, V3};
+        use crate::math::simd::Float8;
+        use lanes::LaneModel;
+        let mut dir = || {
+            let v = Vec3::new(2.0 * rng.next_f32() - 1.0, 2.0 * rng.next_f32() - 1.0, 2.0 * rng.next_f32() - 1.0);
+            v.try_normalize().unwrap_or(Vec3::Z)
+        };
+        let (wo, wi): (Vec<Vec3>, Vec<Vec3>) = (0..PER_LANE).map(|_| (dir(), dir())).unzip();
+        let lanes = |v: &[Vec3]| V3::new(Float8::from_fn(|i| v[i].x), Float8::from_fn(|i| v[i].y), Float8::from_fn(|i| v[i].z));
+        let (uc, ux, uy) = (Float8::from_fn(|_| rng.next_f32()), Float8::from_fn(|_| rng.next_f32()), Float8::from_fn(|_| rng.next_f32()));
+        let f = kernel.f_lanes(lanes(&wo), lanes(&wi));
+        let pdf = kernel.pdf_lanes(lanes(&wo), lanes(&wi));
+        let s = kernel.sample_lanes(lanes(&wo), uc, ux, uy);
+        let valid = Float8::bitmask(s.valid);
+        let mut sampled = 0;
+        for l in 0..PER_LANE {
+            let Some(own) = own(l) else { continue };
+            let at = format!("{label}, lane {l}, {} → {}", wo[l], wi[l]);
+            let want = own.f(wo[l], wi[l]);
+            for (got, want) in f.iter().map(|c| c.lane(l)).zip(want.0) {
+                assert_eq!(got.to_bits(), want.to_bits(), "{at}: f {got} against {want}");
+            }
+            assert_eq!(pdf.lane(l).to_bits(), own.pdf(wo[l], wi[l]).to_bits(), "{at}: pdf");
+            match own.sample(wo[l], uc.lane(l), Vec2::new(ux.lane(l), uy.lane(l))) {
+                Some(b) => {
+                    assert!(valid & (1 << l) != 0, "{at}: a sample in the model only");
+                    let a_wi = Vec3::new(s.wi.x.lane(l), s.wi.y.lane(l), s.wi.z.lane(l));
+                    assert_eq!((a_wi, s.pdf.lane(l).to_bits()), (b.wi, b.pdf.to_bits()), "{at}: sample");
+                    for (got, want) in s.weight.iter().map(|c| c.lane(l)).zip(b.weight.0) {
+                        assert_eq!(got.to_bits(), want.to_bits(), "{at}: weight");
+                    }
+                    sampled += 1;
+                }
+                None => assert!(valid & (1 << l) == 0, "{at}: a sample in the kernel only"),
+            }
+        }
+        sampled
+    }
+
     /// Spectral mode's copies of a rough conductor at each lane's wavelengths (and each lane's roughness)
     /// run as one kernel (`Bsdf::kernel_of_lanes`), each lane's f, pdf and sample its own model's bit for
     /// bit; models that differ otherwise, or have no such kernel, are refused.
     #[test]
     fn kernels_of_lanes_are_each_lanes_model() {
-        use crate::math::lanes::{Real, V3};
-        use crate::math::simd::Float8;
         use crate::scene::spectral::{reflectances_at, GivenSpectra};
-        use lanes::LaneModel;
         let cases = [
             r#"{"type": "roughconductor"}"#,
             r#"{"type": "roughconductor", "distribution": "ggx", "material": "Cu", "specular_reflectance": [0.9, 0.6, 0.3]}"#,
@@ -1268,12 +1312,9 @@ mod tests {
             r#"{"type": "torrance_sparrow", "distribution": "beckmann", "material": "Al"}"#,
         ];
         let mut rng = Pcg32::new(23, 0);
-        let dir = |rng: &mut Pcg32| {
-            let v = Vec3::new(2.0 * rng.next_f32() - 1.0, 2.0 * rng.next_f32() - 1.0, 2.0 * rng.next_f32() - 1.0);
-            v.try_normalize().unwrap_or(Vec3::Z)
-        };
         for json in cases {
             let model = Bsdf::from_json(json).unwrap();
+            let mut sampled = 0;
             for round in 0..200 {
                 // Lanes 2 and 5 are not in the group (another material's lanes in a packet).
                 let own: Vec<Bsdf> = (0..PER_LANE)
@@ -1289,34 +1330,9 @@ mod tests {
                     .collect();
                 let lanes: [Option<&Bsdf>; PER_LANE] = std::array::from_fn(|l| (l != 2 && l != 5).then_some(&own[l]));
                 let kernel = own[0].kernel_of_lanes(&lanes).unwrap_or_else(|| panic!("{json}: a kernel"));
-                let (wo, wi): (Vec<Vec3>, Vec<Vec3>) = (0..PER_LANE).map(|_| (dir(&mut rng), dir(&mut rng))).unzip();
-                let lanes8 = |v: &[Vec3]| V3::new(Float8::from_fn(|i| v[i].x), Float8::from_fn(|i| v[i].y), Float8::from_fn(|i| v[i].z));
-                let (uc, ux, uy) =
-                    (Float8::from_fn(|_| rng.next_f32()), Float8::from_fn(|_| rng.next_f32()), Float8::from_fn(|_| rng.next_f32()));
-                let f = kernel.f_lanes(lanes8(&wo), lanes8(&wi));
-                let pdf = kernel.pdf_lanes(lanes8(&wo), lanes8(&wi));
-                let s = kernel.sample_lanes(lanes8(&wo), uc, ux, uy);
-                let valid = Float8::bitmask(s.valid);
-                for l in (0..PER_LANE).filter(|l| lanes[*l].is_some()) {
-                    let at = format!("{json}, lane {l}, {} → {}", wo[l], wi[l]);
-                    let want = own[l].f(wo[l], wi[l]);
-                    for (got, want) in f.iter().map(|c| c.lane(l)).zip(want.0) {
-                        assert_eq!(got.to_bits(), want.to_bits(), "{at}: f {got} against {want}");
-                    }
-                    assert_eq!(pdf.lane(l).to_bits(), own[l].pdf(wo[l], wi[l]).to_bits(), "{at}: pdf");
-                    match own[l].sample(wo[l], uc.lane(l), Vec2::new(ux.lane(l), uy.lane(l))) {
-                        Some(b) => {
-                            assert!(valid & (1 << l) != 0, "{at}: a sample in the model only");
-                            let a_wi = Vec3::new(s.wi.x.lane(l), s.wi.y.lane(l), s.wi.z.lane(l));
-                            assert_eq!((a_wi, s.pdf.lane(l).to_bits()), (b.wi, b.pdf.to_bits()), "{at}: sample");
-                            for (got, want) in s.weight.iter().map(|c| c.lane(l)).zip(b.weight.0) {
-                                assert_eq!(got.to_bits(), want.to_bits(), "{at}: weight");
-                            }
-                        }
-                        None => assert!(valid & (1 << l) == 0, "{at}: a sample in the kernel only"),
-                    }
-                }
+                sampled += assert_lanes_are_models(&kernel, &|l| lanes[l].cloned(), &mut rng, json);
             }
+            assert!(sampled > 400, "{json}: {sampled} samples compared");
         }
         // Refused: a mirror beside a metal, another model, energy compensation, Blinn, other models.
         let of = |json: &str| Bsdf::from_json(json).unwrap();
@@ -1339,9 +1355,6 @@ mod tests {
 
     #[test]
     fn per_lane_parameters_are_each_lanes_model() {
-        use crate::math::lanes::{Real, V3};
-        use crate::math::simd::Float8;
-        use lanes::LaneModel;
         let cases = [
             (r#"{"type": "roughconductor"}"#, "alpha"),
             (r#"{"type": "roughconductor", "distribution": "ggx", "material": "Cu"}"#, "alpha"),
@@ -1362,10 +1375,6 @@ mod tests {
             (r#"{"type": "principled", "spec_trans": 0.7, "roughness": 0.3}"#, "base_color"),
         ];
         let mut rng = Pcg32::new(17, 0);
-        let dir = |rng: &mut Pcg32| {
-            let v = Vec3::new(2.0 * rng.next_f32() - 1.0, 2.0 * rng.next_f32() - 1.0, 2.0 * rng.next_f32() - 1.0);
-            v.try_normalize().unwrap_or(Vec3::Z)
-        };
         for (json, name) in cases {
             let model = Bsdf::from_json(json).unwrap();
             let colour = name == "diffuse_reflectance" || name == "base_color";
@@ -1382,40 +1391,16 @@ mod tests {
                 let values: [[f32; PER_LANE]; 3] = std::array::from_fn(|_| std::array::from_fn(|_| value(&mut rng)));
                 let lane_value = if colour { LaneValue::Colour(values) } else { LaneValue::Float(values[0]) };
                 let kernel = model.per_lane_kernel([(name, lane_value)]).unwrap_or_else(|| panic!("{json} {name}: a kernel"));
-                let (wo, wi): (Vec<Vec3>, Vec<Vec3>) = (0..PER_LANE).map(|_| (dir(&mut rng), dir(&mut rng))).unzip();
-                let lanes = |v: &[Vec3]| V3::new(Float8::from_fn(|i| v[i].x), Float8::from_fn(|i| v[i].y), Float8::from_fn(|i| v[i].z));
-                let (uc, ux, uy) =
-                    (Float8::from_fn(|_| rng.next_f32()), Float8::from_fn(|_| rng.next_f32()), Float8::from_fn(|_| rng.next_f32()));
-                let f = kernel.f_lanes(lanes(&wo), lanes(&wi));
-                let pdf = kernel.pdf_lanes(lanes(&wo), lanes(&wi));
-                let s = kernel.sample_lanes(lanes(&wo), uc, ux, uy);
-                let valid = Float8::bitmask(s.valid);
-                for l in 0..PER_LANE {
+                let own = |l: usize| {
                     let mut own = model.clone();
                     if colour {
                         *own.reflectance_slot(name).unwrap() = Rgb::new(values[0][l], values[1][l], values[2][l]).map(textured_reflectance);
                     } else {
                         assert!(own.set_float(name, values[0][l]));
                     }
-                    let at = format!("{json} {name} = {}, lane {l}, {} → {}", values[0][l], wo[l], wi[l]);
-                    let want = own.f(wo[l], wi[l]);
-                    for (got, want) in f.iter().map(|c| c.lane(l)).zip(want.0) {
-                        assert_eq!(got.to_bits(), want.to_bits(), "{at}: f {got} against {want}");
-                    }
-                    assert_eq!(pdf.lane(l).to_bits(), own.pdf(wo[l], wi[l]).to_bits(), "{at}: pdf");
-                    match own.sample(wo[l], uc.lane(l), Vec2::new(ux.lane(l), uy.lane(l))) {
-                        Some(b) => {
-                            assert!(valid & (1 << l) != 0, "{at}: a sample in the model only");
-                            let a_wi = Vec3::new(s.wi.x.lane(l), s.wi.y.lane(l), s.wi.z.lane(l));
-                            assert_eq!((a_wi, s.pdf.lane(l).to_bits()), (b.wi, b.pdf.to_bits()), "{at}: sample");
-                            for (got, want) in s.weight.iter().map(|c| c.lane(l)).zip(b.weight.0) {
-                                assert_eq!(got.to_bits(), want.to_bits(), "{at}: weight");
-                            }
-                            sampled += 1;
-                        }
-                        None => assert!(valid & (1 << l) == 0, "{at}: a sample in the kernel only"),
-                    }
-                }
+                    Some(own)
+                };
+                sampled += assert_lanes_are_models(&kernel, &own, &mut rng, &format!("{json} {name}"));
             }
             assert!(sampled > 1000, "{json}: {sampled} samples compared");
         }
