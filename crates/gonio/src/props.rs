@@ -860,10 +860,6 @@ fn json_spectrum(name: &str, v: &serde_json::Value, at: &str) -> Result<Option<(
                 }
             }
         }
-        if kind == "uniform" {
-            let v = parameters.first().map(|(_, v)| *v).ok_or_else(|| Error::spec(at, "a `uniform` spectrum needs a \"value\""))?;
-            return Ok(Some(crate::xml::uniform_spectrum(v, emission)));
-        }
         return crate::xml::spectrum_of_plugin(kind, &parameters, emission)
             .map(Some)
             .map_err(|e| Error::spec(at, format!("`{kind}` spectrum: {e}")));
@@ -998,7 +994,7 @@ mod tests {
             (r#"{"type": "blackbody", "temperature": -5}"#, "temperature > 0 K"),
             (r#"{"type": "d65", "scale": "2"}"#, "`scale` in a `d65` spectrum: it takes a number for each of: scale"),
             (r#"{"type": "d65", "temperature": 5000}"#, "`temperature` in a `d65` spectrum"),
-            (r#"{"type": "uniform"}"#, "a `uniform` spectrum needs a \"value\""),
+            (r#"{"type": "uniform"}"#, "$.radiance: `uniform` spectrum: needs a `value`"),
         ] {
             let e = Props::from_json(&format!(r#"{{"type": "area", "radiance": {json}}}"#)).unwrap_err().to_string();
             assert!(e.contains(expect), "{json}: {e}");

@@ -333,9 +333,8 @@ pub fn parse_spectrum(node: roxmltree::Node, env: &XmlEnv, source: &XmlSource, w
     let tabulated = |w: Vec<f64>, v: Vec<f64>| -> Result<(Rgb, Option<Spectrum>)> {
         tabulated_spectrum(w, v, within_emitter).map_err(|e| Error::spec(&at, format!("<spectrum>: {e}")))
     };
-    let uniform = |v: f64| -> Result<(Rgb, Option<Spectrum>)> { Ok(uniform_spectrum(v, within_emitter)) };
     if let Some(kind) = env.attr(node, "type", source)? {
-        return spectrum_plugin(node, env, source, &kind, within_emitter, &uniform);
+        return spectrum_plugin(node, env, source, &kind, within_emitter);
     }
     if let Some(file) = env.attr(node, "filename", source)? {
         let path = env.resolve_file(&file, &at)?;
@@ -346,7 +345,7 @@ pub fn parse_spectrum(node: roxmltree::Node, env: &XmlEnv, source: &XmlSource, w
     let raw = env.required(node, "value", source)?;
     if !raw.contains(':') {
         return match parse_numbers(&raw).as_deref() {
-            Some([v]) => uniform(*v),
+            Some([v]) => Ok(uniform_spectrum(*v, within_emitter)),
             _ => Err(Error::spec(at, format!("<spectrum>: expected a number or \"λ:value, …\" pairs, got \"{raw}\""))),
         };
     }
@@ -404,7 +403,6 @@ fn spectrum_plugin(
     source: &XmlSource,
     kind: &str,
     within_emitter: bool,
-    uniform: &dyn Fn(f64) -> Result<(Rgb, Option<Spectrum>)>,
 ) -> Result<(Rgb, Option<Spectrum>)> {
     let at = xml_at(source, node);
     let Some(accepted) = spectrum_plugin_parameters(kind) else {
@@ -429,10 +427,6 @@ fn spectrum_plugin(
             .ok_or_else(|| Error::spec(&cat, format!("`{name}`: expected a number, got \"{raw}\"")))?;
         floats.push((name, v));
     }
-    if kind == "uniform" {
-        let value = floats.first().map(|(_, v)| *v);
-        return uniform(value.ok_or_else(|| Error::spec(&at, "<spectrum type=\"uniform\"> needs <float name=\"value\">"))?);
-    }
     spectrum_of_plugin(kind, &floats, within_emitter).map_err(|e| Error::spec(at, format!("<spectrum type=\"{kind}\">: {e}")))
 }
 
@@ -446,7 +440,7 @@ pub(crate) fn spectrum_plugin_parameters(kind: &str) -> Option<&'static [&'stati
     }
 }
 
-/// The spectrum plugin `d65` or `blackbody` with its numeric `parameters` (checked by the caller against
+/// The spectrum plugin `d65`, `blackbody` or `uniform` with its numeric `parameters` (checked by the caller against
 /// [`spectrum_plugin_parameters`]): its RGB reduction and, inside an emitter, its spectrum (see
 /// [`parse_spectrum`]). The XML `<spectrum type=…>` and the dictionary `{"type": "d65"}` read through it; the
 /// error is the problem alone, for the caller to place.
@@ -472,6 +466,7 @@ pub(crate) fn spectrum_of_plugin(
             let v: Vec<f64> = w.iter().map(|&l| body.eval(l)).collect();
             Ok((spectrum_to_rgb(&w, &v), Some(Spectrum::Blackbody(body))))
         }
+        "uniform" => Ok(uniform_spectrum(get("value").ok_or("needs a `value`")?, within_emitter)),
         _ => Err(format!("not a spectrum plugin gonio reads: `{kind}`")),
     }
 }

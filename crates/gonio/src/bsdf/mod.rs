@@ -962,10 +962,19 @@ impl Bsdf {
         }
     }
 
-    /// Set the models that read a path's wavelengths themselves to `lambda` (nm, one per channel): a
-    /// `measured` file's spectra ([`Measured::set_wavelengths`]) and a dispersive `thindielectric`'s index
-    /// per channel ([`ThinDielectric::set_wavelengths`]); other models are unchanged.
+    /// Set what this model (not the models it holds) reads of a path's wavelengths `lambda` (nm, one per
+    /// channel) itself: a conductor's index ([`Conductor::set_wavelengths`], where
+    /// [`Self::conductor_fresnel`] gives it), a dispersive interface's index at the hero wavelength
+    /// `lambda[0]` ([`Self::dispersion_mut`]), a dispersive `thindielectric`'s index per channel
+    /// ([`ThinDielectric::set_wavelengths`]) and a `measured` file's spectra ([`Measured::set_wavelengths`]);
+    /// other models are unchanged.
     pub fn set_wavelengths(&mut self, lambda: [f32; 3]) {
+        if let Some(c) = self.conductor_fresnel() {
+            c.set_wavelengths(lambda);
+        }
+        if let Some((law, eta)) = self.dispersion_mut() {
+            *eta = law.eta(lambda[0]);
+        }
         match self {
             Bsdf::Measured(m) => m.set_wavelengths(lambda),
             Bsdf::ThinDielectric(t) => t.set_wavelengths(lambda),

@@ -367,10 +367,9 @@ fn is_model(p: &Props) -> bool {
 /// Model `b` at the wavelengths `lambda`, in `b` and in the models it holds ([`Bsdf::for_each_nested`]):
 /// each colour parameter of `CONVERTED` (those [`check_bsdf`] takes) replaced by its reflectance spectrum's
 /// values at `lambda` (the table it was given as, in `given`, clamped to [0, 1] as a texture's value; else
-/// its colour's upsampled spectrum), a conductor's index by its spectra's ([`crate::bsdf::Conductor::set_wavelengths`]),
-/// a dispersive dielectric's by its value at the hero wavelength `lambda[0]`, and the models that read
-/// `lambda` themselves ([`Bsdf::set_wavelengths`]: a `measured` file's spectra, a dispersive
-/// `thindielectric`'s index per channel).
+/// its colour's upsampled spectrum), and what a model reads of the wavelengths itself set by
+/// [`Bsdf::set_wavelengths`] (a conductor's index from its spectra, a dispersive dielectric's at the hero
+/// wavelength `lambda[0]`, a dispersive `thindielectric`'s per channel, a `measured` file's spectra).
 pub fn reflectances_at(b: &mut Bsdf, lambda: [f32; PATH_WAVELENGTHS], given: &GivenSpectra) {
     convert(b, lambda);
     for (slot, table) in &given.0 {
@@ -382,12 +381,6 @@ pub fn reflectances_at(b: &mut Bsdf, lambda: [f32; PATH_WAVELENGTHS], given: &Gi
 
 /// [`reflectances_at`] without the tables.
 fn convert(b: &mut Bsdf, lambda: [f32; PATH_WAVELENGTHS]) {
-    if let Some(c) = b.conductor_fresnel() {
-        c.set_wavelengths(lambda);
-    }
-    if let Some((law, eta)) = b.dispersion_mut() {
-        *eta = law.eta(lambda[0]);
-    }
     b.set_wavelengths(lambda);
     for name in CONVERTED {
         if let Some(r) = b.reflectance_slot(name) {

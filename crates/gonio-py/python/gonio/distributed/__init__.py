@@ -161,7 +161,7 @@ def _scene(boxed: List[Any]) -> Any:
     key = ref.hex()
     if key not in _SCENES:
         bundle = ray.get(ref)
-        mode = bundle.get("mode", "rgb")
+        mode = bundle["mode"]
         if bundle["kind"] == "dict":
             _SCENES[key] = load_dict(bundle["scene"], mode=mode)
         else:
