@@ -2,7 +2,7 @@
 //! 3.9.1 (`cie_d65`, `MI_CIE_D65_NORMALIZATION`), D65's colour (sRGB white), Planck's law against
 //! Mitsuba's `blackbody`, the blackbody normalisations, and `Spectrum` of every kind.
 
-use gonio::spectrum::illuminant::{d65, d65_normalization, d65_relative, planck, Blackbody, BlackbodyNormalization, Spectrum};
+use gonio::spectrum::illuminant::{d65, d65_at, d65_normalization, d65_relative, planck, Blackbody, BlackbodyNormalization, Spectrum};
 use gonio::spectrum::named::xyz_to_linear_srgb;
 use gonio::spectrum::piecewise::PiecewiseLinear;
 use gonio::spectrum::upsample::{RgbIlluminantSpectrum, RgbReflectanceSpectrum, RgbUnboundedSpectrum};
@@ -43,6 +43,26 @@ fn d65_matches_mitsuba_and_the_cie_table() {
     assert_eq!(d65_relative(830.1), 0.0);
     assert_eq!(d65_relative(f64::NAN), 0.0);
     assert!((d65_relative(302.5) - 0.5 * (0.0341 + 1.6643)).abs() < 1e-12);
+}
+
+/// The renderer's D65 in `f32` lanes follows the `f64` one to `f32`'s precision, 0 outside the table.
+#[test]
+fn d65_in_lanes_follows_d65() {
+    use gonio::math::lanes::{F32x8, Real};
+    let peak = (300..=830).map(|l| d65(f64::from(l))).fold(0.0, f64::max);
+    let mut worst = 0.0f64;
+    for i in 0..=53_000 {
+        let lambda = 300.0 + i as f32 / 100.0;
+        worst = worst.max((f64::from(d65_at(lambda)) - d65(f64::from(lambda))).abs() / peak);
+    }
+    assert!(worst < 1e-6, "worst {worst:e} of the peak");
+    for outside in [299.99f32, 830.01, -1.0, f32::NAN, f32::INFINITY] {
+        assert_eq!(d65_at(outside), 0.0, "{outside}");
+    }
+    let lanes = F32x8::from_fn(|i| 350.0 + 61.0 * i as f32);
+    for i in 0..8 {
+        assert_eq!(d65_at(lanes).lane(i).to_bits(), d65_at(lanes.lane(i)).to_bits());
+    }
 }
 
 /// D65 of luminance 1 is sRGB's white: (1, 1, 1) to within the 6-decimal matrix and the tables.

@@ -863,32 +863,51 @@ impl Bsdf {
         }
     }
 
-    /// One kernel for the lanes of a packet whose models are copies of this one that differ only where
+    /// One kernel for the lanes of a packet whose models are copies of this one that differ from it where
     /// spectral mode sets each lane's copy at its wavelengths ([`crate::scene::spectral::reflectances_at`]),
-    /// or where a texture sets each lane's roughness: `models[lane]`, `None` for lanes not in the group.
-    /// The rough conductors (`roughconductor`, `torrance_sparrow` with GGX or Beckmann, without energy
-    /// compensation: their roughness and Fresnel term per lane); `None` for other models, which then run
-    /// one lane at a time. Each lane's values are its own model's, bit for bit (test
+    /// or where a texture sets a parameter the kernel takes per lane: `models[lane]`, `None` for lanes not
+    /// in the group. The rough conductors (`roughconductor`, `torrance_sparrow` with GGX or Beckmann, without
+    /// energy compensation: their roughness and Fresnel term per lane), `plastic` and `roughplastic` (their
+    /// `diffuse_reflectance` per lane) and `principled` (its `base_color`), as [`Self::per_lane_kernel`]
+    /// takes them; `None` for other models, and where a copy differs from this model in anything else —
+    /// those lanes then run one at a time. Each lane's values are its own model's, bit for bit (test
     /// `kernels_of_lanes_are_each_lanes_model`).
     #[must_use]
-    pub fn kernel_of_lanes(&self, models: &[Option<&Bsdf>; PER_LANE]) -> Option<PerLaneKernel<'static>> {
+    pub fn kernel_of_lanes(&self, models: &[Option<&Bsdf>; PER_LANE]) -> Option<PerLaneKernel<'_>> {
         fn conductor(b: &Bsdf) -> Option<&MicrofacetConductor> {
             match b {
                 Bsdf::RoughConductor(RoughConductor(c)) | Bsdf::TorranceSparrow(TorranceSparrow(c)) => Some(c),
                 _ => None,
             }
         }
-        let own = conductor(self)?;
-        let mut lanes = [None; PER_LANE];
-        for (lane, model) in lanes.iter_mut().zip(models) {
-            if let Some(m) = model {
-                if std::mem::discriminant(*m) != std::mem::discriminant(self) {
-                    return None;
-                }
-                *lane = Some(conductor(m)?);
+        if models.iter().flatten().any(|m| std::mem::discriminant(*m) != std::mem::discriminant(self)) {
+            return None;
+        }
+        if let Some(own) = conductor(self) {
+            let lanes = models.map(|m| m.and_then(conductor));
+            return own.kernel_of_lanes(&lanes);
+        }
+        // A colour per lane: each copy must be this model once its colour is this model's.
+        let name = match self {
+            Bsdf::Plastic(_) | Bsdf::RoughPlastic(_) => "diffuse_reflectance",
+            Bsdf::Principled(_) => "base_color",
+            _ => return None,
+        };
+        let own = *self.clone().reflectance_slot(name)?;
+        let mut colour = own.0.map(|c| [c; PER_LANE]);
+        for (lane, model) in models.iter().enumerate() {
+            let Some(model) = model else { continue };
+            let mut copy = (*model).clone();
+            let value = std::mem::replace(copy.reflectance_slot(name)?, own);
+            // (A value the kernel would clamp differently, or NaN, is not taken.)
+            if copy != *self || value.0.iter().any(|&v| textured_reflectance(v) != v) {
+                return None;
+            }
+            for (channel, v) in colour.iter_mut().zip(value.0) {
+                channel[lane] = v;
             }
         }
-        own.kernel_of_lanes(&lanes)
+        self.per_lane_kernel([(name, LaneValue::Colour(colour))])
     }
 
     /// The models this one built from the k-th of its `count` nested descriptions (`Props::nested`'s
@@ -1306,9 +1325,9 @@ mod tests {
         sampled
     }
 
-    /// Spectral mode's copies of a rough conductor at each lane's wavelengths (and each lane's roughness)
-    /// run as one kernel (`Bsdf::kernel_of_lanes`), each lane's f, pdf and sample its own model's bit for
-    /// bit; models that differ otherwise, or have no such kernel, are refused.
+    /// Spectral mode's copies of a model at each lane's wavelengths (and each lane's roughness, for the
+    /// rough conductors) run as one kernel (`Bsdf::kernel_of_lanes`), each lane's f, pdf and sample its own
+    /// model's bit for bit; copies that differ otherwise, and models without such a kernel, are refused.
     #[test]
     fn kernels_of_lanes_are_each_lanes_model() {
         use crate::scene::spectral::{reflectances_at, GivenSpectra};
@@ -1319,10 +1338,16 @@ mod tests {
             r#"{"type": "roughconductor", "distribution": "ggx", "sample_visible": false, "material": "Ag"}"#,
             r#"{"type": "roughconductor", "material": "none"}"#,
             r#"{"type": "torrance_sparrow", "distribution": "beckmann", "material": "Al"}"#,
+            r#"{"type": "plastic", "diffuse_reflectance": [0.8, 0.3, 0.1]}"#,
+            r#"{"type": "plastic", "diffuse_reflectance": [0.1, 0.5, 0.9], "nonlinear": true, "int_ior": 1.7}"#,
+            r#"{"type": "roughplastic", "diffuse_reflectance": [0.8, 0.3, 0.1]}"#,
+            r#"{"type": "roughplastic", "distribution": "ggx", "alpha": 0.3, "diffuse_reflectance": [0.2, 0.6, 0.3], "nonlinear": true}"#,
+            r#"{"type": "principled", "base_color": [0.7, 0.2, 0.4], "metallic": 0.3, "roughness": 0.4, "sheen": 0.5, "clearcoat": 0.3, "spec_trans": 0.2}"#,
         ];
         let mut rng = Pcg32::new(23, 0);
         for json in cases {
             let model = Bsdf::from_json(json).unwrap();
+            let conductor = json.contains("conductor") || json.contains("torrance");
             let mut sampled = 0;
             for round in 0..200 {
                 // Lanes 2 and 5 are not in the group (another material's lanes in a packet).
@@ -1331,19 +1356,20 @@ mod tests {
                         let mut m = model.clone();
                         let lambda = [0, 1, 2].map(|_| 360.0 + 470.0 * rng.next_f32());
                         reflectances_at(&mut m, lambda, &GivenSpectra::NONE);
-                        if round % 2 == 1 {
+                        if conductor && round % 2 == 1 {
                             assert!(m.set_float("alpha", 10f32.powf(-3.0 + 3.0 * rng.next_f32())));
                         }
                         m
                     })
                     .collect();
                 let lanes: [Option<&Bsdf>; PER_LANE] = std::array::from_fn(|l| (l != 2 && l != 5).then_some(&own[l]));
-                let kernel = own[0].kernel_of_lanes(&lanes).unwrap_or_else(|| panic!("{json}: a kernel"));
+                let kernel = model.kernel_of_lanes(&lanes).unwrap_or_else(|| panic!("{json}: a kernel"));
                 sampled += assert_lanes_are_models(&kernel, &|l| lanes[l].cloned(), &mut rng, json);
             }
             assert!(sampled > 400, "{json}: {sampled} samples compared");
         }
-        // Refused: a mirror beside a metal, another model, energy compensation, Blinn, other models.
+        // Refused: a mirror beside a metal, another model, copies that differ in more than the kernel takes
+        // per lane, energy compensation, Blinn, other models.
         let of = |json: &str| Bsdf::from_json(json).unwrap();
         let (gold, mirror) =
             (of(r#"{"type": "roughconductor", "material": "Au"}"#), of(r#"{"type": "roughconductor", "material": "none"}"#));
@@ -1358,8 +1384,17 @@ mod tests {
         assert!(!pair(&compensated, &compensated));
         let blinn = of(r#"{"type": "torrance_sparrow", "distribution": "blinn"}"#);
         assert!(!pair(&blinn, &blinn));
-        let plastic = of(r#"{"type": "roughplastic"}"#);
-        assert!(!pair(&plastic, &plastic));
+        let plastic = of(r#"{"type": "roughplastic", "diffuse_reflectance": [0.8, 0.3, 0.1]}"#);
+        assert!(pair(&plastic, &plastic) && pair(&plastic, &of(r#"{"type": "roughplastic", "diffuse_reflectance": [0.1, 0.3, 0.8]}"#)));
+        assert!(!pair(&plastic, &of(r#"{"type": "roughplastic", "diffuse_reflectance": [0.8, 0.3, 0.1], "alpha": 0.2}"#)));
+        assert!(!pair(&plastic, &of(r#"{"type": "roughplastic", "diffuse_reflectance": [0.8, 0.3, 0.1], "specular_reflectance": 0.5}"#)));
+        assert!(!pair(&plastic, &of(r#"{"type": "plastic", "diffuse_reflectance": [0.8, 0.3, 0.1]}"#)));
+        let compensated = of(r#"{"type": "roughplastic", "diffuse_reflectance": [0.8, 0.3, 0.1], "energy_compensation": true}"#);
+        assert!(!pair(&compensated, &compensated));
+        let principled = of(r#"{"type": "principled", "base_color": [0.7, 0.2, 0.4]}"#);
+        assert!(!pair(&principled, &of(r#"{"type": "principled", "base_color": [0.7, 0.2, 0.4], "metallic": 0.5}"#)));
+        let dielectric = of(r#"{"type": "roughdielectric"}"#);
+        assert!(!pair(&dielectric, &dielectric));
     }
 
     #[test]

@@ -32,7 +32,6 @@ use crate::geometry::shape::solid_angle_density;
 use crate::geometry::sphere::sample_sphere_from;
 use crate::geometry::{Ray, Shape};
 use crate::light::area::towards;
-use crate::light::envmap::LaneWavelengths;
 use crate::light::point::point_source_lanes;
 use crate::light::selection::SelectionSums;
 use crate::light::{Light, LightSample};
@@ -166,16 +165,21 @@ impl Packet {
         self.lambda.get(lane).to_array()
     }
 
+    /// The lanes' wavelengths, per channel.
+    #[inline(always)]
+    fn lambda_lanes(&self) -> [Float8; 3] {
+        let l = self.lambda.lanes();
+        [l.x, l.y, l.z]
+    }
+
     /// Lanes `lanes` (new paths) draw their wavelengths, in spectral mode: the next number of each one's
     /// stream.
     #[inline(always)]
     fn sample_wavelengths(&mut self, lanes: u32) {
-        let u = self.rng.next_f32(lanes).to_array();
-        for lane in bits(lanes) {
-            let (lambda, pdf) = sample_path_wavelengths(u[lane]);
-            self.lambda.set(lane, Vec3::from_array(lambda));
-            self.lambda_pdf.set(lane, Vec3::from_array(pdf));
-        }
+        let (lambda, pdf) = sample_path_wavelengths(self.rng.next_f32(lanes));
+        let m = Mask8::from_bitmask(lanes);
+        self.lambda.store(V3::select(m, V3::new(lambda[0], lambda[1], lambda[2]), self.lambda.lanes()));
+        self.lambda_pdf.store(V3::select(m, V3::new(pdf[0], pdf[1], pdf[2]), self.lambda_pdf.lanes()));
     }
 
     /// In spectral mode, the live lanes on a dispersive material ([`Dependence::Dispersion`]) follow their
@@ -373,8 +377,8 @@ fn trace(scene: &Scene, p: &mut Packet, lanes: u32, hit: &mut Surfaces8, setting
         Some(Light::Constant(constant)) => Some((constant.radiance.0.map(Float8::splat), Float8::splat(constant.pdf_li(Vec3::Z)))),
         Some(Light::EnvMap(env)) if shown & !hit.found != 0 => {
             // In spectral mode at each lane's wavelengths already (`EnvMap::eval_lanes_at`).
-            let lambda = |lane: usize| p.lambda(lane);
-            let e = env.eval_lanes_at(p.d.lanes(), shown & !hit.found, p.spectral.then_some(&lambda as LaneWavelengths<'_>));
+            let lambda = p.lambda_lanes();
+            let e = env.eval_lanes_at(p.d.lanes(), shown & !hit.found, p.spectral.then_some(&lambda));
             Some((e.li, e.pdf))
         }
         _ => None,
@@ -594,7 +598,7 @@ fn shading<'a>(scene: &'a Scene, p: &Packet, hit: &Surfaces8) -> Shading<'a> {
         if modelled.count_ones() > 1 {
             let lanes: [Option<&Bsdf>; W] = std::array::from_fn(|l| if modelled & (1 << l) != 0 { models[l].as_deref() } else { None });
             let first = modelled.trailing_zeros() as usize;
-            if let Some(kernel) = lanes[first].and_then(|m| m.kernel_of_lanes(&lanes)) {
+            if let Some(kernel) = material.model().and_then(|m| m.kernel_of_lanes(&lanes)) {
                 (groups_of[n_groups], kernels[n_groups]) = ((modelled, first), Some(kernel));
                 n_groups += 1;
                 grouped |= modelled;
@@ -748,8 +752,8 @@ fn light_sample(scene: &Scene, p: &mut Packet, hit: &Surfaces8, sh: &Shading<'_>
         if let Light::EnvMap(env) = &scene.lights[index] {
             // `EnvMap::sample_li` in lanes (the surfaces' normals are never zero), where the sample
             // carries light.
-            let lambda = |lane: usize| p.lambda(lane);
-            let s = env.sample_lanes_at(u_c, u_x, u_y, same, p.spectral.then_some(&lambda as LaneWavelengths<'_>));
+            let lambda = p.lambda_lanes();
+            let s = env.sample_lanes_at(u_c, u_x, u_y, same, p.spectral.then_some(&lambda));
             spectral_li |= same;
             let zero = Float8::splat(0.0);
             let ok = s.valid & m & (s.li[0].ne(zero) | s.li[1].ne(zero) | s.li[2].ne(zero));

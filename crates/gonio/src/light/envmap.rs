@@ -57,8 +57,8 @@ use crate::math::trig::{self, sin_cos_turn};
 use crate::math::Transform;
 use crate::props::Props;
 use crate::sampling::alias::AliasTable;
-use crate::spectrum::illuminant::d65;
-use crate::spectrum::upsample::{srgb_table, SigmoidPolynomial};
+use crate::spectrum::illuminant::d65_at;
+use crate::spectrum::upsample::{sigmoid_polynomial_lanes, srgb_table, SigmoidPolynomial};
 use crate::spectrum::Rgb;
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
@@ -80,9 +80,6 @@ pub struct EnvMap {
     /// In spectral mode, each texel's spectrum as (c₀, c₁, c₂, scale), laid out as `texels` (module docs).
     spectra: Option<Arc<Vec<[f32; 4]>>>,
 }
-
-/// Each lane's wavelengths (lane → its three wavelengths, nm), for the lookups of spectral mode.
-pub type LaneWavelengths<'a> = &'a dyn Fn(usize) -> [f32; 3];
 
 /// Sampled directions in lanes ([`EnvMap::sample_lanes`]).
 #[derive(Clone, Copy, Debug)]
@@ -259,32 +256,37 @@ impl EnvMap {
         })
     }
 
-    /// The radiance at each lane's wavelengths `lambda` from the spectra ([`Self::prepare_spectra`]) of the
-    /// four texels around each lane's cell, blended as Mitsuba's spectral variants blend them (module docs),
-    /// in the lanes set in `lanes` (the others 0). Without spectra (not prepared), [`Self::blend`]'s colours.
+    /// The radiance at each lane's wavelengths `lambda` (nm, per channel) from the spectra
+    /// ([`Self::prepare_spectra`]) of the four texels around each lane's cell, blended as Mitsuba's spectral
+    /// variants blend them (module docs): the texels read lane by lane, the rest in lanes. Without spectra
+    /// (not prepared), [`Self::blend`]'s colours.
     #[inline(always)]
-    fn blend_at<R: Real>(&self, (x, y): &Cells, fx: R, fy: R, lanes: u32, lambda: LaneWavelengths<'_>) -> [R; 3] {
+    fn blend_at<R: Real>(&self, (x, y): &Cells, fx: R, fy: R, lambda: &[R; 3]) -> [R; 3] {
         let Some(spectra) = &self.spectra else { return self.blend(&(*x, *y), fx, fy) };
         let row = self.width + 1;
-        let mut out = [[0.0f32; MAX_LANES]; 3];
-        for i in (0..R::LANES).filter(|i| lanes >> i & 1 != 0) {
-            let (fx, fy) = (fx.lane(i), fy.lane(i));
-            let texel = |dx: usize, dy: usize| spectra.get((y[i] as usize + dy) * row + x[i] as usize + dx).copied().unwrap_or([0.0; 4]);
-            let (t00, t10, t01, t11) = (texel(0, 0), texel(1, 0), texel(0, 1), texel(1, 1));
-            let blend = |v: [f32; 4]| {
-                let top = v[0] * (1.0 - fx) + v[1] * fx;
-                let bottom = v[2] * (1.0 - fx) + v[3] * fx;
-                top * (1.0 - fy) + bottom * fy
-            };
-            let scale = blend([t00[3], t10[3], t01[3], t11[3]]);
-            for (c, l) in lambda(i).into_iter().enumerate() {
-                let at = |t: [f32; 4]| SigmoidPolynomial::new([t[0], t[1], t[2]]).eval(l);
-                #[allow(clippy::cast_possible_truncation)]
-                let illuminant = d65(f64::from(l)) as f32;
-                out[c][i] = blend([at(t00), at(t10), at(t01), at(t11)]) * scale * illuminant;
+        // One texel per lane, as in `blend`: (c₀, c₁, c₂, scale).
+        let texel = |dx: usize, dy: usize| -> [R; 4] {
+            let mut t = [[0.0f32; MAX_LANES]; 4];
+            for i in 0..R::LANES {
+                let v = spectra.get((y[i] as usize + dy) * row + x[i] as usize + dx).copied().unwrap_or([0.0; 4]);
+                for (field, v) in t.iter_mut().zip(v) {
+                    field[i] = v;
+                }
             }
-        }
-        out.map(|c| R::from_fn(|i| c[i]))
+            t.map(|field| R::from_fn(|i| field[i]))
+        };
+        let corners = [texel(0, 0), texel(1, 0), texel(0, 1), texel(1, 1)];
+        let (one_x, one_y) = (R::splat(1.0) - fx, R::splat(1.0) - fy);
+        let blend = |v: [R; 4]| {
+            let top = v[0] * one_x + v[1] * fx;
+            let bottom = v[2] * one_x + v[3] * fx;
+            top * one_y + bottom * fy
+        };
+        let scale = blend(corners.map(|t| t[3]));
+        std::array::from_fn(|c| {
+            let s = blend(corners.map(|t| sigmoid_polynomial_lanes([t[0], t[1], t[2]], lambda[c])));
+            s * scale * d65_at(lambda[c])
+        })
     }
 
     /// Bilinear lookup at texture coordinates `uv` (module docs).
@@ -307,7 +309,7 @@ impl EnvMap {
     /// [`Self::sample_lanes`], the radiance at each lane's wavelengths where `lambda` is given (spectral
     /// mode, after [`Self::prepare_spectra`]).
     #[inline(always)]
-    pub fn sample_lanes_at<R: Real>(&self, uc: R, ux: R, uy: R, lanes: u32, lambda: Option<LaneWavelengths<'_>>) -> EnvSample<R> {
+    pub fn sample_lanes_at<R: Real>(&self, uc: R, ux: R, uy: R, lanes: u32, lambda: Option<&[R; 3]>) -> EnvSample<R> {
         let (uc, ux, uy) = (numbers(uc), numbers(ux), numbers(uy));
         let (mut cells, mut fx, mut fy, mut density) =
             (([0u32; MAX_LANES], [0u32; MAX_LANES]), [0.0; MAX_LANES], [0.0; MAX_LANES], [0.0; MAX_LANES]);
@@ -327,7 +329,7 @@ impl EnvMap {
         let zero = R::splat(0.0);
         let valid = density.gt(zero) & sin_theta.gt(zero);
         let li = match lambda {
-            Some(lambda) => self.blend_at(&cells, fx, fy, lanes, lambda),
+            Some(lambda) => self.blend_at(&cells, fx, fy, lambda),
             None => self.blend(&cells, fx, fy),
         };
         EnvSample { wi, li, pdf: density / (sin_theta * (2.0 * PI * PI)), valid }
@@ -343,7 +345,7 @@ impl EnvMap {
     /// [`Self::eval_lanes`], the radiance at each lane's wavelengths where `lambda` is given (spectral mode,
     /// after [`Self::prepare_spectra`]).
     #[inline(always)]
-    pub fn eval_lanes_at<R: Real>(&self, wi: V3<R>, lanes: u32, lambda: Option<LaneWavelengths<'_>>) -> EnvEval<R> {
+    pub fn eval_lanes_at<R: Real>(&self, wi: V3<R>, lanes: u32, lambda: Option<&[R; 3]>) -> EnvEval<R> {
         let d = self.to_local.vector_lanes(wi);
         let length = d.length();
         let zero = R::splat(0.0);
@@ -361,7 +363,7 @@ impl EnvMap {
         }
         let (fx, fy) = (R::from_fn(|i| fx[i]), R::from_fn(|i| fy[i]));
         let li = match lambda {
-            Some(lambda) => self.blend_at(&cells, fx, fy, lanes, lambda),
+            Some(lambda) => self.blend_at(&cells, fx, fy, lambda),
             None => self.blend(&cells, fx, fy),
         };
         let pdf = R::select(sin_theta.gt(zero), R::from_fn(|i| density[i]) / (sin_theta * (2.0 * PI * PI)), zero);
@@ -561,22 +563,30 @@ mod tests {
         use crate::math::simd::Float8;
         let rot = Transform::rotate(Vec3::new(1.0, 2.0, 0.5), 40.0).unwrap();
         let e = env(rot);
+        // Spectral mode's lookups too, each lane at its own wavelengths.
+        let mut spectral = e.clone();
+        spectral.prepare_spectra();
         let mut rng = crate::sampling::Pcg32::new(11, 3);
-        for _ in 0..500 {
+        for round in 0..1000 {
+            let (e, at_wavelengths) = if round % 2 == 0 { (&e, false) } else { (&spectral, true) };
             let u: [[f32; 8]; 3] = std::array::from_fn(|_| std::array::from_fn(|_| rng.next_f32()));
+            let lambda: [[f32; 8]; 3] = std::array::from_fn(|_| std::array::from_fn(|_| 360.0 + 470.0 * rng.next_f32()));
+            let lambda8 = lambda.map(|c| Float8::load(&c));
             let lanes = rng.next_u32() & 0xff | 1;
-            let s8 = e.sample_lanes(Float8::load(&u[0]), Float8::load(&u[1]), Float8::load(&u[2]), lanes);
+            let s8 =
+                e.sample_lanes_at(Float8::load(&u[0]), Float8::load(&u[1]), Float8::load(&u[2]), lanes, at_wavelengths.then_some(&lambda8));
             let wi8 = [s8.wi.x.to_array(), s8.wi.y.to_array(), s8.wi.z.to_array()];
             let (li8, pdf8, valid8) = (s8.li.map(|c| c.to_array()), s8.pdf.to_array(), s8.valid.bitmask());
-            let e8 = e.eval_lanes(s8.wi, lanes);
+            let e8 = e.eval_lanes_at(s8.wi, lanes, at_wavelengths.then_some(&lambda8));
             let (eli8, epdf8) = (e8.li.map(|c| c.to_array()), e8.pdf.to_array());
             for i in (0..8).filter(|i| lanes >> i & 1 != 0) {
-                let s = e.sample_lanes::<f32>(u[0][i], u[1][i], u[2][i], 1);
+                let lambda = lambda.map(|c| c[i]);
+                let s = e.sample_lanes_at::<f32>(u[0][i], u[1][i], u[2][i], 1, at_wavelengths.then_some(&lambda));
                 assert_eq!(s.valid, valid8 >> i & 1 != 0);
                 assert_eq!([s.wi.x, s.wi.y, s.wi.z].map(f32::to_bits), wi8.map(|c| c[i].to_bits()));
                 assert_eq!(s.li.map(f32::to_bits), li8.map(|c| c[i].to_bits()));
                 assert_eq!(s.pdf.to_bits(), pdf8[i].to_bits());
-                let ev = e.eval_lanes::<f32>(s.wi, 1);
+                let ev = e.eval_lanes_at::<f32>(s.wi, 1, at_wavelengths.then_some(&lambda));
                 assert_eq!(ev.li.map(f32::to_bits), eli8.map(|c| c[i].to_bits()));
                 assert_eq!(ev.pdf.to_bits(), epdf8[i].to_bits());
             }

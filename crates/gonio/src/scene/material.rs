@@ -448,6 +448,16 @@ impl Material {
         t.eval_lanes(u, v, lanes).map(|c| Real::clamp(c, 0.0, 1.0)) // textured_reflectance in lanes
     }
 
+    /// The model this material's models at hits are copies of, where it has one: a `Fixed` model, or a
+    /// `Slotted` one before its textures are written into it ([`Bsdf::kernel_of_lanes`] takes the copies).
+    #[must_use]
+    pub fn model(&self) -> Option<&Bsdf> {
+        match self {
+            Material::Fixed(model) | Material::Slotted { model, .. } => Some(model),
+            Material::TexturedDiffuse(_) | Material::Textured { .. } => None,
+        }
+    }
+
     /// The BSDF at texture coordinates `uv`. A texture's value outside its parameter's range is clamped
     /// into it (`Props::set_texture_value`); one a model still rejects (not a number) gives a black
     /// diffuse rather than a panic; load-time validation catches constant mistakes.

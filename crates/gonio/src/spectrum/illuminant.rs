@@ -29,6 +29,8 @@
 
 use std::sync::OnceLock;
 
+use crate::math::lanes::Real;
+
 use super::cie::{cie1931_xyz, CIE1931_XYZ, CIE_MAX, CIE_MIN, CIE_SAMPLES, CIE_Y_NORMALIZATION};
 use super::piecewise::PiecewiseLinear;
 use super::upsample::{RgbIlluminantSpectrum, RgbReflectanceSpectrum, RgbUnboundedSpectrum};
@@ -93,6 +95,21 @@ pub fn d65_normalization() -> f64 {
 #[must_use]
 pub fn d65(lambda: f64) -> f64 {
     d65_relative(lambda) * d65_normalization()
+}
+
+/// [`d65`] in `f32` lanes, for a renderer's wavelengths: the table times the normalisation, rounded to `f32`
+/// once, and interpolated in `f32` (within 10⁻⁶ of [`d65`]'s peak: the position between two nodes is found
+/// in `f32`, to a few 10⁻⁶ nm); 0 outside [300, 830] nm and for NaN.
+#[inline(always)]
+#[must_use]
+pub fn d65_at<R: Real>(lambda: R) -> R {
+    static TABLE: OnceLock<[f32; D65_TABLE.len()]> = OnceLock::new();
+    #[allow(clippy::cast_possible_truncation)]
+    let table = TABLE.get_or_init(|| D65_TABLE.map(|v| (v * d65_normalization()) as f32));
+    #[allow(clippy::cast_possible_truncation)]
+    let (lo, hi) = (D65_MIN as f32, D65_MAX as f32);
+    let inside = lambda.ge(R::splat(lo)) & lambda.le(R::splat(hi));
+    R::select(inside, ((lambda - lo) / (hi - lo)).lerp_table(table), R::splat(0.0))
 }
 
 /// Planck constant h, J·s (SI 2019, exact).

@@ -18,23 +18,26 @@
 //!   luminance 1 ([`emission_at`]). It is linear in a scale factor, so emission already multiplied by a
 //!   light's falloff, a distance or an MIS weight converts to the same spectrum times that factor.
 
-use super::illuminant::d65;
+use super::illuminant::d65_at;
 use super::named::xyz_to_linear_srgb;
 use super::observer::wavelengths_to_xyz;
 use super::upsample::srgb_table;
 use super::wavelengths::{sample_visible_wavelength, visible_wavelength_pdf};
 use super::Rgb;
+use crate::math::lanes::Real;
 
 /// Wavelengths per path in spectral mode (module docs).
 pub const PATH_WAVELENGTHS: usize = 3;
 
-/// A path's wavelengths (nm, the hero first) and the density of each (nm⁻¹) from one sample `uc` ∈ [0, 1].
+/// A path's wavelengths (nm, the hero first) and the density of each (nm⁻¹) from one sample `uc` ∈ [0, 1],
+/// in lanes.
+#[inline(always)]
 #[must_use]
-pub fn sample_path_wavelengths(uc: f32) -> ([f32; PATH_WAVELENGTHS], [f32; PATH_WAVELENGTHS]) {
-    let lambda: [f32; PATH_WAVELENGTHS] = std::array::from_fn(|i| {
+pub fn sample_path_wavelengths<R: Real>(uc: R) -> ([R; PATH_WAVELENGTHS], [R; PATH_WAVELENGTHS]) {
+    let lambda: [R; PATH_WAVELENGTHS] = std::array::from_fn(|i| {
         #[allow(clippy::cast_precision_loss)]
         let u = uc + i as f32 / PATH_WAVELENGTHS as f32;
-        sample_visible_wavelength(if u > 1.0 { u - 1.0 } else { u })
+        sample_visible_wavelength(R::select(u.gt(R::splat(1.0)), u - 1.0, u))
     });
     (lambda, lambda.map(visible_wavelength_pdf))
 }
@@ -57,8 +60,7 @@ pub fn reflectance_at(rgb: [f32; 3], lambda: [f32; PATH_WAVELENGTHS]) -> [f32; P
 #[must_use]
 pub fn emission_at(rgb: [f32; 3], lambda: [f32; PATH_WAVELENGTHS]) -> [f32; PATH_WAVELENGTHS] {
     let s = unbounded_at(rgb, lambda);
-    #[allow(clippy::cast_possible_truncation)]
-    std::array::from_fn(|c| s[c] * d65(f64::from(lambda[c])) as f32)
+    std::array::from_fn(|c| s[c] * d65_at(lambda[c]))
 }
 
 /// An unbounded value `rgb` (negative components count as 0, NaN stays NaN) at the wavelengths `lambda`:

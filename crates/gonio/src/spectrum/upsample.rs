@@ -59,25 +59,35 @@ use std::sync::OnceLock;
 use rayon::prelude::*;
 
 use super::cie::{cie1931_xyz, CIE_MAX, CIE_MIN, CIE_SAMPLES, CIE_Y_NORMALIZATION};
-use super::illuminant::d65;
+use super::illuminant::{d65, d65_at};
 use super::named::xyz_to_linear_srgb;
 use super::Rgb;
+use crate::math::lanes::Real;
 
 /// Jakob & Hanika's sigmoid, S(x) = 1/2 + x / (2 √(1 + x²)): (0, 1) for finite x,
-/// 0 and 1 at ∓∞ (and for |x| ≥ 10¹⁸, where x² would overflow); NaN stays NaN.
+/// 0 and 1 at ∓∞ (and for |x| ≥ 10¹⁸, where x² would overflow); NaN stays NaN. [`sigmoid_lanes`] at one lane.
 #[inline]
 #[must_use]
 pub fn sigmoid(x: f32) -> f32 {
-    if !(x.abs() < 1e18) {
-        return if x.is_nan() {
-            x
-        } else if x > 0.0 {
-            1.0
-        } else {
-            0.0
-        };
-    }
-    0.5 + x / (2.0 * x.mul_add(x, 1.0).sqrt())
+    sigmoid_lanes(x)
+}
+
+/// [`sigmoid`] in lanes.
+#[inline(always)]
+#[must_use]
+pub fn sigmoid_lanes<R: Real>(x: R) -> R {
+    let (zero, one) = (R::splat(0.0), R::splat(1.0));
+    let inner = R::splat(0.5) + x / (x.mul_add(x, one).sqrt() * 2.0);
+    let outside = R::select(x.is_nan(), x, R::select(x.gt(zero), one, zero));
+    R::select(x.abs().lt(R::splat(1e18)), inner, outside)
+}
+
+/// s(λ) = S(c₀ λ² + c₁ λ + c₂) per lane (the coefficients `c` of [`SigmoidPolynomial`], one set per lane),
+/// `lambda` in nm: [`SigmoidPolynomial::eval`] in lanes.
+#[inline(always)]
+#[must_use]
+pub fn sigmoid_polynomial_lanes<R: Real>(c: [R; 3], lambda: R) -> R {
+    sigmoid_lanes(c[0].mul_add(lambda, c[1]).mul_add(lambda, c[2]))
 }
 
 /// Centre of the solver's variable t = (λ − [`T_CENTER`]) / [`T_HALF_WIDTH`], nm.
@@ -123,7 +133,7 @@ impl SigmoidPolynomial {
     #[inline]
     #[must_use]
     pub fn eval(&self, lambda: f32) -> f32 {
-        sigmoid(self.c[0].mul_add(lambda, self.c[1]).mul_add(lambda, self.c[2]))
+        sigmoid_polynomial_lanes(self.c, lambda)
     }
 
     /// The linear sRGB of this reflectance under D65 (the round trip of the module docs, by its 282-node
@@ -673,8 +683,6 @@ impl RgbIlluminantSpectrum {
     #[inline]
     #[must_use]
     pub fn eval(&self, lambda: f32) -> f32 {
-        #[allow(clippy::cast_possible_truncation)]
-        let illuminant = d65(f64::from(lambda)) as f32;
-        self.0.eval(lambda) * illuminant
+        self.0.eval(lambda) * d65_at(lambda)
     }
 }
