@@ -52,8 +52,8 @@ const VISIBLE_T_RANGE: f64 = 1.827_501_972_410_097_8;
 const VISIBLE_NORM: f32 = (0.0072 / VISIBLE_T_RANGE) as f32;
 
 /// Draws one wavelength (nm) from the visible-importance density p(λ) (module docs) by inverting its CDF
-/// (atanh by [`atanh`], within 10⁻⁴ nm of the exact inverse), in lanes. `uc` ∈ [0, 1]; the result lies in
-/// [[`LAMBDA_MIN`], [`LAMBDA_MAX`]] (clamped against f32 rounding).
+/// (atanh by [`atanh`]: within 3·10⁻⁴ nm of the exact inverse by its bound), in lanes. `uc` ∈ [0, 1]; the
+/// result lies in [[`LAMBDA_MIN`], [`LAMBDA_MAX`]] (clamped against f32 rounding).
 #[inline]
 #[must_use]
 pub fn sample_visible_wavelength<R: Real>(uc: R) -> R {
