@@ -887,20 +887,24 @@ impl Bsdf {
             let lanes = models.map(|m| m.and_then(conductor));
             return own.kernel_of_lanes(&lanes);
         }
-        // A colour per lane: each copy must be this model once its colour is this model's.
-        let name = match self {
-            Bsdf::Plastic(_) | Bsdf::RoughPlastic(_) => "diffuse_reflectance",
-            Bsdf::Principled(_) => "base_color",
-            _ => return None,
-        };
-        let own = *self.clone().reflectance_slot(name)?;
+        // A colour per lane: each copy must be this model with its colour written into it.
+        fn colour_of(b: &Bsdf) -> Option<(&'static str, Rgb)> {
+            match b {
+                Bsdf::Plastic(p) => Some(("diffuse_reflectance", p.diffuse_reflectance)),
+                Bsdf::RoughPlastic(p) => Some(("diffuse_reflectance", p.diffuse_reflectance)),
+                Bsdf::Principled(p) => Some(("base_color", p.base_color)),
+                _ => None,
+            }
+        }
+        let (name, own) = colour_of(self)?;
         let mut colour = own.0.map(|c| [c; PER_LANE]);
+        let mut probe = self.clone();
         for (lane, model) in models.iter().enumerate() {
             let Some(model) = model else { continue };
-            let mut copy = (*model).clone();
-            let value = std::mem::replace(copy.reflectance_slot(name)?, own);
+            let (_, value) = colour_of(model)?;
+            *probe.reflectance_slot(name)? = value;
             // (A value the kernel would clamp differently, or NaN, is not taken.)
-            if copy != *self || value.0.iter().any(|&v| textured_reflectance(v) != v) {
+            if probe != **model || value.0.iter().any(|&v| textured_reflectance(v) != v) {
                 return None;
             }
             for (channel, v) in colour.iter_mut().zip(value.0) {

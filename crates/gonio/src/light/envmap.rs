@@ -116,6 +116,14 @@ fn numbers<R: Real>(v: R) -> [f32; MAX_LANES] {
 
 type Cells = ([u32; MAX_LANES], [u32; MAX_LANES]);
 
+/// The bilinear blend of the values `v` at a cell's corners (in [`EnvMap::corners`]' order) with fractions
+/// (fx, fy): (1 − fy)((1 − fx) v₀₀ + fx v₁₀) + fy((1 − fx) v₀₁ + fx v₁₁).
+#[inline(always)]
+fn bilinear<R: Real>(v: [R; 4], fx: R, fy: R) -> R {
+    let (one_x, one_y) = (R::splat(1.0) - fx, R::splat(1.0) - fy);
+    (v[0] * one_x + v[1] * fx) * one_y + (v[2] * one_x + v[3] * fx) * fy
+}
+
 impl EnvMap {
     /// An environment from a linear-RGB lat-long image.
     ///
@@ -231,29 +239,30 @@ impl EnvMap {
         self.cells.pmf(y as usize * self.width + x as usize) * self.cells.len() as f32
     }
 
+    /// The four texels around each lane's cell, (x, y), (x + 1, y), (x, y + 1), (x + 1, y + 1), each field
+    /// in lanes: read lane by lane from `texel(index)` (x, y are in range by construction; a miss reads
+    /// zeros, never panics).
+    #[inline(always)]
+    fn corners<R: Real, const N: usize>(&self, (x, y): &Cells, texel: impl Fn(usize) -> Option<[f32; N]>) -> [[R; N]; 4] {
+        let row = self.width + 1;
+        [(0, 0), (1, 0), (0, 1), (1, 1)].map(|(dx, dy)| {
+            let mut fields = [[0.0f32; MAX_LANES]; N];
+            for i in 0..R::LANES {
+                let t = texel((y[i] as usize + dy) * row + x[i] as usize + dx).unwrap_or([0.0; N]);
+                for (field, v) in fields.iter_mut().zip(t) {
+                    field[i] = v;
+                }
+            }
+            fields.map(|field| R::from_fn(|i| field[i]))
+        })
+    }
+
     /// The bilinear blend of the four texels around each lane's cell with fractions (fx, fy): the texels
     /// read lane by lane, the blend in lanes.
     #[inline(always)]
-    fn blend<R: Real>(&self, (x, y): &Cells, fx: R, fy: R) -> [R; 3] {
-        let row = self.width + 1;
-        // One texel per lane (x, y are in range by construction; a miss would read black, never panic).
-        let texel = |dx: usize, dy: usize| -> [R; 3] {
-            let mut rgb = [[0.0f32; MAX_LANES]; 3];
-            for i in 0..R::LANES {
-                let t = self.texels.get((y[i] as usize + dy) * row + x[i] as usize + dx).copied().unwrap_or(Rgb::ZERO);
-                for (c, v) in rgb.iter_mut().zip(t.0) {
-                    c[i] = v;
-                }
-            }
-            rgb.map(|c| R::from_fn(|i| c[i]))
-        };
-        let (t00, t10, t01, t11) = (texel(0, 0), texel(1, 0), texel(0, 1), texel(1, 1));
-        let (one_x, one_y) = (R::splat(1.0) - fx, R::splat(1.0) - fy);
-        std::array::from_fn(|c| {
-            let top = t00[c] * one_x + t10[c] * fx;
-            let bottom = t01[c] * one_x + t11[c] * fx;
-            top * one_y + bottom * fy
-        })
+    fn blend<R: Real>(&self, cells: &Cells, fx: R, fy: R) -> [R; 3] {
+        let t = self.corners::<R, 3>(cells, |k| self.texels.get(k).map(|t| t.0));
+        std::array::from_fn(|c| bilinear([t[0][c], t[1][c], t[2][c], t[3][c]], fx, fy))
     }
 
     /// The radiance at each lane's wavelengths `lambda` (nm, per channel) from the spectra
@@ -261,30 +270,13 @@ impl EnvMap {
     /// variants blend them (module docs): the texels read lane by lane, the rest in lanes. Without spectra
     /// (not prepared), [`Self::blend`]'s colours.
     #[inline(always)]
-    fn blend_at<R: Real>(&self, (x, y): &Cells, fx: R, fy: R, lambda: &[R; 3]) -> [R; 3] {
-        let Some(spectra) = &self.spectra else { return self.blend(&(*x, *y), fx, fy) };
-        let row = self.width + 1;
-        // One texel per lane, as in `blend`: (c₀, c₁, c₂, scale).
-        let texel = |dx: usize, dy: usize| -> [R; 4] {
-            let mut t = [[0.0f32; MAX_LANES]; 4];
-            for i in 0..R::LANES {
-                let v = spectra.get((y[i] as usize + dy) * row + x[i] as usize + dx).copied().unwrap_or([0.0; 4]);
-                for (field, v) in t.iter_mut().zip(v) {
-                    field[i] = v;
-                }
-            }
-            t.map(|field| R::from_fn(|i| field[i]))
-        };
-        let corners = [texel(0, 0), texel(1, 0), texel(0, 1), texel(1, 1)];
-        let (one_x, one_y) = (R::splat(1.0) - fx, R::splat(1.0) - fy);
-        let blend = |v: [R; 4]| {
-            let top = v[0] * one_x + v[1] * fx;
-            let bottom = v[2] * one_x + v[3] * fx;
-            top * one_y + bottom * fy
-        };
-        let scale = blend(corners.map(|t| t[3]));
+    fn blend_at<R: Real>(&self, cells: &Cells, fx: R, fy: R, lambda: &[R; 3]) -> [R; 3] {
+        let Some(spectra) = &self.spectra else { return self.blend(cells, fx, fy) };
+        // (c₀, c₁, c₂, scale) of each corner.
+        let corners = self.corners::<R, 4>(cells, |k| spectra.get(k).copied());
+        let scale = bilinear(corners.map(|t| t[3]), fx, fy);
         std::array::from_fn(|c| {
-            let s = blend(corners.map(|t| sigmoid_polynomial_lanes([t[0], t[1], t[2]], lambda[c])));
+            let s = bilinear(corners.map(|t| sigmoid_polynomial_lanes([t[0], t[1], t[2]], lambda[c])), fx, fy);
             s * scale * d65_at(lambda[c])
         })
     }
