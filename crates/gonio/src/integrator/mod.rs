@@ -70,6 +70,30 @@ fn stream_and_offset(scene: &Scene, seed: u64, s: CameraSample) -> (glam::Vec2, 
     (offset, rng)
 }
 
+/// The stratum of camera sample `s`'s wavelengths in spectral mode ([`hero_offset`]): the base-2 radical
+/// inverse of its number `k` (van der Corput), rotated by an offset drawn once per pixel from the seed. Any
+/// `2ᵐ` consecutive samples from a multiple of `2ᵐ` fall one in each `2⁻ᵐ` of [0, 1), and every prefix of a
+/// pixel's samples is spread nearly as evenly; sample `k` has its stratum whichever range it is rendered
+/// in. The rotation makes each sample's stratum uniform on its own, and pixels' strata independent.
+///
+/// [`hero_offset`]: crate::spectrum::sampled::hero_offset
+#[inline(always)]
+#[must_use]
+pub(crate) fn wavelength_stratum(scene: &Scene, seed: u64, s: CameraSample) -> f32 {
+    // The pixel's rotation: 32 bits of a hash of the seed (kept apart from the paths' streams, which hash
+    // the sample's number) and the pixel.
+    #[allow(clippy::cast_possible_truncation)]
+    let rotation = (mix(mix(seed, WAVELENGTH_STREAM), pixel_index(scene, s)) >> 32) as u32;
+    let bits = rotation.wrapping_add(s.k.reverse_bits());
+    // The top 24 bits: exact in f32, below 1.
+    #[allow(clippy::cast_precision_loss)]
+    let stratum = (bits >> 8) as f32 * (1.0 / 16_777_216.0);
+    stratum
+}
+
+/// What [`wavelength_stratum`] mixes into the seed (any constant other than the samples' numbers' range).
+const WAVELENGTH_STREAM: u64 = 0x7761_7665_6c65_6e67;
+
 /// The stream of a camera sample's generator: its pixel's row-major index.
 #[inline(always)]
 fn pixel_index(scene: &Scene, s: CameraSample) -> u64 {
@@ -215,5 +239,44 @@ pub fn emitter_hit(scene: &Scene, ray: &Ray, hit: Option<&SurfaceInteraction>, p
     match weighted {
         Some(p) => le * power_heuristic(p.n_bsdf, p.pdf, p.n_light, light_pdf),
         None => le,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::mitsuba_xml;
+    use std::path::Path;
+
+    /// A pixel's wavelength strata: every aligned run of 2ᵐ samples puts one in each 2⁻ᵐ of [0, 1) (the
+    /// 16 of 0..16, the 32 of 32..64), and pixels are rotated apart.
+    #[test]
+    fn wavelength_strata_spread_over_a_pixels_samples() {
+        let xml = r#"<scene version="3.0.0"><sensor type="perspective"><film type="hdrfilm">
+            <integer name="width" value="8"/><integer name="height" value="4"/></film></sensor></scene>"#;
+        let scene = Scene::build(mitsuba_xml::load_str(xml, "strata.xml", Path::new("."), &[]).unwrap()).unwrap();
+        let strata = |x: u32, y: u32, ks: std::ops::Range<u32>| -> Vec<f32> {
+            ks.map(|k| wavelength_stratum(&scene, 7, CameraSample { x, y, k })).collect()
+        };
+        for (x, y) in [(0, 0), (5, 3)] {
+            for (ks, n) in [(0..16, 16usize), (32..64, 32)] {
+                let s = strata(x, y, ks.clone());
+                let mut seen = vec![false; n];
+                for &w in &s {
+                    assert!((0.0..1.0).contains(&w), "{w}");
+                    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, clippy::cast_precision_loss)]
+                    let bin = (w * n as f32) as usize;
+                    assert!(!seen[bin], "pixel ({x}, {y}), samples {ks:?}: two strata in bin {bin}: {s:?}");
+                    seen[bin] = true;
+                }
+            }
+        }
+        assert_ne!(strata(0, 0, 0..1), strata(5, 3, 0..1));
+        assert_ne!(strata(0, 0, 0..1), strata(1, 0, 0..1));
+        // Another seed rotates the pixel elsewhere.
+        assert_ne!(
+            wavelength_stratum(&scene, 7, CameraSample { x: 0, y: 0, k: 0 }),
+            wavelength_stratum(&scene, 8, CameraSample { x: 0, y: 0, k: 0 })
+        );
     }
 }

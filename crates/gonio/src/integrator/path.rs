@@ -21,7 +21,7 @@
 //! draws from its own random stream in the order a path traced alone would, so the packet changes nothing
 //! but the speed.
 
-use super::{emitter_hit, mix, start_lanes, BsdfSampled, CameraSample};
+use super::{emitter_hit, mix, start_lanes, wavelength_stratum, BsdfSampled, CameraSample};
 use crate::bsdf::diffuse::{diffuse_f, diffuse_pdf, diffuse_sample};
 use crate::bsdf::lanes::{LaneModel, LaneSample};
 use crate::bsdf::{Bsdf, BsdfModel, PerLaneKernel};
@@ -44,7 +44,7 @@ use crate::sampling::Pcg32x8;
 use crate::scene::spectral::{reflectances_at, Dependence, GivenSpectra};
 use crate::scene::surfaces::{Rows3, Surfaces8};
 use crate::scene::Scene;
-use crate::spectrum::sampled::{path_to_linear_srgb, sample_path_wavelengths, PATH_WAVELENGTHS};
+use crate::spectrum::sampled::{hero_offset, path_to_linear_srgb, sample_path_wavelengths, PATH_WAVELENGTHS};
 use crate::spectrum::Rgb;
 use std::borrow::Cow;
 
@@ -172,11 +172,13 @@ impl Packet {
         [l.x, l.y, l.z]
     }
 
-    /// Lanes `lanes` (new paths) draw their wavelengths, in spectral mode: the next number of each one's
-    /// stream.
+    /// Lanes `lanes` (new paths) draw their wavelengths, in spectral mode: each one's camera sample's
+    /// stratum (`strata`, [`wavelength_stratum`]) in the third the next number of its stream picks
+    /// ([`hero_offset`]).
     #[inline(always)]
-    fn sample_wavelengths(&mut self, lanes: u32) {
-        let (lambda, pdf) = sample_path_wavelengths(self.rng.next_f32(lanes));
+    fn sample_wavelengths(&mut self, lanes: u32, strata: &[f32; W]) {
+        let uc = hero_offset(Float8::load(strata), self.rng.next_f32(lanes));
+        let (lambda, pdf) = sample_path_wavelengths(uc);
         let m = Mask8::from_bitmask(lanes);
         self.lambda.store(V3::select(m, V3::new(lambda[0], lambda[1], lambda[2]), self.lambda.lanes()));
         self.lambda_pdf.store(V3::select(m, V3::new(pdf[0], pdf[1], pdf[2]), self.lambda_pdf.lanes()));
@@ -959,11 +961,15 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
         let mut pending = p.live;
         loop {
             let (mut fill, mut chosen, mut mixed) = (0u32, [CameraSample { x: 0, y: 0, k: 0 }; W], [0u64; W]);
+            let mut strata = [0.0f32; W];
             for lane in bits(!p.live & ((1 << W) - 1)) {
                 if next == samples.len() {
                     break;
                 }
                 (chosen[lane], p.sample[lane], mixed[lane]) = (samples[next], next, mix(seed, u64::from(samples[next].k)));
+                if p.spectral {
+                    strata[lane] = wavelength_stratum(scene, seed, samples[next]);
+                }
                 fill |= 1 << lane;
                 next += 1;
             }
@@ -971,7 +977,7 @@ pub fn radiance(scene: &Scene, seed: u64, samples: &[CameraSample], out: &mut [R
                 let rays = start_lanes(scene, &mixed, &chosen, fill, &mut p.rng);
                 p.start(fill, &rays);
                 if p.spectral {
-                    p.sample_wavelengths(fill);
+                    p.sample_wavelengths(fill, &strata);
                 }
             }
             pending |= fill;
