@@ -206,10 +206,27 @@ impl Packet {
     /// Emission `le` (linear RGB) found by lanes `lanes`, each from light `light(lane)`, as the path carries
     /// it: unchanged in RGB mode, and at each lane's wavelengths in spectral mode
     /// ([`SpectralScene::emission`](crate::scene::SpectralScene::emission)).
+    ///
+    /// The lanes of one light whose spectrum is fitted from its colour are evaluated together
+    /// ([`SpectralScene::fitted_emission`](crate::scene::SpectralScene::fitted_emission), which
+    /// `SpectralScene::emission` is at one lane), the others lane by lane.
     #[inline(always)]
     fn emission(&self, scene: &Scene, le: [Float8; 3], lanes: u32, light: impl Fn(usize) -> Option<usize>) -> [Float8; 3] {
         let Some(spectral) = &scene.spectral else { return le };
-        map_lanes(le, lanes, |lane, rgb| spectral.emission(light(lane), rgb, self.lambda(lane)))
+        let lights: [Option<usize>; W] = std::array::from_fn(|lane| if lanes >> lane & 1 != 0 { light(lane) } else { None });
+        let same = |lane: usize| (0..W).filter(|&l| lights[l] == lights[lane]).fold(0u32, |m, l| m | 1 << l);
+        let (mut out, mut alone) = (le, 0u32);
+        for (lane, group) in groups(lanes, same) {
+            let Some(values) = spectral.fitted_emission(lights[lane], le, self.lambda_lanes()) else {
+                alone |= group;
+                continue;
+            };
+            let m = Mask8::from_bitmask(group);
+            for c in 0..3 {
+                out[c] = Float8::select(m, values[c], out[c]);
+            }
+        }
+        map_lanes(out, alone, |lane, rgb| spectral.emission(lights[lane], rgb, self.lambda(lane)))
     }
 
     /// The probability of choosing light `index` at the vertex lane `lane`'s ray left

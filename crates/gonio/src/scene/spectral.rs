@@ -20,6 +20,7 @@ use crate::bsdf::textured_reflectance;
 use crate::bsdf::Bsdf;
 use crate::error::{Error, Result};
 use crate::light::Light;
+use crate::math::lanes::Real;
 use crate::props::{Props, Value};
 use crate::spectrum::illuminant::Spectrum;
 use crate::spectrum::piecewise::PiecewiseLinear;
@@ -201,12 +202,30 @@ impl SpectralScene {
         }
     }
 
+    /// [`SpectralScene::emission`] where light `light` has a spectrum fitted from its one colour (an
+    /// [`RgbIlluminantSpectrum`]), in lanes (`rgb` and `lambda` per channel, one light for every lane):
+    /// that spectrum times the factor `rgb` is of the light's colour (its largest component over the
+    /// colour's; NaN stays NaN). `None` for a light of no one colour or whose spectrum was given, and for
+    /// `None`.
+    #[inline(always)]
+    #[must_use]
+    pub fn fitted_emission<R: Real>(&self, light: Option<usize>, rgb: [R; 3], lambda: [R; PATH_WAVELENGTHS]) -> Option<[R; 3]> {
+        let (max, spectrum) = light.and_then(|i| self.lights.get(i)).and_then(Option::as_ref)?;
+        let Spectrum::Illuminant(spectrum) = spectrum.as_ref() else { return None };
+        let factor = rgb[0].max(rgb[1]).max(rgb[2]).max(R::splat(0.0)) / *max;
+        let nan = rgb[0].is_nan() | rgb[1].is_nan() | rgb[2].is_nan();
+        Some(lambda.map(|l| R::select(nan, R::splat(f32::NAN), factor * spectrum.eval_lanes(l))))
+    }
+
     /// Emission `rgb` from light `light` (its index; `None` if not known) at the wavelengths `lambda`: the
     /// light's fitted spectrum times the factor `rgb` is of its colour, where it has one colour; else by
     /// [`emission_at`].
     #[inline]
     #[must_use]
     pub fn emission(&self, light: Option<usize>, rgb: [f32; 3], lambda: [f32; PATH_WAVELENGTHS]) -> [f32; PATH_WAVELENGTHS] {
+        if let Some(values) = self.fitted_emission(light, rgb, lambda) {
+            return values;
+        }
         let Some((max, spectrum)) = light.and_then(|i| self.lights.get(i)).and_then(Option::as_ref) else {
             return emission_at(rgb, lambda);
         };
@@ -388,4 +407,53 @@ fn convert(b: &mut Bsdf, lambda: [f32; PATH_WAVELENGTHS]) {
         }
     }
     b.for_each_nested(&mut |m| convert(m, lambda));
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::simd::Float8;
+    use crate::sampling::Pcg32;
+    use crate::scene::{mitsuba_xml, Scene};
+    use std::path::Path;
+
+    /// The emission of lights fitted from a colour, in lanes (as the path tracer's packets take it), is
+    /// each lane's [`SpectralScene::emission`] bit for bit, NaN and negative colours included; a light whose
+    /// spectrum was given (a black body) has no fitted spectrum and keeps its own.
+    #[test]
+    fn fitted_emission_in_lanes_is_each_lanes() {
+        let xml = r#"<scene version="3.0.0"><sensor type="perspective"/>
+            <emitter type="point"><rgb name="intensity" value="4, 2, 0.5"/></emitter>
+            <emitter type="constant"><rgb name="radiance" value="0.1, 0.3, 0.9"/></emitter>
+            <emitter type="point"><point name="position" x="1" y="0" z="0"/>
+                <spectrum name="intensity" type="blackbody"><float name="temperature" value="3000"/></spectrum></emitter>
+            </scene>"#;
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/ior");
+        let scene = Scene::build_in(mitsuba_xml::load_str(xml, "lights.xml", &dir, &[]).unwrap(), Mode::Spectral).unwrap();
+        let spectral = scene.spectral.as_ref().unwrap();
+        let mut rng = Pcg32::new(3, 5);
+        for round in 0..200 {
+            let mut rgb: [[f32; 8]; 3] = std::array::from_fn(|_| std::array::from_fn(|_| 5.0 * rng.next_f32() - 0.5));
+            if round % 7 == 0 {
+                rgb[round % 3][round % 8] = f32::NAN;
+            }
+            let lambda: [[f32; 8]; 3] = std::array::from_fn(|_| std::array::from_fn(|_| 360.0 + 470.0 * rng.next_f32()));
+            let lanes = |rows: &[[f32; 8]; 3]| rows.map(|r| Float8::load(&r));
+            for light in [Some(0), Some(1)] {
+                let values = spectral.fitted_emission(light, lanes(&rgb), lanes(&lambda)).unwrap().map(Float8::to_array);
+                for l in 0..8 {
+                    let one = spectral.emission(light, [rgb[0][l], rgb[1][l], rgb[2][l]], [lambda[0][l], lambda[1][l], lambda[2][l]]);
+                    for c in 0..3 {
+                        let (a, b) = (values[c][l], one[c]);
+                        assert!(
+                            a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan()) || (a == 0.0 && b == 0.0),
+                            "light {light:?} lane {l} channel {c}: {a} against {b}"
+                        );
+                    }
+                }
+            }
+            assert!(spectral.fitted_emission(Some(2), lanes(&rgb), lanes(&lambda)).is_none());
+            assert!(spectral.fitted_emission(None, lanes(&rgb), lanes(&lambda)).is_none());
+        }
+    }
 }

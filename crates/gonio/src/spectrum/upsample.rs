@@ -683,6 +683,14 @@ impl RgbIlluminantSpectrum {
     #[inline]
     #[must_use]
     pub fn eval(&self, lambda: f32) -> f32 {
-        self.0.eval(lambda) * d65_at(lambda)
+        self.eval_lanes(lambda)
+    }
+
+    /// [`RgbIlluminantSpectrum::eval`] in lanes (which is this at one lane).
+    #[inline(always)]
+    #[must_use]
+    pub fn eval_lanes<R: Real>(&self, lambda: R) -> R {
+        let unbounded = sigmoid_polynomial_lanes(self.0.polynomial.c.map(R::splat), lambda) * self.0.scale;
+        unbounded * d65_at(lambda)
     }
 }
