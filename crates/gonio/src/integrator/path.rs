@@ -44,7 +44,7 @@ use crate::sampling::Pcg32x8;
 use crate::scene::spectral::{reflectances_at, Dependence, GivenSpectra};
 use crate::scene::surfaces::{Rows3, Surfaces8};
 use crate::scene::Scene;
-use crate::spectrum::sampled::{hero_offset, path_to_linear_srgb, sample_path_wavelengths, PATH_WAVELENGTHS};
+use crate::spectrum::sampled::{path_to_linear_srgb, sample_path_wavelengths, PATH_WAVELENGTHS};
 use crate::spectrum::Rgb;
 use std::borrow::Cow;
 
@@ -172,13 +172,11 @@ impl Packet {
         [l.x, l.y, l.z]
     }
 
-    /// Lanes `lanes` (new paths) draw their wavelengths, in spectral mode: each one's camera sample's
-    /// stratum (`strata`, [`wavelength_stratum`]) in the third the next number of its stream picks
-    /// ([`hero_offset`]).
+    /// Lanes `lanes` (new paths) take their wavelengths, in spectral mode: the hero at each one's camera
+    /// sample's stratum (`strata`, [`wavelength_stratum`]).
     #[inline(always)]
     fn sample_wavelengths(&mut self, lanes: u32, strata: &[f32; W]) {
-        let uc = hero_offset(Float8::load(strata), self.rng.next_f32(lanes));
-        let (lambda, pdf) = sample_path_wavelengths(uc);
+        let (lambda, pdf) = sample_path_wavelengths(Float8::load(strata));
         let m = Mask8::from_bitmask(lanes);
         self.lambda.store(V3::select(m, V3::new(lambda[0], lambda[1], lambda[2]), self.lambda.lanes()));
         self.lambda_pdf.store(V3::select(m, V3::new(pdf[0], pdf[1], pdf[2]), self.lambda_pdf.lanes()));

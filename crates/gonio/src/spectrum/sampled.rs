@@ -7,7 +7,7 @@
 //! [`super::wavelengths`] describes (`uc + i/3` wrapped) and each drawn with the visible-importance
 //! density. Each of the three is an unbiased estimate on its own. Three where Mitsuba 3 and pbrt-v4 carry
 //! four gives a path's colour estimate far more variance (2–35× per sRGB channel for a flat spectrum), so
-//! the path tracer stratifies the wavelengths over a pixel's samples instead ([`hero_offset`]): the
+//! the path tracer stratifies `uc` over a pixel's samples instead (`integrator::wavelength_stratum`): the
 //! channels are there in RGB mode already, and a pixel's colour noise ends up below four independent
 //! wavelengths per path (docs/spectral.md).
 //!
@@ -42,28 +42,6 @@ pub fn sample_path_wavelengths<R: Real>(uc: R) -> ([R; PATH_WAVELENGTHS], [R; PA
         sample_visible_wavelength(R::select(u.gt(R::splat(1.0)), u - 1.0, u))
     });
     (lambda, lambda.map(visible_wavelength_pdf))
-}
-
-/// The sample-space position of a path's hero wavelength (the `uc` of [`sample_path_wavelengths`]) from its
-/// pixel's stratum `stratum` ∈ [0, 1) and a uniform number `u` ∈ [0, 1): (stratum + ⌊3u⌋) / 3, the
-/// stratum's point in the third `u` picks.
-///
-/// A path's three wavelengths are `uc`, `uc + 1/3` and `uc + 2/3` (wrapped), so which third holds the
-/// hero does not change the set, only which of them is the hero: the set is `stratum / 3` shifted by each
-/// third. Strata spread evenly over [0, 1) across a pixel's samples (the path tracer's
-/// `wavelength_stratum`, a rotated van der Corput sequence) therefore spread the pixel's wavelengths evenly
-/// over the whole sample space, where one uniform number per path leaves them clumped: the film's estimate
-/// of a pixel's colour, whose integrand (the CIE functions over the density) is smooth, then has almost
-/// no variance of its own. `u` is uniform and independent of the stratum, and the stratum uniform over
-/// the pixel's random rotation, so each path's `uc` (and its hero, which a dispersive interface follows
-/// alone) is uniform on its own, as the estimator needs.
-#[inline(always)]
-#[must_use]
-pub fn hero_offset<R: Real>(stratum: R, u: R) -> R {
-    const BELOW_ONE: f32 = 1.0 - f32::EPSILON / 2.0;
-    let t = u * 3.0;
-    let third = R::select(t.ge(R::splat(2.0)), R::splat(2.0), R::select(t.ge(R::splat(1.0)), R::splat(1.0), R::splat(0.0)));
-    ((stratum + third) * (1.0 / 3.0)).min(R::splat(BELOW_ONE))
 }
 
 /// A reflectance `rgb` (clamped to [0, 1]) at the wavelengths `lambda`.
@@ -149,35 +127,6 @@ mod tests {
         // Wrapped past 1.
         let (lambda, _) = sample_path_wavelengths(0.9);
         assert!(close(lambda[1], sample_visible_wavelength(0.9 + 1.0 / 3.0 - 1.0)), "{lambda:?}");
-    }
-
-    #[test]
-    fn hero_offsets_keep_the_strata_set_and_are_uniform() {
-        // Whichever third the number picks, the three wavelengths' sample-space positions are the stratum's
-        // point in each third: {stratum/3 + i/3}.
-        for stratum in [0.0f32, 0.1, 0.5, 0.999_999_9] {
-            for u in [0.0f32, 0.2, 0.34, 0.5, 0.7, 0.999_999_9] {
-                let uc = hero_offset(stratum, u);
-                assert!((0.0..1.0).contains(&uc), "{stratum} {u}: {uc}");
-                let third = (0..3).find(|&i| ((uc * 3.0 - stratum) - i as f32).abs() < 1e-5);
-                #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
-                let picked = ((u * 3.0) as usize).min(2);
-                assert_eq!(third, Some(picked), "{stratum} {u}: {uc}");
-            }
-        }
-        // Uniform strata and numbers give a uniform position: 20 bins of 20 000 draws each within 5 standard
-        // deviations (a hero confined to one third would fill 7 of them).
-        let mut rng = crate::sampling::Pcg32::new(7, 1);
-        let mut bins = [0u32; 20];
-        for _ in 0..400_000 {
-            let uc = hero_offset(rng.next_f32(), rng.next_f32());
-            #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
-            let bin = (uc * 20.0) as usize;
-            bins[bin] += 1;
-        }
-        for n in bins {
-            assert!((f64::from(n) - 20_000.0).abs() < 5.0 * 20_000f64.sqrt(), "{bins:?}");
-        }
     }
 
     #[test]
