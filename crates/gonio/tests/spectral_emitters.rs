@@ -60,9 +60,9 @@ fn emission_spectra_render_as_in_mitsuba() {
 }
 
 /// A pixel's wavelengths are spread over the spectrum across its samples (`integrator::wavelength_stratum`),
-/// so that a spectral pixel's colour has almost no noise of its own: a
-/// sky of one colour, seen directly at 32 spp through a box filter (each pixel its own samples' mean), gives
-/// every pixel within 1 % of the colour's maximum of the image's mean. With one independent number per
+/// so that a spectral pixel's colour has almost no noise of its own: a sky of one colour, seen directly at
+/// 32 spp through a box filter (each pixel its own samples' mean), gives every pixel within 1 % of the
+/// colour's maximum of the image's mean. With one independent number per
 /// path, as before 2026-12-07, the pixels spread a hundred times as far (the blue channel of the first sky:
 /// 0.0004 RMS now, 0.04 before; Mitsuba 3's four wavelengths per path 0.08) and this fails. Through the
 /// default Gaussian filter a pixel's value weighs its neighbours' samples unequally and keeps more of the

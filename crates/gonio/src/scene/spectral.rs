@@ -210,11 +210,16 @@ impl SpectralScene {
     #[inline(always)]
     #[must_use]
     pub fn fitted_emission<R: Real>(&self, light: Option<usize>, rgb: [R; 3], lambda: [R; PATH_WAVELENGTHS]) -> Option<[R; 3]> {
-        let (max, spectrum) = light.and_then(|i| self.lights.get(i)).and_then(Option::as_ref)?;
+        let (max, spectrum) = self.light_spectrum(light)?;
         let Spectrum::Illuminant(spectrum) = spectrum.as_ref() else { return None };
-        let factor = rgb[0].max(rgb[1]).max(rgb[2]).max(R::splat(0.0)) / *max;
-        let nan = rgb[0].is_nan() | rgb[1].is_nan() | rgb[2].is_nan();
-        Some(lambda.map(|l| R::select(nan, R::splat(f32::NAN), factor * spectrum.eval_lanes(l))))
+        let factor = emission_factor(rgb, *max);
+        Some(lambda.map(|l| factor * spectrum.eval_lanes(l)))
+    }
+
+    /// Light `light`'s spectrum and its colour's largest component, where it has one colour.
+    #[inline(always)]
+    fn light_spectrum(&self, light: Option<usize>) -> Option<&(f32, Arc<Spectrum>)> {
+        light.and_then(|i| self.lights.get(i)).and_then(Option::as_ref)
     }
 
     /// Emission `rgb` from light `light` (its index; `None` if not known) at the wavelengths `lambda`: the
@@ -226,16 +231,21 @@ impl SpectralScene {
         if let Some(values) = self.fitted_emission(light, rgb, lambda) {
             return values;
         }
-        let Some((max, spectrum)) = light.and_then(|i| self.lights.get(i)).and_then(Option::as_ref) else {
+        let Some((max, spectrum)) = self.light_spectrum(light) else {
             return emission_at(rgb, lambda);
         };
-        if rgb.iter().any(|v| v.is_nan()) {
-            return [f32::NAN; PATH_WAVELENGTHS];
-        }
-        let factor = rgb[0].max(rgb[1]).max(rgb[2]).max(0.0) / max;
+        let factor = emission_factor(rgb, *max);
         #[allow(clippy::cast_possible_truncation)]
         lambda.map(|l| factor * spectrum.eval(f64::from(l)) as f32)
     }
+}
+
+/// The factor emission `rgb` is of a light's colour whose largest component is `max`: rgb's largest (negative
+/// counting as 0) over `max`; NaN where a component is NaN, so that the emission is NaN there.
+#[inline(always)]
+fn emission_factor<R: Real>(rgb: [R; 3], max: f32) -> R {
+    let nan = rgb[0].is_nan() | rgb[1].is_nan() | rgb[2].is_nan();
+    R::select(nan, R::splat(f32::NAN), rgb[0].max(rgb[1]).max(rgb[2]).max(R::splat(0.0)) / max)
 }
 
 impl super::Scene {

@@ -133,7 +133,14 @@ impl SigmoidPolynomial {
     #[inline]
     #[must_use]
     pub fn eval(&self, lambda: f32) -> f32 {
-        sigmoid_polynomial_lanes(self.c, lambda)
+        self.eval_lanes(lambda)
+    }
+
+    /// [`SigmoidPolynomial::eval`] in lanes (which is this at one lane).
+    #[inline(always)]
+    #[must_use]
+    pub fn eval_lanes<R: Real>(&self, lambda: R) -> R {
+        sigmoid_polynomial_lanes(self.c.map(R::splat), lambda)
     }
 
     /// The linear sRGB of this reflectance under D65 (the round trip of the module docs, by its 282-node
@@ -657,7 +664,14 @@ impl RgbUnboundedSpectrum {
     #[inline]
     #[must_use]
     pub fn eval(&self, lambda: f32) -> f32 {
-        self.scale * self.polynomial.eval(lambda)
+        self.eval_lanes(lambda)
+    }
+
+    /// [`RgbUnboundedSpectrum::eval`] in lanes (which is this at one lane).
+    #[inline(always)]
+    #[must_use]
+    pub fn eval_lanes<R: Real>(&self, lambda: R) -> R {
+        self.polynomial.eval_lanes(lambda) * self.scale
     }
 }
 
@@ -690,7 +704,6 @@ impl RgbIlluminantSpectrum {
     #[inline(always)]
     #[must_use]
     pub fn eval_lanes<R: Real>(&self, lambda: R) -> R {
-        let unbounded = sigmoid_polynomial_lanes(self.0.polynomial.c.map(R::splat), lambda) * self.0.scale;
-        unbounded * d65_at(lambda)
+        self.0.eval_lanes(lambda) * d65_at(lambda)
     }
 }
