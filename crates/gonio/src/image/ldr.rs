@@ -35,9 +35,12 @@ pub(super) fn decode_stored(path: &Path, bytes: &[u8], format: Format) -> Result
             let data = decoded.into_rgb16().into_raw().into_iter().map(|v| srgb_to_linear(f32::from(v) / 65535.0)).collect();
             Stored::Linear(Image { width, height, data })
         }
-        _ => Stored::Bytes(Bytes8 { width, height, data: decoded.into_rgb8().into_raw() }),
+        DynamicImage::ImageLuma8(_) | DynamicImage::ImageLumaA8(_) => {
+            Stored::Bytes(Bytes8 { width, height, channels: 1, data: decoded.into_luma8().into_raw() })
+        }
+        _ => Stored::Bytes(Bytes8 { width, height, channels: 3, data: decoded.into_rgb8().into_raw() }),
     };
-    if stored.samples() != 3 * width * height {
+    if !stored.samples_fit() {
         return Err(Error::format(path, "pixels", "decoder returned the wrong number of samples"));
     }
     Ok(stored)

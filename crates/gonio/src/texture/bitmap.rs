@@ -74,6 +74,20 @@ enum Texels {
     Bytes { image: Arc<Bytes8>, table: &'static [f32; 256] },
 }
 
+impl Texels {
+    /// Pixel `p` (row-major, `y · width + x`) as linear RGB.
+    #[inline(always)]
+    fn texel(&self, p: usize) -> [f32; 3] {
+        match self {
+            Texels::Linear(image) => {
+                let i = 3 * p;
+                [image.data[i], image.data[i + 1], image.data[i + 2]]
+            }
+            Texels::Bytes { image, table } => image.rgb(p).map(|v| table[usize::from(v)]),
+        }
+    }
+}
+
 /// A decoded image as bitmaps share it.
 #[derive(Clone)]
 enum SharedImage {
@@ -193,17 +207,20 @@ impl Bitmap {
 
     #[must_use]
     pub fn eval(&self, uv: Vec2) -> Rgb {
-        match &self.texels {
-            Texels::Linear(image) => {
-                let d = &image.data;
-                self.filter(uv, image.width, image.height, |i| Rgb::new(d[i], d[i + 1], d[i + 2]))
-            }
-            Texels::Bytes { image, table } => {
-                let d = &image.data;
-                let v = |i: usize| table[usize::from(d[i])];
-                self.filter(uv, image.width, image.height, |i| Rgb::new(v(i), v(i + 1), v(i + 2)))
-            }
+        let (iw, ih) = self.resolution();
+        let texel = |p: usize| Rgb(self.texels.texel(p));
+        let q = self.to_uv.point(Vec3::new(uv.x, uv.y, 0.0));
+        let (w, h) = (iw as f32, ih as f32);
+        if !self.bilinear {
+            return texel(self.nearest_texel(q.x * w, q.y * h, iw, ih));
         }
+        let (x, y) = (q.x * w - 0.5, q.y * h - 0.5);
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let [t00, t10, t01, t11] = self.corner_texels(x0, y0, iw, ih).map(texel);
+        let top = t00 * (1.0 - fx) + t10 * fx;
+        let bottom = t01 * (1.0 - fx) + t11 * fx;
+        top * (1.0 - fy) + bottom * fy
     }
 
     /// The gradient ∂/∂(u, v) of the scalar lookup (the luminance of [`Self::eval`]), as Mitsuba 3's
@@ -222,13 +239,7 @@ impl Bitmap {
         let (x, y) = (q.x * w - 0.5, q.y * h - 0.5);
         let (x0, y0) = (x.floor(), y.floor());
         let (fx, fy) = (x - x0, y - y0);
-        let texel = |i: usize| match &self.texels {
-            Texels::Linear(image) => Rgb::new(image.data[i], image.data[i + 1], image.data[i + 2]).luminance(),
-            Texels::Bytes { image, table } => {
-                let v = |k: usize| table[usize::from(image.data[k])];
-                Rgb::new(v(i), v(i + 1), v(i + 2)).luminance()
-            }
-        };
+        let texel = |p: usize| Rgb(self.texels.texel(p)).luminance();
         let [f00, f10, f01, f11] = self.corner_texels(x0, y0, iw, ih).map(texel);
         // ∂f/∂x and ∂f/∂y in texels, then per unit of the transformed coordinates (× resolution).
         let (dx, dy) = (((f10 - f00) * (1.0 - fy) + (f11 - f01) * fy) * w, ((f01 - f00) * (1.0 - fx) + (f11 - f10) * fx) * h);
@@ -236,45 +247,13 @@ impl Bitmap {
         Vec2::new(du.x * dx + du.y * dy, dv.x * dx + dv.y * dy)
     }
 
-    /// The lookup at `uv` of a `iw` × `ih` image whose texel starting at sample `i` (3 (y · iw + x), both
-    /// coordinates already wrapped into it) is `texel(i)`.
-    #[inline(always)]
-    fn filter(&self, uv: Vec2, iw: usize, ih: usize, texel: impl Fn(usize) -> Rgb) -> Rgb {
-        let q = self.to_uv.point(Vec3::new(uv.x, uv.y, 0.0));
-        let (w, h) = (iw as f32, ih as f32);
-        if !self.bilinear {
-            return texel(self.nearest_texel(q.x * w, q.y * h, iw, ih));
-        }
-        let (x, y) = (q.x * w - 0.5, q.y * h - 0.5);
-        let (x0, y0) = (x.floor(), y.floor());
-        let (fx, fy) = (x - x0, y - y0);
-        let [t00, t10, t01, t11] = self.corner_texels(x0, y0, iw, ih).map(texel);
-        let top = t00 * (1.0 - fx) + t10 * fx;
-        let bottom = t01 * (1.0 - fx) + t11 * fx;
-        top * (1.0 - fy) + bottom * fy
-    }
-
     /// The colour lookup ([`Self::eval`]) at eight points (`u`, `v`) in lanes, by the same operations in
     /// each lane of `lanes` (the same value bit for bit; the other lanes are unspecified). The texels are
     /// read lane by lane; the coordinates and the blend are in lanes.
     #[must_use]
     pub fn eval_lanes(&self, u: Float8, v: Float8, lanes: u32) -> [Float8; 3] {
-        match &self.texels {
-            Texels::Linear(image) => {
-                let d = &image.data;
-                self.filter_lanes(u, v, lanes, image.width, image.height, |i| [d[i], d[i + 1], d[i + 2]])
-            }
-            Texels::Bytes { image, table } => {
-                let d = &image.data;
-                let v8 = |i: usize| table[usize::from(d[i])];
-                self.filter_lanes(u, v, lanes, image.width, image.height, |i| [v8(i), v8(i + 1), v8(i + 2)])
-            }
-        }
-    }
-
-    /// [`Self::filter`] in lanes.
-    #[inline(always)]
-    fn filter_lanes(&self, u: Float8, v: Float8, lanes: u32, iw: usize, ih: usize, texel: impl Fn(usize) -> [f32; 3]) -> [Float8; 3] {
+        let (iw, ih) = self.resolution();
+        let texel = |p: usize| self.texels.texel(p);
         let q = self.to_uv.point_lanes(V3::new(u, v, Float8::splat(0.0)));
         let (w, h) = (Float8::splat(iw as f32), Float8::splat(ih as f32));
         // Each corner's channels as rows of lanes.
@@ -310,20 +289,20 @@ impl Bitmap {
         })
     }
 
-    /// The first sample of the texel a `nearest` lookup at texel coordinates (`x`, `y`) reads.
+    /// The pixel (row-major index) a `nearest` lookup at texel coordinates (`x`, `y`) reads.
     #[inline(always)]
     fn nearest_texel(&self, x: f32, y: f32, iw: usize, ih: usize) -> usize {
-        3 * (self.wrap.apply(y.floor() as i64, ih) * iw + self.wrap.apply(x.floor() as i64, iw))
+        self.wrap.apply(y.floor() as i64, ih) * iw + self.wrap.apply(x.floor() as i64, iw)
     }
 
-    /// The first samples of the four texels a bilinear lookup blends, whose lower corner is (`x0`, `y0`):
+    /// The pixels (row-major indices) of the four texels a bilinear lookup blends, whose lower corner is (`x0`, `y0`):
     /// (x0, y0), (x0 + 1, y0), (x0, y0 + 1), (x0 + 1, y0 + 1), each column and row wrapped once.
     #[inline(always)]
     fn corner_texels(&self, x0: f32, y0: f32, iw: usize, ih: usize) -> [usize; 4] {
         let (x0, y0) = (x0 as i64, y0 as i64);
         let (c0, c1) = (self.wrap.apply(x0, iw), self.wrap.apply(x0 + 1, iw));
         let (r0, r1) = (self.wrap.apply(y0, ih), self.wrap.apply(y0 + 1, ih));
-        [(c0, r0), (c1, r0), (c0, r1), (c1, r1)].map(|(x, y)| 3 * (y * iw + x))
+        [(c0, r0), (c1, r0), (c0, r1), (c1, r1)].map(|(x, y)| y * iw + x)
     }
 }
 
@@ -393,6 +372,47 @@ mod tests {
             v,
             Rgb::new(f32::from(samples.data[i]) / 255.0, f32::from(samples.data[i + 1]) / 255.0, f32::from(samples.data[i + 2]) / 255.0)
         );
+    }
+
+    /// A grey 8-bit file (with or without alpha) is kept at one byte a pixel, and every lookup — one point,
+    /// lanes, the gradient — gives what the file expanded to R = G = B gives, bit for bit.
+    #[test]
+    fn grey_files_keep_one_byte_a_pixel() {
+        use crate::image::read_image;
+        use crate::sampling::Pcg32;
+        let dir = crate::scratch::ScratchDir::new("bitmap-grey");
+        let mut rng = Pcg32::new(7, 3);
+        let (w, h) = (17u32, 9u32);
+        let grey: Vec<u8> = (0..w * h).map(|_| (rng.next_f32() * 256.0) as u8).collect();
+        let grey_png = dir.join("grey.png");
+        ::image::GrayImage::from_raw(w, h, grey.clone()).unwrap().save(&grey_png).unwrap();
+        let grey_alpha_png = dir.join("grey-alpha.png");
+        let with_alpha: Vec<u8> = grey.iter().flat_map(|&v| [v, 255 - v]).collect();
+        ::image::GrayAlphaImage::from_raw(w, h, with_alpha).unwrap().save(&grey_alpha_png).unwrap();
+        let rgb_png = dir.join("rgb.png");
+        let rgb: Vec<u8> = grey.iter().flat_map(|&v| [v; 3]).collect();
+        ::image::RgbImage::from_raw(w, h, rgb).unwrap().save(&rgb_png).unwrap();
+        for path in [&grey_png, &grey_alpha_png] {
+            let Stored::Bytes(stored) = read_stored_image(path).unwrap() else { panic!("an 8-bit PNG is kept as bytes") };
+            assert_eq!((stored.channels, stored.data), (1, grey.clone()), "{}", path.display());
+            assert_eq!(read_image(path).unwrap(), read_image(&rgb_png).unwrap(), "decoded to floats, grey is R = G = B");
+        }
+        for filter in ["bilinear", "nearest"] {
+            let load = |path: &Path| {
+                let spec = format!(r#"{{"type": "bitmap", "filename": {:?}, "filter_type": "{filter}"}}"#, path.to_str().unwrap());
+                Bitmap::from_props(&Props::from_json(&spec).unwrap()).unwrap()
+            };
+            let (one, three) = (load(&grey_alpha_png), load(&rgb_png));
+            for _ in 0..200 {
+                let u: [f32; 8] = std::array::from_fn(|_| rng.next_f32() * 3.0 - 1.0);
+                let v: [f32; 8] = std::array::from_fn(|_| rng.next_f32() * 3.0 - 1.0);
+                let lanes = |b: &Bitmap| b.eval_lanes(Float8::load(&u), Float8::load(&v), 0xff).map(|c| c.to_array().map(f32::to_bits));
+                assert_eq!(lanes(&one), lanes(&three), "{filter}");
+                let uv = Vec2::new(u[0], v[0]);
+                assert_eq!(one.eval(uv).0.map(f32::to_bits), three.eval(uv).0.map(f32::to_bits), "{filter} at {uv}");
+                assert_eq!(one.eval_1_grad(uv), three.eval_1_grad(uv), "{filter} at {uv}");
+            }
+        }
     }
 
     /// Bitmaps of one file share its decoded image while one of them lives; a file changed on disk is read
