@@ -111,16 +111,15 @@ impl Mesh {
             }
             other => other,
         };
-        let crosses: Vec<Vec3> = indices
+        let sign = if flip_normals { -1.0 } else { 1.0 };
+        let (tri_areas, tri_normals): (Vec<f32>, Vec<Vec3>) = indices
             .iter()
             .map(|t| {
                 let [p0, p1, p2] = t.map(|i| positions[i as usize]);
-                (p1 - p0).cross(p2 - p0)
+                let (e1, e2) = (p1 - p0, p2 - p0);
+                (0.5 * e1.cross(e2).length(), face_normal(e1, e2, sign))
             })
-            .collect();
-        let tri_areas: Vec<f32> = crosses.iter().map(|c| 0.5 * c.length()).collect();
-        let sign = if flip_normals { -1.0 } else { 1.0 };
-        let tri_normals = crosses.iter().map(|c| c.normalize_or_zero() * sign).collect();
+            .unzip();
         let area = tri_areas.iter().map(|&a| f64::from(a)).sum::<f64>() as f32;
         let mut mesh = Mesh {
             positions,
@@ -402,16 +401,22 @@ impl Mesh {
     #[must_use]
     pub fn dp_du(&self, tri: u32) -> Vec3 {
         let [p0, p1, p2] = self.vertices(tri);
-        let edge = p1 - p0;
-        let Some(uvs) = &self.uvs else { return edge };
+        self.dp_du_of_edges(tri, p1 - p0, p2 - p0)
+    }
+
+    /// [`Self::dp_du`] from the triangle's edges e₁ = p₁ − p₀ and e₂ = p₂ − p₀, where the caller has them.
+    #[inline]
+    #[must_use]
+    pub fn dp_du_of_edges(&self, tri: u32, e1: Vec3, e2: Vec3) -> Vec3 {
+        let Some(uvs) = &self.uvs else { return e1 };
         let idx = self.indices[tri as usize];
         let (uv0, uv1, uv2) = (uvs[idx[0] as usize], uvs[idx[1] as usize], uvs[idx[2] as usize]);
         let (duv1, duv2) = (uv1 - uv0, uv2 - uv0);
         let det = duv1.x * duv2.y - duv1.y * duv2.x;
         if det == 0.0 {
-            edge
+            e1
         } else {
-            ((p1 - p0) * duv2.y - (p2 - p0) * duv1.y) / det
+            (e1 * duv2.y - e2 * duv1.y) / det
         }
     }
 
@@ -611,6 +616,15 @@ pub fn parallelogram_barycentrics(k: u8, st: Vec2) -> Vec2 {
 #[must_use]
 pub fn barycentric_point<R: Real>(p0: V3<R>, e1: V3<R>, e2: V3<R>, b1: R, b2: R) -> V3<R> {
     p0.add(e1.scale(b1)).add(e2.scale(b2))
+}
+
+/// The unit geometric normal of a triangle with edges e₁ = p₁ − p₀ and e₂ = p₂ − p₀ (zero where it is
+/// degenerate), times `sign` (−1 reverses it, for `flip_normals`): [`Mesh::geometric_normal`], which holds
+/// it for each triangle, and the same numbers where a caller has the edges.
+#[inline]
+#[must_use]
+pub fn face_normal(e1: Vec3, e2: Vec3, sign: f32) -> Vec3 {
+    e1.cross(e2).normalize_or_zero() * sign
 }
 
 /// The shading normal at barycentrics (b₁, b₂) of a triangle with vertex normals `n` (as stored; `sign`

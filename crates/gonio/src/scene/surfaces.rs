@@ -22,7 +22,7 @@
 
 use super::{Scene, EMPTY_SLOT};
 use crate::geometry::bvh::{bits, Hits8, LANES};
-use crate::geometry::mesh::{smooth_normal, Triangle8};
+use crate::geometry::mesh::{face_normal, smooth_normal, Triangle8};
 use crate::geometry::ray::{ray_point, RayLanes};
 use crate::geometry::sphere::{sphere_surface, sphere_tangents};
 use crate::geometry::{Ray, Shape, SurfaceInteraction};
@@ -177,25 +177,29 @@ impl Scene {
             let textured = self.textured[r.shape as usize];
             let shape = &self.shapes[r.shape as usize];
             if let Shape::Mesh(mesh) = shape {
-                if let Some(frame) = mesh.flat_frame(r.prim) {
+                if r.smooth {
+                    if let Some(normals) = mesh.vertex_normals(r.prim) {
+                        // Smooth-shaded triangles are never paired into parallelograms, so the slot's edges
+                        // are the triangle's: its normal and ∂p/∂u from them, not from the mesh's records.
+                        debug_assert!(r.corner.is_none());
+                        let (packet, from) = (&self.prims.triangles[slot as usize / LANES], slot as usize % LANES);
+                        smooth.triangles.copy_lane(lane, packet, from);
+                        let [_, e1, e2] = packet.edges(from);
+                        for (rows, n) in smooth.normals.iter_mut().zip(normals) {
+                            rows.set(lane, n);
+                        }
+                        smooth.dp_du.set(lane, mesh.dp_du_of_edges(r.prim, e1, e2));
+                        smooth.sign[lane] = mesh.normal_sign();
+                        out.n.set(lane, face_normal(e1, e2, mesh.normal_sign()));
+                        smooth.lanes |= 1 << lane;
+                        smooth.textured |= u32::from(textured) << lane;
+                        continue;
+                    }
+                } else if let Some(frame) = mesh.flat_frame(r.prim) {
                     flat_uv |= u32::from(textured) << lane;
                     out.set_frame(lane, frame);
                     out.n.set(lane, mesh.geometric_normal(r.prim));
                     flat |= 1 << lane;
-                    continue;
-                }
-                if let Some(normals) = mesh.vertex_normals(r.prim) {
-                    // Smooth-shaded triangles are never paired into parallelograms.
-                    debug_assert!(r.corner.is_none());
-                    smooth.triangles.copy_lane(lane, &self.prims.triangles[slot as usize / LANES], slot as usize % LANES);
-                    for (rows, n) in smooth.normals.iter_mut().zip(normals) {
-                        rows.set(lane, n);
-                    }
-                    smooth.dp_du.set(lane, mesh.dp_du(r.prim));
-                    smooth.sign[lane] = mesh.normal_sign();
-                    out.n.set(lane, mesh.geometric_normal(r.prim));
-                    smooth.lanes |= 1 << lane;
-                    smooth.textured |= u32::from(textured) << lane;
                     continue;
                 }
             }
