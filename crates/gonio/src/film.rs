@@ -308,9 +308,21 @@ impl Film {
     /// returns false.
     #[inline]
     pub fn splat(&mut self, x0: u32, y0: u32, wx: &[f32], wy: &[f32], v: &[f32]) -> bool {
-        debug_assert_eq!(v.len(), self.channels);
+        // The body once, its channel count a constant for the films nearly every render makes (RGB, and
+        // RGB with alpha), so that the per-tap loops over the channels unroll; any count otherwise.
+        match self.channels {
+            3 => self.splat_channels(3, x0, y0, wx, wy, v),
+            4 => self.splat_channels(4, x0, y0, wx, wy, v),
+            k => self.splat_channels(k, x0, y0, wx, wy, v),
+        }
+    }
+
+    /// [`Self::splat`] for `k` = [`Film::channels`].
+    #[inline(always)]
+    fn splat_channels(&mut self, k: usize, x0: u32, y0: u32, wx: &[f32], wy: &[f32], v: &[f32]) -> bool {
+        debug_assert_eq!((v.len(), k), (self.channels, self.channels));
         let finite = v.iter().all(|c| c.is_finite());
-        let (k, width) = (self.channels, self.width as usize);
+        let width = self.width as usize;
         // Only the taps from the first to the last of non-zero weight (the Gaussian has one of weight 0 at
         // one end of each axis); each row's values times its weight once, in groups of up to
         // `SPLAT_GROUP` channels, then one multiply and one add per tap and channel. (2026-12: with a
