@@ -116,8 +116,8 @@ impl Mesh {
             .iter()
             .map(|t| {
                 let [p0, p1, p2] = t.map(|i| positions[i as usize]);
-                let (e1, e2) = (p1 - p0, p2 - p0);
-                (0.5 * e1.cross(e2).length(), face_normal(e1, e2, sign))
+                let cross = (p1 - p0).cross(p2 - p0);
+                (0.5 * cross.length(), face_normal(cross, sign))
             })
             .unzip();
         let area = tri_areas.iter().map(|&a| f64::from(a)).sum::<f64>() as f32;
@@ -618,13 +618,14 @@ pub fn barycentric_point<R: Real>(p0: V3<R>, e1: V3<R>, e2: V3<R>, b1: R, b2: R)
     p0.add(e1.scale(b1)).add(e2.scale(b2))
 }
 
-/// The unit geometric normal of a triangle with edges e₁ = p₁ − p₀ and e₂ = p₂ − p₀ (zero where it is
-/// degenerate), times `sign` (−1 reverses it, for `flip_normals`): [`Mesh::geometric_normal`], which holds
-/// it for each triangle, and the same numbers where a caller has the edges.
+/// The unit geometric normal of a triangle whose edges e₁ = p₁ − p₀ and e₂ = p₂ − p₀ have the cross
+/// product `cross` = e₁ × e₂ (zero where it is degenerate), times `sign` (−1 reverses it, for
+/// `flip_normals`): [`Mesh::geometric_normal`], which holds it for each triangle, and the same numbers
+/// where a caller has the edges.
 #[inline]
 #[must_use]
-pub fn face_normal(e1: Vec3, e2: Vec3, sign: f32) -> Vec3 {
-    e1.cross(e2).normalize_or_zero() * sign
+pub fn face_normal(cross: Vec3, sign: f32) -> Vec3 {
+    cross.normalize_or_zero() * sign
 }
 
 /// The shading normal at barycentrics (b₁, b₂) of a triangle with vertex normals `n` (as stored; `sign`

@@ -250,8 +250,9 @@ impl Primitives {
                 Shape::Mesh(m) => {
                     let k = r.corner.unwrap_or(0);
                     p.triangles[packet].set(lane, m.corner_edges(r.prim, k), r.corner.is_some());
-                    r.smooth = m.flat_frame(r.prim).is_none() && m.vertex_normals(r.prim).is_some();
-                    if textured[r.shape as usize] && m.flat_frame(r.prim).is_some() {
+                    let flat = m.flat_frame(r.prim).is_some();
+                    r.smooth = !flat && m.vertex_normals(r.prim).is_some();
+                    if textured[r.shape as usize] && flat {
                         r.uv_map = p.uv_maps.len() as u32;
                         p.uv_maps.push(m.uv_map(r.prim, k));
                     }

@@ -190,7 +190,7 @@ impl Scene {
                         }
                         smooth.dp_du.set(lane, mesh.dp_du_of_edges(r.prim, e1, e2));
                         smooth.sign[lane] = mesh.normal_sign();
-                        out.n.set(lane, face_normal(e1, e2, mesh.normal_sign()));
+                        out.n.set(lane, face_normal(e1.cross(e2), mesh.normal_sign()));
                         smooth.lanes |= 1 << lane;
                         smooth.textured |= u32::from(textured) << lane;
                         continue;
