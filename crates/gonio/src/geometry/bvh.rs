@@ -39,6 +39,7 @@ use super::ray::RayLanes;
 use super::{Bounds3, Ray};
 use crate::math::simd::{Float8, Mask8};
 use glam::{Vec3, Vec3A};
+use rayon::prelude::*;
 use std::mem::MaybeUninit;
 
 /// Primitives per packet, and the number of children of a node.
@@ -148,9 +149,17 @@ impl BuildBox {
         Bounds3 { min: self.min.into(), max: self.max.into() }
     }
 
+    /// [`Bounds3::surface_area`] (the same operations, so the same value bit for bit) without converting
+    /// the corners out of their registers: the SAH sweep takes 96 areas a node.
     #[inline(always)]
     fn surface_area(&self) -> f32 {
-        self.to_bounds().surface_area()
+        // For finite corners, max − min < 0 exactly where min > max (Bounds3::is_empty); the empty box's
+        // −∞ − ∞ is −∞.
+        let d = self.max - self.min;
+        if d.cmplt(Vec3A::ZERO).any() {
+            return 0.0;
+        }
+        2.0 * (d.x * d.y + d.y * d.z + d.z * d.x)
     }
 }
 
@@ -233,7 +242,7 @@ impl Bvh {
     pub fn build_costed(bounds: &[Bounds3], alone: &[bool]) -> Bvh {
         debug_assert!(bounds.iter().all(|b| b.min.is_finite() && b.max.is_finite()), "primitive bounds must be finite");
         let mut prims: Vec<BuildPrim> =
-            bounds.iter().enumerate().map(|(i, b)| BuildPrim::new(b, i as u32, alone.get(i).copied().unwrap_or(false))).collect();
+            bounds.par_iter().enumerate().map(|(i, b)| BuildPrim::new(b, i as u32, alone.get(i).copied().unwrap_or(false))).collect();
         if prims.is_empty() {
             return Bvh::default();
         }
@@ -880,13 +889,17 @@ fn sah_split(prims: &mut [BuildPrim], bounds: &BuildBox, cbounds: &BuildBox) -> 
     }
     let axes = &axes[..axis_count];
     let (lo, scale) = (cbounds.min, Vec3A::splat(BINS as f32) / (cbounds.max - cbounds.min));
-    let bin_of = |c: Vec3A, axis: usize| (((c[axis] - lo[axis]) * scale[axis]) as usize).min(BINS - 1);
+    // A centroid's bin along each axis, all three in one vector: ⌊(c − lo) · scale⌋ clamped to the bins
+    // (a NaN, from an axis not binned or a scale that overflowed, to bin 0: `max` returns its second
+    // operand where either is NaN), so the conversion to integers needs no saturation.
+    let last = Vec3A::splat((BINS - 1) as f32);
+    let bins_of = |c: Vec3A| ((c - lo) * scale).max(Vec3A::ZERO).min(last).as_ivec3().to_array().map(|b| b as usize);
     // One pass over the primitives bins them along every axis binned.
     let mut bins = [Bins { counts: [0; BINS], alone: [0; BINS], bounds: [BuildBox::EMPTY; BINS] }; 3];
     for p in prims.iter() {
-        let c = p.centroid();
+        let b3 = bins_of(p.centroid());
         for &axis in axes {
-            let b = bin_of(c, axis);
+            let b = b3[axis];
             let bins = &mut bins[axis];
             bins.counts[b] += 1;
             bins.alone[b] += usize::from(p.alone);
@@ -933,18 +946,46 @@ fn sah_split(prims: &mut [BuildPrim], bounds: &BuildBox, cbounds: &BuildBox) -> 
     let side_box = |range: std::ops::Range<usize>| bins[axis].bounds[range].iter().fold(BuildBox::EMPTY, |a, &b| a.union(b));
     let (left_box, right_box) = (side_box(0..boundary), side_box(boundary..BINS));
     let (mut left_c, mut right_c) = (BuildBox::EMPTY, BuildBox::EMPTY);
-    let mut mid = 0;
-    for i in 0..prims.len() {
-        let c = prims[i].centroid();
-        if bin_of(c, axis) < boundary {
+    let (lo, scale) = (lo[axis], scale[axis]);
+    let along = |c: Vec3A| match axis {
+        0 => c.x,
+        1 => c.y,
+        _ => c.z,
+    };
+    // Bin ⌊x⌋ (clamped to the bins, NaN to bin 0) is below the boundary b ∈ 1..BINS exactly where x < b
+    // or x is NaN.
+    let left_of = |c: Vec3A| {
+        let x = (along(c) - lo) * scale;
+        x < boundary as f32 || x.is_nan()
+    };
+    // Hoare's partition from both ends: only the primitives on the wrong side move (the SAH's sides of
+    // spatially ordered triangles mostly are in place), where a one-ended pass moved every left one.
+    // The centroid boxes take every primitive once it is known in place.
+    let (mut i, mut j) = (0, prims.len());
+    loop {
+        while i < j {
+            let c = prims[i].centroid();
+            if !left_of(c) {
+                break;
+            }
             left_c = left_c.with_point(c);
-            prims.swap(i, mid);
-            mid += 1;
-        } else {
-            right_c = right_c.with_point(c);
+            i += 1;
         }
+        while i < j {
+            let c = prims[j - 1].centroid();
+            if left_of(c) {
+                break;
+            }
+            right_c = right_c.with_point(c);
+            j -= 1;
+        }
+        if i == j {
+            break;
+        }
+        // prims[i] belongs right and prims[j − 1] left.
+        prims.swap(i, j - 1);
     }
-    Some(Split { mid, sides: [(left_box, left_c), (right_box, right_c)] })
+    Some(Split { mid: i, sides: [(left_box, left_c), (right_box, right_c)] })
 }
 
 /// Split at the median centroid along `axis` (when the SAH cannot separate a large set).

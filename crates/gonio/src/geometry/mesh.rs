@@ -22,6 +22,7 @@ use crate::math::simd::{Float8, Mask8};
 use crate::math::{Frame, Transform};
 use crate::sampling::distribution::Distribution1D;
 use glam::{Vec2, Vec3};
+use rayon::prelude::*;
 
 /// The most a flat-shaded triangle's unit vertex normals differ, per component ([`Mesh::flat_frames`]):
 /// about eight roundings of 1, what computing one normal of a plane from different triangles of it gives.
@@ -65,17 +66,36 @@ impl Mesh {
         flip_normals: bool,
         at: &str,
     ) -> Result<Mesh> {
-        let mut mesh = Mesh::new(positions, normals, uvs, indices, to_world, face_normals, flip_normals, at)?;
+        let mut mesh = Mesh::without_frames(positions, normals, uvs, indices, to_world, face_normals, flip_normals, at)?;
         if !face_normals && mesh.normals.is_none() {
             mesh.normals = Some(angle_weighted_normals(&mesh.positions, &mesh.indices));
-            mesh.update_flat_frames();
         }
+        mesh.update_flat_frames();
         Ok(mesh)
     }
 
     /// A mesh from object-space data. `at` names the shape in errors (bad indices, non-finite vertices).
     #[allow(clippy::too_many_arguments)] // one argument per plugin parameter, as in the table above
     pub fn new(
+        positions: Vec<Vec3>,
+        normals: Option<Vec<Vec3>>,
+        uvs: Option<Vec<Vec2>>,
+        indices: Vec<[u32; 3]>,
+        to_world: &Transform,
+        face_normals: bool,
+        flip_normals: bool,
+        at: &str,
+    ) -> Result<Mesh> {
+        let mut mesh = Mesh::without_frames(positions, normals, uvs, indices, to_world, face_normals, flip_normals, at)?;
+        mesh.update_flat_frames();
+        Ok(mesh)
+    }
+
+    /// [`Mesh::new`] but for its flat frames, which depend on the vertex normals a caller may yet compute
+    /// (2026-12: a mesh file's 10⁶ triangles had their frames made twice, first as if all were flat).
+    /// The per-vertex and per-triangle work is done in parallel.
+    #[allow(clippy::too_many_arguments)] // one argument per plugin parameter, as in the table above
+    fn without_frames(
         positions: Vec<Vec3>,
         normals: Option<Vec<Vec3>>,
         uvs: Option<Vec<Vec2>>,
@@ -92,7 +112,7 @@ impl Mesh {
         if indices.is_empty() {
             return Err(Error::spec(at, "mesh has no triangles"));
         }
-        let positions: Vec<Vec3> = positions.iter().map(|&p| to_world.point(p)).collect();
+        let positions: Vec<Vec3> = positions.par_iter().map(|&p| to_world.point(p)).collect();
         if positions.iter().any(|p| !p.is_finite()) {
             return Err(Error::spec(at, "mesh has non-finite vertex positions"));
         }
@@ -100,7 +120,7 @@ impl Mesh {
             None
         } else {
             match normals {
-                Some(ns) if ns.len() == n => Some(ns.iter().map(|&v| to_world.normal(v).normalize_or_zero()).collect()),
+                Some(ns) if ns.len() == n => Some(ns.par_iter().map(|&v| to_world.normal(v).normalize_or_zero()).collect()),
                 Some(ns) => return Err(Error::spec(at, format!("mesh has {} normals for {n} vertices", ns.len()))),
                 None => None,
             }
@@ -113,7 +133,7 @@ impl Mesh {
         };
         let sign = if flip_normals { -1.0 } else { 1.0 };
         let (tri_areas, tri_normals): (Vec<f32>, Vec<Vec3>) = indices
-            .iter()
+            .par_iter()
             .map(|t| {
                 let [p0, p1, p2] = t.map(|i| positions[i as usize]);
                 let cross = (p1 - p0).cross(p2 - p0);
@@ -121,7 +141,7 @@ impl Mesh {
             })
             .unzip();
         let area = tri_areas.iter().map(|&a| f64::from(a)).sum::<f64>() as f32;
-        let mut mesh = Mesh {
+        Ok(Mesh {
             positions,
             normals,
             uvs,
@@ -132,9 +152,7 @@ impl Mesh {
             tri_normals,
             flat_frames: Vec::new(),
             attributes: Vec::new(),
-        };
-        mesh.update_flat_frames();
-        Ok(mesh)
+        })
     }
 
     /// The mesh with the per-vertex attributes `attributes` (a PLY file's, each `dim` values per vertex).
@@ -180,7 +198,7 @@ impl Mesh {
     fn update_flat_frames(&mut self) {
         let n = self.indices.len();
         // A smooth mesh (a scanned or subdivided model, most often) keeps no table at all.
-        if !(0..n).any(|t| self.flat_shading_normal(t).is_some()) {
+        if !(0..n).into_par_iter().any(|t| self.flat_shading_normal(t).is_some()) {
             self.flat_frames = Vec::new();
             return;
         }
@@ -192,7 +210,7 @@ impl Mesh {
                 _ => self.shading_frame(t as u32, shading),
             })
         };
-        self.flat_frames = (0..n).map(frame).collect();
+        self.flat_frames = (0..n).into_par_iter().map(frame).collect();
     }
 
     /// The shading normal of triangle `t` where it is flat-shaded ([`Mesh::flat_frames`]): the geometric
@@ -653,17 +671,26 @@ pub fn uniform_triangle_point<R: Real>(p0: V3<R>, p1: V3<R>, p2: V3<R>, ux: R, u
 /// Vertex normals as the angle-weighted mean of the adjacent face normals (world space, unit length;
 /// a vertex of degenerate faces only gets the zero vector, and shading falls back to the face normal).
 fn angle_weighted_normals(positions: &[Vec3], indices: &[[u32; 3]]) -> Vec<Vec3> {
+    // Each triangle's three terms in parallel (the arc cosines are most of the work), then summed per
+    // vertex in triangle order, as one pass would.
+    let terms: Vec<Option<[Vec3; 3]>> = indices
+        .par_iter()
+        .map(|tri| {
+            let p = tri.map(|i| positions[i as usize]);
+            let n = (p[1] - p[0]).cross(p[2] - p[0]).try_normalize()?;
+            Some(std::array::from_fn(|k| {
+                let (a, b) = ((p[(k + 1) % 3] - p[k]).normalize_or_zero(), (p[(k + 2) % 3] - p[k]).normalize_or_zero());
+                n * a.dot(b).clamp(-1.0, 1.0).acos()
+            }))
+        })
+        .collect();
     let mut normals = vec![Vec3::ZERO; positions.len()];
-    for tri in indices {
-        let p = tri.map(|i| positions[i as usize]);
-        let Some(n) = (p[1] - p[0]).cross(p[2] - p[0]).try_normalize() else { continue };
-        for k in 0..3 {
-            let (a, b) = ((p[(k + 1) % 3] - p[k]).normalize_or_zero(), (p[(k + 2) % 3] - p[k]).normalize_or_zero());
-            let angle = a.dot(b).clamp(-1.0, 1.0).acos();
-            normals[tri[k] as usize] += n * angle;
+    for (tri, terms) in indices.iter().zip(&terms) {
+        for (&i, &term) in tri.iter().zip(terms.iter().flatten()) {
+            normals[i as usize] += term;
         }
     }
-    normals.iter().map(|n| n.normalize_or_zero()).collect()
+    normals.par_iter().map(|n| n.normalize_or_zero()).collect()
 }
 
 /// Möller–Trumbore for the triangle p₀ + b₁ e₁ + b₂ e₂; the hit's `uv` holds (b₁, b₂).
