@@ -66,12 +66,7 @@ impl Mesh {
         flip_normals: bool,
         at: &str,
     ) -> Result<Mesh> {
-        let mut mesh = Mesh::without_frames(positions, normals, uvs, indices, to_world, face_normals, flip_normals, at)?;
-        if !face_normals && mesh.normals.is_none() {
-            mesh.normals = Some(angle_weighted_normals(&mesh.positions, &mesh.indices));
-        }
-        mesh.update_flat_frames();
-        Ok(mesh)
+        Mesh::build(positions, normals, uvs, indices, to_world, face_normals, flip_normals, at, true)
     }
 
     /// A mesh from object-space data. `at` names the shape in errors (bad indices, non-finite vertices).
@@ -86,16 +81,15 @@ impl Mesh {
         flip_normals: bool,
         at: &str,
     ) -> Result<Mesh> {
-        let mut mesh = Mesh::without_frames(positions, normals, uvs, indices, to_world, face_normals, flip_normals, at)?;
-        mesh.update_flat_frames();
-        Ok(mesh)
+        Mesh::build(positions, normals, uvs, indices, to_world, face_normals, flip_normals, at, false)
     }
 
-    /// [`Mesh::new`] but for its flat frames, which depend on the vertex normals a caller may yet compute
-    /// (2026-12: a mesh file's 10⁶ triangles had their frames made twice, first as if all were flat).
+    /// [`Mesh::new`], and with `smooth_if_missing` [`Mesh::from_file_data`]: the vertex normals computed
+    /// where none are given (and `face_normals` is off) before the flat frames, which depend on them
+    /// (2026-12: a mesh file's 10⁶ triangles had had their frames made twice, first as if all were flat).
     /// The per-vertex and per-triangle work is done in parallel.
     #[allow(clippy::too_many_arguments)] // one argument per plugin parameter, as in the table above
-    fn without_frames(
+    fn build(
         positions: Vec<Vec3>,
         normals: Option<Vec<Vec3>>,
         uvs: Option<Vec<Vec2>>,
@@ -104,6 +98,7 @@ impl Mesh {
         face_normals: bool,
         flip_normals: bool,
         at: &str,
+        smooth_if_missing: bool,
     ) -> Result<Mesh> {
         let n = positions.len();
         if let Some(bad) = indices.iter().flatten().find(|&&i| i as usize >= n) {
@@ -122,6 +117,7 @@ impl Mesh {
             match normals {
                 Some(ns) if ns.len() == n => Some(ns.par_iter().map(|&v| to_world.normal(v).normalize_or_zero()).collect()),
                 Some(ns) => return Err(Error::spec(at, format!("mesh has {} normals for {n} vertices", ns.len()))),
+                None if smooth_if_missing => Some(angle_weighted_normals(&positions, &indices)),
                 None => None,
             }
         };
@@ -141,7 +137,7 @@ impl Mesh {
             })
             .unzip();
         let area = tri_areas.iter().map(|&a| f64::from(a)).sum::<f64>() as f32;
-        Ok(Mesh {
+        let mut mesh = Mesh {
             positions,
             normals,
             uvs,
@@ -152,7 +148,9 @@ impl Mesh {
             tri_normals,
             flat_frames: Vec::new(),
             attributes: Vec::new(),
-        })
+        };
+        mesh.update_flat_frames();
+        Ok(mesh)
     }
 
     /// The mesh with the per-vertex attributes `attributes` (a PLY file's, each `dim` values per vertex).

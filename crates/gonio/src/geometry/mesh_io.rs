@@ -597,13 +597,20 @@ fn read_ply_vertices(body: &mut PlyBody, element: &Element, mesh: &mut MeshData)
     let has_normals = present[3..6].iter().all(|&b| b);
     let has_uvs = present[6..8].iter().all(|&b| b);
 
-    // The other scalar properties, grouped into attributes: per property its attribute, or none.
+    // Where each property's value goes, decided once rather than by its name per vertex: a slot of
+    // `values`, or one of the other scalar properties' attributes, which group them (and whether it is an
+    // integer colour, in 0..=255).
+    enum Sink {
+        Slot(usize),
+        Attribute(usize, bool),
+        Nowhere,
+    }
     let mut attributes: Vec<VertexAttribute> = Vec::new();
-    let mut feeds: Vec<Option<usize>> = Vec::with_capacity(element.properties.len());
+    let mut sinks: Vec<Sink> = Vec::with_capacity(element.properties.len());
     let mut last_prefix: Option<&str> = None;
     for p in &element.properties {
         match p {
-            Property::Scalar { name, .. } if slot(name).is_none() => {
+            Property::Scalar { name, ty } if slot(name).is_none() => {
                 let prefix = attribute_prefix(name);
                 if last_prefix != Some(prefix) || attributes.last().is_some_and(|a| a.dim == 4) {
                     attributes.push(VertexAttribute { name: format!("vertex_{prefix}"), dim: 0, values: Vec::new() });
@@ -611,11 +618,15 @@ fn read_ply_vertices(body: &mut PlyBody, element: &Element, mesh: &mut MeshData)
                 last_prefix = Some(prefix);
                 let a = attributes.len() - 1;
                 attributes[a].dim += 1;
-                feeds.push(Some(a));
+                let colour = attributes[a].name == "vertex_color" && !matches!(ty, Scalar::F32 | Scalar::F64);
+                sinks.push(Sink::Attribute(a, colour));
             }
             _ => {
                 last_prefix = None;
-                feeds.push(None);
+                sinks.push(match p {
+                    Property::Scalar { name, .. } => slot(name).map_or(Sink::Nowhere, Sink::Slot),
+                    Property::List { .. } => Sink::Nowhere,
+                });
             }
         }
     }
@@ -630,26 +641,6 @@ fn read_ply_vertices(body: &mut PlyBody, element: &Element, mesh: &mut MeshData)
     for a in &mut attributes {
         a.values.reserve(n * a.dim);
     }
-    // Where each property's value goes, decided once rather than by its name per vertex: a slot of
-    // `values`, or an attribute (and whether it is an integer colour, in 0..=255).
-    enum Sink {
-        Slot(usize),
-        Attribute(usize, bool),
-        Nowhere,
-    }
-    let sinks: Vec<Sink> = element
-        .properties
-        .iter()
-        .zip(&feeds)
-        .map(|(p, feed)| match (p, feed) {
-            (Property::Scalar { name, ty }, feed) => match (slot(name), feed) {
-                (Some(s), _) => Sink::Slot(s),
-                (None, Some(a)) => Sink::Attribute(*a, attributes[*a].name == "vertex_color" && !matches!(ty, Scalar::F32 | Scalar::F64)),
-                (None, None) => Sink::Nowhere,
-            },
-            (Property::List { .. }, _) => Sink::Nowhere,
-        })
-        .collect();
     for i in 0..n {
         let at = body.next_at();
         let mut values = [0.0f32; 8];
