@@ -583,20 +583,6 @@ fn read_ply_vertices(body: &mut PlyBody, element: &Element, mesh: &mut MeshData)
             _ => return None,
         })
     };
-    let mut present = [false; 8];
-    for p in &element.properties {
-        if let Property::Scalar { name, .. } = p {
-            if let Some(s) = slot(name) {
-                present[s] = true;
-            }
-        }
-    }
-    if !present[..3].iter().all(|&b| b) {
-        return Err(Error::format(body.path, "header", "the vertex element lacks one of x, y, z"));
-    }
-    let has_normals = present[3..6].iter().all(|&b| b);
-    let has_uvs = present[6..8].iter().all(|&b| b);
-
     // Where each property's value goes, decided once rather than by its name per vertex: a slot of
     // `values`, or one of the other scalar properties' attributes, which group them (and whether it is an
     // integer colour, in 0..=255).
@@ -607,29 +593,44 @@ fn read_ply_vertices(body: &mut PlyBody, element: &Element, mesh: &mut MeshData)
     }
     let mut attributes: Vec<VertexAttribute> = Vec::new();
     let mut sinks: Vec<Sink> = Vec::with_capacity(element.properties.len());
+    // Consecutive properties of one prefix form an attribute; any other property between them ends it.
     let mut last_prefix: Option<&str> = None;
     for p in &element.properties {
-        match p {
-            Property::Scalar { name, ty } if slot(name).is_none() => {
-                let prefix = attribute_prefix(name);
-                if last_prefix != Some(prefix) || attributes.last().is_some_and(|a| a.dim == 4) {
-                    attributes.push(VertexAttribute { name: format!("vertex_{prefix}"), dim: 0, values: Vec::new() });
+        let sink = match p {
+            Property::Scalar { name, ty } => match slot(name) {
+                Some(s) => {
+                    last_prefix = None;
+                    Sink::Slot(s)
                 }
-                last_prefix = Some(prefix);
-                let a = attributes.len() - 1;
-                attributes[a].dim += 1;
-                let colour = attributes[a].name == "vertex_color" && !matches!(ty, Scalar::F32 | Scalar::F64);
-                sinks.push(Sink::Attribute(a, colour));
-            }
-            _ => {
+                None => {
+                    let prefix = attribute_prefix(name);
+                    if last_prefix != Some(prefix) || attributes.last().is_some_and(|a| a.dim == 4) {
+                        attributes.push(VertexAttribute { name: format!("vertex_{prefix}"), dim: 0, values: Vec::new() });
+                    }
+                    last_prefix = Some(prefix);
+                    let a = attributes.len() - 1;
+                    attributes[a].dim += 1;
+                    Sink::Attribute(a, attributes[a].name == "vertex_color" && !matches!(ty, Scalar::F32 | Scalar::F64))
+                }
+            },
+            Property::List { .. } => {
                 last_prefix = None;
-                sinks.push(match p {
-                    Property::Scalar { name, .. } => slot(name).map_or(Sink::Nowhere, Sink::Slot),
-                    Property::List { .. } => Sink::Nowhere,
-                });
+                Sink::Nowhere
             }
+        };
+        sinks.push(sink);
+    }
+    let mut present = [false; 8];
+    for sink in &sinks {
+        if let Sink::Slot(s) = *sink {
+            present[s] = true;
         }
     }
+    if !present[..3].iter().all(|&b| b) {
+        return Err(Error::format(body.path, "header", "the vertex element lacks one of x, y, z"));
+    }
+    let has_normals = present[3..6].iter().all(|&b| b);
+    let has_uvs = present[6..8].iter().all(|&b| b);
     if let Some(twice) = attributes.iter().enumerate().find(|(i, a)| attributes[..*i].iter().any(|b| b.name == a.name)) {
         return Err(Error::format(body.path, "header", format!("the vertex attribute `{}` is given twice", twice.1.name)));
     }
