@@ -182,11 +182,11 @@ impl RayPre {
     fn new(ray: &Ray) -> Self {
         let inv_d = ray.d.recip();
         let near = |axis: usize| usize::from(inv_d[axis].is_sign_negative());
-        let row = |side: usize, axis: usize| Node8::row_offset(side, axis);
+        let offset = Node8::row_offset;
         RayPre {
             o: [Float8::splat(ray.o.x), Float8::splat(ray.o.y), Float8::splat(ray.o.z)],
             inv_d: [Float8::splat(inv_d.x), Float8::splat(inv_d.y), Float8::splat(inv_d.z)],
-            rows: [std::array::from_fn(|a| row(near(a), a)), std::array::from_fn(|a| row(1 - near(a), a))],
+            rows: [std::array::from_fn(|a| offset(near(a), a)), std::array::from_fn(|a| offset(1 - near(a), a))],
         }
     }
 }
